@@ -1,1 +1,168 @@
-fn main(){}
+//! `motorgen`: design motor-controller constants from a motor TOML file.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use codegen::{Diagnostic, Diagnostics};
+
+/// Motor description (TOML) → tuned motor-controller constants.
+#[derive(Parser)]
+#[command(name = "motorgen", version, about)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the whole design of one motor.
+    Design {
+        /// The motor spec, e.g. motors/fischer-ti085.toml.
+        spec: PathBuf,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = Format::Summary)]
+        format: Format,
+    },
+    /// Validate specs; exit non-zero if any has a problem.
+    Check {
+        /// One or more motor specs.
+        #[arg(required = true)]
+        specs: Vec<PathBuf>,
+    },
+    /// List the motors in a directory (default: motors/).
+    List {
+        /// Directory of motor specs.
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Format {
+    /// Human-readable headline constants.
+    Summary,
+    /// The complete design as JSON (SI units).
+    Json,
+}
+
+/// Reads a spec as UTF-8 text, or a diagnostic naming the file.
+fn read_spec(path: &Path) -> Result<String, Diagnostics> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| {
+        Diagnostics(vec![Diagnostic {
+            file: file.clone(),
+            line: 1,
+            column: 1,
+            key: String::new(),
+            problem: format!("cannot read the file: {e}"),
+            accepted: "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)".into(),
+            excerpt: String::new(),
+        }])
+    })?;
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let text = String::from_utf8_lossy(e.as_bytes());
+        codegen::Source {
+            file: &file,
+            text: &text,
+        }
+        .error(
+            at..at,
+            "",
+            format!("the file is not valid UTF-8 (byte {at})"),
+            "a UTF-8 text file; save the spec as UTF-8",
+        )
+        .into()
+    })
+}
+
+fn design(path: &Path) -> Result<codegen::Design, Diagnostics> {
+    let text = read_spec(path)?;
+    codegen::design_source(&path.display().to_string(), &text)
+}
+
+/// `motors/` in the working directory, else the one in this repository.
+fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
+    dir.unwrap_or_else(|| {
+        let here = PathBuf::from("motors");
+        if here.is_dir() {
+            here
+        } else {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("motors")
+        }
+    })
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Design { spec, format } => match design(&spec) {
+            Ok(d) => {
+                let out = match format {
+                    Format::Summary => codegen::summary::summary(&d),
+                    Format::Json => match serde_json::to_string_pretty(&d) {
+                        Ok(s) => s + "\n",
+                        Err(e) => {
+                            eprintln!("error: cannot serialise the design: {e}");
+                            return ExitCode::FAILURE;
+                        }
+                    },
+                };
+                print!("{out}");
+                ExitCode::SUCCESS
+            }
+            Err(e) => {
+                eprint!("{e}");
+                ExitCode::FAILURE
+            }
+        },
+        Command::Check { specs } => {
+            let mut ok = true;
+            for path in &specs {
+                match design(path) {
+                    Ok(d) => {
+                        println!("ok: {} ({})", path.display(), d.name);
+                        for w in &d.warnings {
+                            println!("  warning: {w}");
+                        }
+                    }
+                    Err(e) => {
+                        ok = false;
+                        eprint!("{e}");
+                    }
+                }
+            }
+            if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+        }
+        Command::List { dir } => {
+            let dir = motors_dir(dir);
+            let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {
+                Ok(rd) => rd
+                    .filter_map(|e| e.ok().map(|e| e.path()))
+                    .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                    .collect(),
+                Err(e) => {
+                    eprintln!("error: cannot read {}: {e}", dir.display());
+                    return ExitCode::FAILURE;
+                }
+            };
+            entries.sort();
+            for path in entries {
+                let stem = path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                match design(&path) {
+                    Ok(d) => println!("{stem:<24} {}", d.name),
+                    Err(e) => println!(
+                        "{stem:<24} INVALID ({} problem{})",
+                        e.0.len(),
+                        if e.0.len() == 1 { "" } else { "s" }
+                    ),
+                }
+            }
+            ExitCode::SUCCESS
+        }
+    }
+}

@@ -1,0 +1,357 @@
+//! Physical quantities written as `"<value> <unit>"` strings, parsed with `uom`.
+//!
+//! Typed quantities end here: every parser returns the value in SI base units
+//! as `f64`, and callers name their fields with the unit (`_ohm`, `_h`, …).
+//! A bare number is never accepted where a quantity belongs, so `0.0012`
+//! cannot silently mean henries.
+
+use std::str::FromStr;
+use uom::si::f64 as q;
+
+/// What kind of quantity a key holds; decides the accepted units.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// Ω.
+    Resistance,
+    /// H.
+    Inductance,
+    /// Wb (flux linkage).
+    FluxLinkage,
+    /// A.
+    Current,
+    /// V.
+    Voltage,
+    /// Hz.
+    Frequency,
+    /// rad/s or rpm (speed).
+    Speed,
+    /// rad/s, or Hz taken as 2π·f (bandwidths, natural frequencies).
+    AngularFrequency,
+    /// N·m.
+    Torque,
+    /// °C or K, returned in °C.
+    TemperatureCelsius,
+    /// F.
+    Capacitance,
+    /// J.
+    Energy,
+    /// W.
+    Power,
+    /// s.
+    Time,
+    /// dB, returned in dB (positive = attenuation).
+    Decibel,
+    /// N·m/A, returned in N·m/A.
+    TorqueConstant,
+    /// V·s/rad (per rad/s), V/krpm or V/rpm, returned in V·s/rad.
+    BackEmfConstant,
+    /// kg·m².
+    Inertia,
+    /// N·m·s/rad (viscous friction b).
+    ViscousFriction,
+}
+
+impl Kind {
+    /// Human name of the dimension.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Resistance => "a resistance",
+            Kind::Inductance => "an inductance",
+            Kind::FluxLinkage => "a flux linkage",
+            Kind::Current => "a current",
+            Kind::Voltage => "a voltage",
+            Kind::Frequency => "a frequency",
+            Kind::Speed => "a speed",
+            Kind::AngularFrequency => "an angular frequency",
+            Kind::Torque => "a torque",
+            Kind::TemperatureCelsius => "a temperature",
+            Kind::Capacitance => "a capacitance",
+            Kind::Energy => "an energy",
+            Kind::Power => "a power",
+            Kind::Time => "a time",
+            Kind::Decibel => "a level in decibels",
+            Kind::TorqueConstant => "a torque constant",
+            Kind::BackEmfConstant => "a back-EMF constant",
+            Kind::Inertia => "a moment of inertia",
+            Kind::ViscousFriction => "a viscous friction coefficient",
+        }
+    }
+
+    /// What a user may write, with an example.
+    pub fn accepted(self) -> &'static str {
+        match self {
+            Kind::Resistance => "a resistance such as \"0.126 Ω\" (units: Ω, mΩ, µΩ, kΩ, ohm, mohm)",
+            Kind::Inductance => "an inductance such as \"0.393 mH\" (units: H, mH, µH, uH, nH, henry)",
+            Kind::FluxLinkage => "a flux linkage such as \"60 mWb\" (units: Wb, mWb, µWb, V·s)",
+            Kind::Current => "a current such as \"22.6 A\" (units: A, mA, kA)",
+            Kind::Voltage => "a voltage such as \"600 V\" (units: V, mV, kV)",
+            Kind::Frequency => "a frequency such as \"20 kHz\" (units: Hz, kHz, MHz)",
+            Kind::Speed => "a speed such as \"20000 rpm\" or \"2094 rad/s\" (units: rpm, krpm, rad/s)",
+            Kind::AngularFrequency => {
+                "an angular frequency such as \"100 rad/s\" (units: rad/s; Hz, kHz are taken as 2π·f)"
+            }
+            Kind::Torque => "a torque such as \"11.1 N·m\" (units: N·m, Nm, N m)",
+            Kind::TemperatureCelsius => "a temperature such as \"20 °C\" (units: °C, degC, K)",
+            Kind::Capacitance => "a capacitance such as \"5 pF\" (units: F, µF, nF, pF)",
+            Kind::Energy => "an energy such as \"306 mJ\" (units: J, mJ, µJ)",
+            Kind::Power => "a power such as \"50 kW\" (units: W, kW)",
+            Kind::Time => "a time such as \"1.5 ms\" (units: s, ms, µs, ns)",
+            Kind::Decibel => "a level in decibels such as \"40 dB\"",
+            Kind::TorqueConstant => "a torque constant such as \"0.492 N·m/A\" (units: N·m/A, Nm/A)",
+            Kind::BackEmfConstant => {
+                "a back-EMF constant such as \"0.296 V·s/rad\" (units: V·s/rad, V/(rad/s), V/krpm, V/rpm, mV/rpm)"
+            }
+            Kind::Inertia => "a moment of inertia such as \"0.01 kg·m²\" (units: kg·m², kg m^2)",
+            Kind::ViscousFriction => "a viscous friction coefficient such as \"0.001 N·m·s/rad\"",
+        }
+    }
+}
+
+/// Why a quantity string was refused.
+#[derive(Debug, Clone, PartialEq)]
+pub struct UnitError {
+    /// What is wrong.
+    pub problem: String,
+}
+
+/// Splits `"0.126 Ω"` (or `"0.126Ω"`) into the number and the trimmed unit.
+fn split(text: &str) -> Result<(f64, String), UnitError> {
+    let t = text.trim();
+    let end = t
+        .char_indices()
+        .find(|&(i, c)| {
+            !(c.is_ascii_digit()
+                || c == '.'
+                || ((c == '-' || c == '+') && (i == 0 || t[..i].ends_with(['e', 'E'])))
+                || ((c == 'e' || c == 'E')
+                    && i > 0
+                    && t[i + 1..].starts_with(|n: char| n.is_ascii_digit() || n == '-' || n == '+')))
+        })
+        .map_or(t.len(), |(i, _)| i);
+    let (number, unit) = t.split_at(end);
+    let unit = unit.trim();
+    if number.is_empty() {
+        let word = unit.split_whitespace().next().unwrap_or("");
+        let lower = word.to_ascii_lowercase();
+        if matches!(lower.as_str(), "nan" | "inf" | "+inf" | "-inf" | "infinity") {
+            return Err(UnitError {
+                problem: format!("\"{text}\" is not a finite number"),
+            });
+        }
+        return Err(UnitError {
+            problem: format!("\"{text}\" does not start with a number"),
+        });
+    }
+    let value: f64 = number.parse().map_err(|_| UnitError {
+        problem: format!("\"{number}\" in \"{text}\" is not a number"),
+    })?;
+    if unit.is_empty() {
+        return Err(UnitError {
+            problem: format!("\"{text}\" has no unit; write the unit after the number"),
+        });
+    }
+    Ok((value, normalise(unit)))
+}
+
+/// Canonical spellings: the micro sign, `u` for micro, `ohm`, `N·m`.
+fn normalise(unit: &str) -> String {
+    let mut u = unit.replace('\u{03BC}', "\u{00B5}"); // Greek mu → micro sign
+    for (from, to) in [
+        ("Ohm", "Ω"),
+        ("ohms", "Ω"),
+        ("ohm", "Ω"),
+        ("N·m", "N · m"),
+        ("N*m", "N · m"),
+        ("N.m", "N · m"),
+        ("Nm", "N · m"),
+        ("degC", "°C"),
+        ("deg C", "°C"),
+        ("kg·m²", "kg · m²"),
+        ("kg m^2", "kg · m²"),
+        ("kg·m^2", "kg · m²"),
+        ("r/min", "rpm"),
+        ("RPM", "rpm"),
+    ] {
+        u = u.replace(from, to);
+    }
+    if u == "N m" {
+        u = "N · m".to_string();
+    }
+    // `uH`, `uWb`, `us`, … : a leading ASCII `u` before a unit letter means micro.
+    if let Some(rest) = u.strip_prefix('u')
+        && rest.starts_with(|c: char| c.is_ascii_uppercase() || c == 's' || c == 'Ω') {
+            u = format!("µ{rest}");
+        }
+    u
+}
+
+fn via_uom<Q: FromStr>(value: f64, unit: &str) -> Option<Q> {
+    format!("{value:e} {unit}").parse::<Q>().ok()
+}
+
+/// Parses `text` as a quantity of `kind`, returning its value in SI units
+/// (°C for temperatures, dB for decibels, N·m/A and V·s/rad for the motor constants).
+pub fn parse(kind: Kind, text: &str) -> Result<f64, UnitError> {
+    use uom::si::{
+        angular_velocity::radian_per_second, capacitance::farad, electric_current::ampere, electric_potential::volt,
+        electrical_resistance::ohm, energy::joule, frequency::hertz, inductance::henry, magnetic_flux::weber,
+        moment_of_inertia::kilogram_square_meter, power::watt, thermodynamic_temperature::degree_celsius, time::second,
+        torque::newton_meter,
+    };
+    let (value, unit) = split(text)?;
+    if !value.is_finite() {
+        return Err(UnitError {
+            problem: format!("\"{text}\" is not a finite number"),
+        });
+    }
+    let si = match kind {
+        Kind::Resistance => via_uom::<q::ElectricalResistance>(value, &unit).map(|v| v.get::<ohm>()),
+        Kind::Inductance => via_uom::<q::Inductance>(value, &unit).map(|v| v.get::<henry>()),
+        Kind::FluxLinkage => match unit.as_str() {
+            "V·s" | "Vs" | "V s" => Some(value),
+            _ => via_uom::<q::MagneticFlux>(value, &unit).map(|v| v.get::<weber>()),
+        },
+        Kind::Current => via_uom::<q::ElectricCurrent>(value, &unit).map(|v| v.get::<ampere>()),
+        Kind::Voltage => via_uom::<q::ElectricPotential>(value, &unit).map(|v| v.get::<volt>()),
+        Kind::Frequency => via_uom::<q::Frequency>(value, &unit).map(|v| v.get::<hertz>()),
+        Kind::Speed => match unit.as_str() {
+            "krpm" | "kRPM" | "krpm " => via_uom::<q::AngularVelocity>(value * 1e3, "rpm"),
+            _ => via_uom::<q::AngularVelocity>(value, &unit),
+        }
+        .map(|v| v.get::<radian_per_second>()),
+        Kind::AngularFrequency => via_uom::<q::AngularVelocity>(value, &unit)
+            .filter(|_| unit == "rad/s" || unit.starts_with("radian"))
+            .map(|v| v.get::<radian_per_second>())
+            .or_else(|| via_uom::<q::Frequency>(value, &unit).map(|f| 2.0 * std::f64::consts::PI * f.get::<hertz>())),
+        Kind::Torque => via_uom::<q::Torque>(value, &unit).map(|v| v.get::<newton_meter>()),
+        Kind::TemperatureCelsius => {
+            via_uom::<q::ThermodynamicTemperature>(value, &unit).map(|v| v.get::<degree_celsius>())
+        }
+        Kind::Capacitance => via_uom::<q::Capacitance>(value, &unit).map(|v| v.get::<farad>()),
+        Kind::Energy => via_uom::<q::Energy>(value, &unit).map(|v| v.get::<joule>()),
+        Kind::Power => via_uom::<q::Power>(value, &unit).map(|v| v.get::<watt>()),
+        Kind::Time => via_uom::<q::Time>(value, &unit).map(|v| v.get::<second>()),
+        Kind::Inertia => via_uom::<q::MomentOfInertia>(value, &unit).map(|v| v.get::<kilogram_square_meter>()),
+        Kind::Decibel => (unit == "dB").then_some(value),
+        Kind::ViscousFriction => {
+            matches!(unit.as_str(), "N · m·s/rad" | "N · m s/rad" | "N · ms/rad" | "N · m·s").then_some(value)
+        }
+        Kind::TorqueConstant => match unit.as_str() {
+            "N · m/A" | "N · m / A" => Some(value),
+            _ => None,
+        },
+        Kind::BackEmfConstant => {
+            let rpm = std::f64::consts::PI / 30.0; // rad/s per rpm
+            match unit.as_str() {
+                "V·s/rad" | "Vs/rad" | "V s/rad" | "V/(rad/s)" | "V/rad/s" => Some(value),
+                "mV·s/rad" | "mV/(rad/s)" => Some(value * 1e-3),
+                "V/krpm" | "V/kRPM" => Some(value / (1e3 * rpm)),
+                "V/rpm" => Some(value / rpm),
+                "mV/rpm" => Some(value * 1e-3 / rpm),
+                _ => None,
+            }
+        }
+    };
+    si.ok_or_else(|| UnitError {
+        problem: format!(
+            "\"{text}\" is not {}: unit \"{unit}\" is not accepted here",
+            kind.name()
+        ),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12 * b.abs().max(1e-300)
+    }
+
+    #[test]
+    fn accepts_the_spellings_users_write() {
+        assert!(close(parse(Kind::Resistance, "0.126 Ω").unwrap(), 0.126));
+        assert!(close(parse(Kind::Resistance, "0.126 ohm").unwrap(), 0.126));
+        assert!(close(parse(Kind::Resistance, "7.9 mΩ").unwrap(), 7.9e-3));
+        assert!(close(parse(Kind::Resistance, "7.9 mOhm").unwrap(), 7.9e-3));
+        assert!(close(parse(Kind::Inductance, "0.393 mH").unwrap(), 0.393e-3));
+        assert!(close(parse(Kind::Inductance, "393 µH").unwrap(), 393e-6)); // U+00B5
+        assert!(close(parse(Kind::Inductance, "393 μH").unwrap(), 393e-6)); // U+03BC
+        assert!(close(parse(Kind::Inductance, "393 uH").unwrap(), 393e-6));
+        assert!(close(parse(Kind::Inductance, "393µH").unwrap(), 393e-6));
+        assert!(close(parse(Kind::FluxLinkage, "60 mWb").unwrap(), 0.060));
+        assert!(close(parse(Kind::Frequency, "20 kHz").unwrap(), 20e3));
+        assert!(close(parse(Kind::Capacitance, "5 pF").unwrap(), 5e-12));
+        assert!(close(parse(Kind::Energy, "306 mJ").unwrap(), 0.306));
+        assert!(close(parse(Kind::Time, "1.5 ms").unwrap(), 1.5e-3));
+        assert!(close(parse(Kind::Decibel, "40 dB").unwrap(), 40.0));
+        assert!(close(parse(Kind::Torque, "11.1 N·m").unwrap(), 11.1));
+        assert!(close(parse(Kind::Torque, "11.1 Nm").unwrap(), 11.1));
+        assert!(close(parse(Kind::TemperatureCelsius, "130 °C").unwrap(), 130.0));
+        assert!((parse(Kind::TemperatureCelsius, "293.15 K").unwrap() - 20.0).abs() < 1e-9);
+        assert!(close(parse(Kind::Voltage, "1.2e2 V").unwrap(), 120.0));
+    }
+
+    #[test]
+    fn speeds_convert_rpm_to_rad_per_second() {
+        // 20000 rpm = 20000·2π/60 = 2094.3951 rad/s (hand calculation).
+        let w = parse(Kind::Speed, "20000 rpm").unwrap();
+        assert!((w - 2_094.395_102_393_195).abs() < 1e-9, "{w}");
+        assert!((parse(Kind::Speed, "20 krpm").unwrap() - w).abs() < 1e-9);
+        assert!(close(parse(Kind::Speed, "100 rad/s").unwrap(), 100.0));
+    }
+
+    #[test]
+    fn bandwidth_in_hertz_is_taken_as_two_pi_f() {
+        assert!(close(parse(Kind::AngularFrequency, "100 rad/s").unwrap(), 100.0));
+        let w = parse(Kind::AngularFrequency, "1 kHz").unwrap();
+        assert!((w - 6_283.185_307_179_586).abs() < 1e-9);
+    }
+
+    #[test]
+    fn motor_constants_in_datasheet_units() {
+        assert!(close(parse(Kind::TorqueConstant, "0.492 N·m/A").unwrap(), 0.492));
+        assert!(close(parse(Kind::TorqueConstant, "0.492 Nm/A").unwrap(), 0.492));
+        assert!(close(parse(Kind::BackEmfConstant, "0.296 V·s/rad").unwrap(), 0.296));
+        // 31 V/krpm = 31 V / (1000·π/30 rad/s) = 0.296028 V·s/rad (hand calculation).
+        let k = parse(Kind::BackEmfConstant, "31 V/krpm").unwrap();
+        assert!((k - 0.296_028_194_6).abs() < 1e-9, "{k}");
+    }
+
+    #[test]
+    fn refuses_wrong_dimension_missing_unit_and_non_finite() {
+        assert!(
+            parse(Kind::Inductance, "0.393 mA")
+                .unwrap_err()
+                .problem
+                .contains("not an inductance")
+        );
+        assert!(
+            parse(Kind::Inductance, "0.393")
+                .unwrap_err()
+                .problem
+                .contains("no unit")
+        );
+        assert!(
+            parse(Kind::Inductance, "NaN mH")
+                .unwrap_err()
+                .problem
+                .contains("finite")
+        );
+        assert!(
+            parse(Kind::Inductance, "inf mH")
+                .unwrap_err()
+                .problem
+                .contains("finite")
+        );
+        assert!(
+            parse(Kind::Inductance, "1e999 mH")
+                .unwrap_err()
+                .problem
+                .contains("finite")
+        );
+        assert!(parse(Kind::Inductance, "mH").is_err());
+        assert!(parse(Kind::AngularFrequency, "100 rpm").is_err());
+        assert!(parse(Kind::Decibel, "40").is_err());
+    }
+}

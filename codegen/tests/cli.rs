@@ -1,0 +1,319 @@
+//! The `motorgen` CLI as a user runs it: good specs design, bad specs fail with
+//! located messages (file:line:column, key, problem, accepted), exit non-zero,
+//! print nothing on stdout and never panic.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn fischer() -> String {
+    std::fs::read_to_string(repo().join("motors/fischer-ti085.toml")).unwrap()
+}
+
+fn motorgen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_motorgen"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .unwrap()
+}
+
+/// Writes `bytes` to a fresh file under the test temp dir and returns its path.
+fn write(name: &str, bytes: &[u8]) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli");
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join(name);
+    std::fs::write(&path, bytes).unwrap();
+    path
+}
+
+/// 1-based line of the first occurrence of `needle` in `text` (the test's own locator).
+fn line_of(text: &str, needle: &str) -> usize {
+    let at = text.find(needle).unwrap_or_else(|| panic!("{needle:?} not in spec"));
+    text[..at].matches('\n').count() + 1
+}
+
+/// Runs `design` and `check` on `text` and asserts a located failure.
+fn fails(name: &str, text: &str, line: usize, key: &str, words: &[&str]) {
+    let path = write(&format!("{name}.toml"), text.as_bytes());
+    let p = path.to_str().unwrap();
+    for args in [vec!["design", p, "--format", "json"], vec!["check", p]] {
+        let out = motorgen(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{name}: {args:?} succeeded");
+        assert_eq!(
+            out.status.code(),
+            Some(1),
+            "{name}: exit code (a panic exits 101)\n{stderr}"
+        );
+        assert!(out.stdout.is_empty() || args[0] == "check", "{name}: wrote to stdout");
+        assert!(!stderr.contains("panicked"), "{name}: panic\n{stderr}");
+        let loc = format!("{p}:{line}:");
+        assert!(stderr.contains(&loc), "{name}: expected {loc} in\n{stderr}");
+        if !key.is_empty() {
+            assert!(
+                stderr.contains(&format!("`{key}`")),
+                "{name}: expected key `{key}` in\n{stderr}"
+            );
+        }
+        assert!(stderr.contains("accepted: "), "{name}: no 'accepted' in\n{stderr}");
+        for w in words {
+            assert!(stderr.contains(w), "{name}: expected {w:?} in\n{stderr}");
+        }
+    }
+}
+
+/// Replaces `from` (which must occur) by `to` and returns the new text and the line of the change.
+fn mutate(from: &str, to: &str) -> (String, usize) {
+    let text = fischer();
+    assert!(text.contains(from), "{from:?}");
+    let new = text.replacen(from, to, 1);
+    let line = line_of(&new, to.lines().next().unwrap_or(to));
+    (new, line)
+}
+
+#[test]
+fn seed_motors_design_and_check() {
+    for m in ["fischer-ti085", "unimotor-142umd300", "chalmers-hev50"] {
+        let path = format!("motors/{m}.toml");
+        let out = motorgen(&["design", &path, "--format", "json"]);
+        assert!(out.status.success(), "{m}: {}", String::from_utf8_lossy(&out.stderr));
+        let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        assert_eq!(json["spec_file"], path.as_str());
+        let out = motorgen(&["check", &path]);
+        assert!(out.status.success());
+    }
+    let out = motorgen(&["list"]);
+    let s = String::from_utf8_lossy(&out.stdout);
+    for m in ["fischer-ti085", "unimotor-142umd300", "chalmers-hev50"] {
+        assert!(s.contains(m), "{s}");
+    }
+}
+
+#[test]
+fn syntax_error() {
+    let (t, line) = mutate("pole_pairs = 4 ", "pole_pairs = = 4 ");
+    fails("syntax", &t, line, "", &["TOML syntax error"]);
+}
+
+#[test]
+fn unknown_key_typo() {
+    let (t, line) = mutate("inductance = \"0.393 mH\"", "inductanse = \"0.393 mH\"");
+    fails(
+        "typo",
+        &t,
+        line,
+        "motor.datasheet.inductanse",
+        &["unknown key `inductanse`", "phase_resistance"],
+    );
+}
+
+#[test]
+fn missing_key_and_section() {
+    let (t, _) = mutate("error = \"trig_identity\"", "");
+    let line = line_of(&t, "[angle_observer]");
+    fails(
+        "missing_key",
+        &t,
+        line,
+        "angle_observer.error",
+        &["missing required key"],
+    );
+    let text = fischer();
+    let start = text.find("[fir]").unwrap();
+    let t = &text[..start];
+    fails("missing_section", t, 1, "fir", &["missing required key `fir`"]);
+    let (t, _) = mutate("max_speed = \"20000 rpm\"", "");
+    let line = line_of(&t, "[motor]");
+    fails(
+        "missing_motor_key",
+        &t,
+        line,
+        "motor.datasheet.max_speed",
+        &["missing required key `max_speed`"],
+    );
+}
+
+#[test]
+fn wrong_dimension_and_bare_number() {
+    let (t, line) = mutate("inductance = \"0.393 mH\"", "inductance = \"0.393 mA\"");
+    fails(
+        "dimension",
+        &t,
+        line,
+        "motor.datasheet.inductance",
+        &["not an inductance", "mH"],
+    );
+    let (t, line) = mutate("inductance = \"0.393 mH\"", "inductance = 0.000393");
+    fails(
+        "bare",
+        &t,
+        line,
+        "motor.datasheet.inductance",
+        &["bare number", "never taken as SI"],
+    );
+}
+
+#[test]
+fn non_positive_and_non_finite() {
+    let (t, line) = mutate("phase_resistance = \"0.126 Ω\"", "phase_resistance = \"-0.126 Ω\"");
+    fails(
+        "negative_r",
+        &t,
+        line,
+        "motor.datasheet.phase_resistance",
+        &["greater than zero"],
+    );
+    let (t, line) = mutate("inductance = \"0.393 mH\"", "inductance = \"0 mH\"");
+    fails("zero_l", &t, line, "motor.datasheet.inductance", &["greater than zero"]);
+    let (t, line) = mutate("value = \"0.296 V·s/rad\"", "value = \"-0.296 V·s/rad\"");
+    fails(
+        "negative_psi",
+        &t,
+        line,
+        "motor.datasheet.back_emf_constant.value",
+        &["greater than zero"],
+    );
+    let (t, line) = mutate("peak_current = \"61 A\"", "peak_current = \"NaN A\"");
+    fails(
+        "nan",
+        &t,
+        line,
+        "motor.datasheet.peak_current",
+        &["not a finite number"],
+    );
+    let (t, line) = mutate("peak_current = \"61 A\"", "peak_current = \"inf A\"");
+    fails(
+        "inf",
+        &t,
+        line,
+        "motor.datasheet.peak_current",
+        &["not a finite number"],
+    );
+    let (t, line) = mutate("damping = 1.0", "damping = nan");
+    fails("nan_number", &t, line, "angle_observer.damping", &["out of range"]);
+}
+
+#[test]
+fn pole_pairs_must_be_positive_whole() {
+    let (t, line) = mutate("pole_pairs = 4 ", "pole_pairs = 4.5 ");
+    fails("fractional_pp", &t, line, "motor.pole_pairs", &["not a whole number"]);
+    let (t, line) = mutate("pole_pairs = 4 ", "pole_pairs = 0 ");
+    fails("zero_pp", &t, line, "motor.pole_pairs", &["out of range"]);
+}
+
+#[test]
+fn conflicting_inductance_forms() {
+    let (t, line) = mutate(
+        "inductance = \"0.393 mH\"",
+        "inductance = \"0.393 mH\"\nd_inductance = \"0.4 mH\"\nq_inductance = \"0.4 mH\"",
+    );
+    fails(
+        "conflict",
+        &t,
+        line + 1,
+        "motor.datasheet.d_inductance",
+        &["conflicting inductance forms"],
+    );
+}
+
+#[test]
+fn empty_file_and_invalid_utf8() {
+    fails("empty", "", 1, "", &["empty"]);
+    let mut bytes = fischer().into_bytes();
+    let at = fischer().find("Ω").unwrap();
+    bytes[at] = 0xFF;
+    let line = line_of(&fischer(), "Ω");
+    let path = write("utf8.toml", &bytes);
+    let out = motorgen(&["check", path.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(stderr.contains(&format!("utf8.toml:{line}:")), "{stderr}");
+    assert!(stderr.contains("not valid UTF-8"), "{stderr}");
+}
+
+#[test]
+fn unknown_method_and_observer_error() {
+    let (t, line) = mutate("method = \"imc\"", "method = \"pid\"");
+    fails(
+        "method",
+        &t,
+        line,
+        "current_loop.method",
+        &["`pid` is not a known value", "pole_placement"],
+    );
+    let (t, line) = mutate("error = \"trig_identity\"", "error = \"cordic\"");
+    fails(
+        "observer_error",
+        &t,
+        line,
+        "angle_observer.error",
+        &["`cordic`", "atan2"],
+    );
+}
+
+#[test]
+fn fir_requests_out_of_bounds() {
+    let (t, line) = mutate("stop_edge = \"2 kHz\"", "stop_edge = \"50 Hz\"");
+    fails("fir_order", &t, line, "fir.stop_edge", &["pass_edge < stop_edge"]);
+    let (t, line) = mutate("stop_edge = \"2 kHz\"", "stop_edge = \"12 kHz\"");
+    fails("fir_nyquist", &t, line, "fir.stop_edge", &["Nyquist"]);
+    let (t, _) = mutate("order = 20", "");
+    let line = line_of(&t, "[fir]");
+    fails(
+        "fir_no_length",
+        &t,
+        line,
+        "fir.order",
+        &["neither `order` nor `stop_attenuation`"],
+    );
+    let (t, line) = mutate("order = 20", "order = 200");
+    fails("fir_too_long", &t, line, "fir.order", &["127 taps"]);
+}
+
+#[test]
+fn observer_gain_overflows_q31() {
+    // K̃_p = 2·1·70 000/(20 000·π) = 2.23 ≥ 1.
+    let (t, line) = mutate(
+        "natural_frequency = \"70 rad/s\"",
+        "natural_frequency = \"70000 rad/s\"",
+    );
+    fails(
+        "q31",
+        &t,
+        line,
+        "angle_observer.natural_frequency",
+        &["does not fit Q1.31"],
+    );
+}
+
+#[test]
+fn design_rules_are_located_errors() {
+    // Pole placement at 100 rad/s: RHP zero for Fischer (R/(2L) = 160 rad/s), smallest α = 226.7 rad/s.
+    let (t, line) = mutate("method = \"imc\"", "method = \"pole_placement\"\ndamping = 0.7071");
+    let _ = line;
+    let line = line_of(&t, "bandwidth = ");
+    fails(
+        "rhp",
+        &t,
+        line,
+        "current_loop.bandwidth",
+        &["right-half-plane zero", "226."],
+    );
+    // 30 % of 20 kHz = 6 kHz = 37 699 rad/s.
+    let (t, line) = mutate("bandwidth = \"100 rad/s\"", "bandwidth = \"40000 rad/s\"");
+    fails("bandwidth", &t, line, "current_loop.bandwidth", &["30 %", "37699"]);
+    // f_s ≥ 12·1333 Hz = 16 kHz.
+    let (t, line) = mutate("switching_frequency = \"20 kHz\"", "switching_frequency = \"15 kHz\"");
+    fails("fs", &t, line, "drive.switching_frequency", &["12·f_e,max", "16000"]);
+}
+
+#[test]
+fn missing_file() {
+    let out = motorgen(&["check", "motors/no-such-motor.toml"]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("motors/no-such-motor.toml:1:1"));
+}
