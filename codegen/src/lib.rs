@@ -6,7 +6,9 @@
 //! constant cannot differ between the three paths.
 
 pub mod design;
+pub mod constants;
 pub mod diagnostic;
+pub mod render;
 pub mod spec;
 pub mod summary;
 pub mod units;

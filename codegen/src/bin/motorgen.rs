@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
+use codegen::render::{Output, render_with};
 use codegen::{Diagnostic, Diagnostics};
 
 /// Motor description (TOML) → tuned motor-controller constants.
@@ -23,6 +24,21 @@ enum Command {
         /// Output format.
         #[arg(long, value_enum, default_value_t = Format::Summary)]
         format: Format,
+        /// Directory with replacement templates (for rust, c, markdown).
+        #[arg(long)]
+        templates: Option<PathBuf>,
+    },
+    /// Write the Rust module, C header and Markdown summary of one motor into a directory
+    /// (files are only rewritten when their bytes change).
+    Generate {
+        /// The motor spec.
+        spec: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
+        /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2).
+        #[arg(long)]
+        templates: Option<PathBuf>,
     },
     /// Validate specs; exit non-zero if any has a problem.
     Check {
@@ -44,6 +60,43 @@ enum Format {
     Summary,
     /// The complete design as JSON (SI units).
     Json,
+    /// Rust module of documented `const` items.
+    Rust,
+    /// C header with the same values.
+    C,
+    /// Markdown summary of every constant.
+    Markdown,
+}
+
+impl Format {
+    fn output(self) -> Option<Output> {
+        match self {
+            Format::Rust => Some(Output::Rust),
+            Format::C => Some(Output::C),
+            Format::Markdown => Some(Output::Markdown),
+            Format::Summary | Format::Json => None,
+        }
+    }
+}
+
+/// Renders `out` with the template from `dir` if given, else the built-in one.
+fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String, String> {
+    match dir {
+        Some(dir) => {
+            let path = dir.join(out.template());
+            let source = std::fs::read_to_string(&path).map_err(|e| format!("error: cannot read template {}: {e}", path.display()))?;
+            render_with(d, &path.display().to_string(), &source).map_err(|e| e.to_string())
+        }
+        None => codegen::render::render(d, out).map_err(|e| e.to_string()),
+    }
+}
+
+/// Writes `bytes` to `path` unless it already holds exactly them; returns whether it wrote.
+fn write_if_changed(path: &Path, bytes: &[u8]) -> std::io::Result<bool> {
+    if std::fs::read(path).is_ok_and(|old| old == bytes) {
+        return Ok(false);
+    }
+    std::fs::write(path, bytes).map(|()| true)
 }
 
 /// Reads a spec as UTF-8 text, or a diagnostic naming the file.
@@ -97,9 +150,19 @@ fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Design { spec, format } => match design(&spec) {
+        Command::Design { spec, format, templates } => match design(&spec) {
             Ok(d) => {
                 let out = match format {
+                    Format::Rust | Format::C | Format::Markdown => {
+                        let Some(o) = format.output() else { return ExitCode::FAILURE };
+                        match render(&d, o, templates.as_deref()) {
+                            Ok(s) => s,
+                            Err(e) => {
+                                eprintln!("{e}");
+                                return ExitCode::FAILURE;
+                            }
+                        }
+                    }
                     Format::Summary => codegen::summary::summary(&d),
                     Format::Json => match serde_json::to_string_pretty(&d) {
                         Ok(s) => s + "\n",
@@ -117,6 +180,42 @@ fn main() -> ExitCode {
                 ExitCode::FAILURE
             }
         },
+        Command::Generate { spec, out, templates } => {
+            let d = match design(&spec) {
+                Ok(d) => d,
+                Err(e) => {
+                    eprint!("{e}");
+                    return ExitCode::FAILURE;
+                }
+            };
+            let stem = spec.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "motor".into());
+            // Render everything first: nothing is written unless every output renders.
+            let mut files = Vec::new();
+            for o in Output::ALL {
+                match render(&d, o, templates.as_deref()) {
+                    Ok(text) => files.push((out.join(o.file_name(&stem)), text)),
+                    Err(e) => {
+                        eprintln!("{e}");
+                        return ExitCode::FAILURE;
+                    }
+                }
+            }
+            if let Err(e) = std::fs::create_dir_all(&out) {
+                eprintln!("error: cannot create {}: {e}", out.display());
+                return ExitCode::FAILURE;
+            }
+            for (path, text) in files {
+                match write_if_changed(&path, text.as_bytes()) {
+                    Ok(true) => println!("wrote {}", path.display()),
+                    Ok(false) => println!("unchanged {}", path.display()),
+                    Err(e) => {
+                        eprintln!("error: cannot write {}: {e}", path.display());
+                        return ExitCode::FAILURE;
+                    }
+                }
+            }
+            ExitCode::SUCCESS
+        }
         Command::Check { specs } => {
             let mut ok = true;
             for path in &specs {

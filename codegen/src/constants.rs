@@ -1,0 +1,239 @@
+//! The design as a flat list of documented constants, grouped by concern.
+//!
+//! This is the single path from a [`Design`] to code: the Rust module, the C
+//! header, the Markdown report and the proc-macro all render this list, so a
+//! constant cannot differ between them. Every entry carries its physical value
+//! with unit, its formula, the source equation and the provenance of its inputs.
+
+use serde::{Deserialize, Serialize};
+
+use crate::design::{Design, Origin};
+use crate::spec::Provenance;
+
+/// A constant's machine value, with its Rust and C spellings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Value {
+    /// Rust type (absolute paths), e.g. `f32`, `::fixed::types::I1F31`, `[i16; 21]`.
+    pub rust_type: String,
+    /// Rust const expression.
+    pub rust_expr: String,
+    /// C type, e.g. `float`, `int32_t`.
+    pub c_type: String,
+    /// C array suffix (`[21]`) or empty.
+    pub c_array: String,
+    /// C initialiser.
+    pub c_expr: String,
+    /// The value as JSON-able number(s) for tests: integers are exact, floats are the f32 value.
+    pub number: serde_json::Value,
+}
+
+/// One generated constant.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Constant {
+    /// Identifier within its group, SCREAMING_SNAKE_CASE.
+    pub name: String,
+    /// Machine value.
+    pub value: Value,
+    /// Physical value with unit, e.g. `0.0393 V/A`.
+    pub physical: String,
+    /// Formula, e.g. `K_p = L_d·α`.
+    pub formula: String,
+    /// Source equation, e.g. `thesis A (5.9)`.
+    pub equation: String,
+    /// Inputs with their provenance, e.g. `L_d = 0.393 mH (datasheet)`.
+    pub inputs: String,
+}
+
+/// Constants of one concern (a Rust module, a C prefix, a report section).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Group {
+    /// Module name, snake_case.
+    pub name: &'static str,
+    /// One-line description.
+    pub title: &'static str,
+    /// The constants, in a stable order.
+    pub constants: Vec<Constant>,
+}
+
+/// Shortest decimal that round-trips the f32 nearest `x`, always with a `.` or exponent.
+pub fn f32_literal(x: f64) -> String {
+    let s = format!("{:?}", x as f32);
+    if s.contains(['.', 'e', 'E']) || s.contains("inf") || s.contains("NaN") { s } else { format!("{s}.0") }
+}
+
+fn f32v(x: f64) -> Value {
+    let lit = f32_literal(x);
+    let c = if lit.contains(['.', 'e']) { format!("{lit}f") } else { format!("{lit}.0f") };
+    Value {
+        rust_type: "f32".into(),
+        rust_expr: lit,
+        c_type: "float".into(),
+        c_array: String::new(),
+        c_expr: c,
+        number: serde_json::json!(x as f32),
+    }
+}
+
+fn intv(x: i64, rust: &str, c: &str) -> Value {
+    let c_expr = if rust == "i32" && x == i64::from(i32::MIN) { "INT32_MIN".to_string() } else { x.to_string() };
+    Value {
+        rust_type: rust.into(),
+        rust_expr: x.to_string(),
+        c_type: c.into(),
+        c_array: String::new(),
+        c_expr,
+        number: serde_json::json!(x),
+    }
+}
+
+fn q31v(bits: i32) -> Value {
+    Value {
+        rust_type: "::fixed::types::I1F31".into(),
+        rust_expr: format!("::fixed::types::I1F31::from_bits({bits})"),
+        c_type: "int32_t".into(),
+        c_array: String::new(),
+        c_expr: bits.to_string(),
+        number: serde_json::json!(bits),
+    }
+}
+
+fn i16_array(v: &[i16]) -> Value {
+    let list = v.iter().map(i16::to_string).collect::<Vec<_>>().join(", ");
+    Value {
+        rust_type: format!("[i16; {}]", v.len()),
+        rust_expr: format!("[{list}]"),
+        c_type: "int16_t".into(),
+        c_array: format!("[{}]", v.len()),
+        c_expr: format!("{{{list}}}"),
+        number: serde_json::json!(v),
+    }
+}
+
+/// Physical value with unit and 6 significant digits.
+fn phys(x: f64, unit: &str) -> String {
+    let s = if x == 0.0 {
+        "0".to_string()
+    } else if (1e-6..1e7).contains(&x.abs()) {
+        let digits = (5 - x.abs().log10().floor() as i32).clamp(0, 12) as usize;
+        let t = format!("{x:.digits$}");
+        if t.contains('.') { t.trim_end_matches('0').trim_end_matches('.').to_string() } else { t }
+    } else {
+        format!("{x:.5e}")
+    };
+    if unit.is_empty() { s } else { format!("{s} {unit}") }
+}
+
+fn prov(o: Option<&Origin>) -> &'static str {
+    match o.map(|o| o.source) {
+        Some(Provenance::Datasheet) => "datasheet",
+        Some(Provenance::Identified) => "identified",
+        Some(Provenance::Derived) => "derived",
+        Some(Provenance::Default) | None => "default",
+    }
+}
+
+fn c(name: impl Into<String>, value: Value, physical: String, formula: &str, equation: &str, inputs: String) -> Constant {
+    Constant { name: name.into(), value, physical, formula: formula.into(), equation: equation.into(), inputs }
+}
+
+/// All constants of `d`, grouped: current loop, observer, scalings, filter, limits.
+pub fn constants(d: &Design) -> Vec<Group> {
+    let m = &d.motor;
+    let pv = |k: &str| prov(m.provenance.get(k));
+    let r_in = format!("R_s = {} ({})", phys(m.phase_resistance_ohm, "Ω"), pv("phase_resistance"));
+    let ld_in = format!("L_d = {} ({})", phys(m.d_inductance_h, "H"), pv("d_inductance"));
+    let lq_in = format!("L_q = {} ({})", phys(m.q_inductance_h, "H"), pv("q_inductance"));
+    let cl = &d.current_loop;
+    let alpha_in = format!("α = {} (spec)", phys(cl.bandwidth_rad_s, "rad/s"));
+    let fs = d.drive.switching_frequency_hz;
+    let fs_in = format!("f_s = {} (spec)", phys(fs, "Hz"));
+
+    let mut current = Vec::new();
+    for (axis, g, l_in) in [("D", &cl.d, &ld_in), ("Q", &cl.q, &lq_in)] {
+        let (kp_f, ki_f, eq) = match cl.method {
+            crate::spec::Method::Imc => ("K_p = K_a = L·α", "K_i = K_a·K_b = R·α", "thesis A (5.9), (5.7)"),
+            crate::spec::Method::PolePlacement => ("K_p = 2ζω_n·L − R", "K_i = L·ω_n²", "thesis A (5.14), (5.15)"),
+            crate::spec::Method::ImcActiveDamping => ("k_p = α_c·L", "k_i = α_c·(R + R_a)", "thesis B (2.38), (2.39)"),
+        };
+        let ins = format!("{l_in}, {r_in}, {alpha_in}{}", cl.damping.map_or(String::new(), |z| format!(", ζ = {z} (spec)")));
+        current.push(c(format!("{axis}_KP"), f32v(g.kp), phys(g.kp, "V/A"), kp_f, eq, ins.clone()));
+        current.push(c(format!("{axis}_KI"), f32v(g.ki), phys(g.ki, "V/(A·s)"), ki_f, eq, ins.clone()));
+        current.push(c(format!("{axis}_KI_TS"), f32v(g.ki_ts), phys(g.ki_ts, "V/A"), "K_i·T_s (forward-difference integrator)", "thesis A (4.17b)", format!("{ins}, {fs_in}")));
+        current.push(c(format!("{axis}_KB"), f32v(g.kb), phys(g.kb, "rad/s"), "K_b = K_i/K_p (series-form zero)", "thesis A (5.7)", ins.clone()));
+        current.push(c(format!("{axis}_ACTIVE_DAMPING"), f32v(g.active_damping_ohm), phys(g.active_damping_ohm, "Ω"), "R_a = α_c·L − R (0 unless imc_active_damping)", "thesis B (2.43)", ins.clone()));
+        current.push(c(format!("{axis}_ANTI_WINDUP"), f32v(g.anti_windup_gain), phys(g.anti_windup_gain, "A/V"), "1/k_p in dI/dt = e + (ū − u)/k_p", "thesis B (2.49)", ins.clone()));
+        if let Some(p) = &g.prefilter {
+            current.push(c(format!("{axis}_PREFILTER"), f32v(p.discrete_coefficient), phys(p.discrete_coefficient, ""), "a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y)", "thesis A (5.16)", format!("{ins}, {fs_in}")));
+        }
+    }
+    let ff = &cl.feedforward;
+    current.push(c("FF_LD", f32v(ff.d_inductance_h), phys(ff.d_inductance_h, "H"), "L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)", "thesis A (5.3)", ld_in.clone()));
+    current.push(c("FF_LQ", f32v(ff.q_inductance_h), phys(ff.q_inductance_h, "H"), "L_q in u_d,ff = −ω_e·L_q·i_q", "thesis A (5.3)", lq_in.clone()));
+    let psi = ff.flux_linkage_wb.unwrap_or(0.0);
+    let psi_in = ff.flux_linkage_wb.map_or("ψ_M unknown → 0 (term omitted)".to_string(), |p| format!("ψ_M = {} ({})", phys(p, "Wb"), pv("flux_linkage")));
+    current.push(c("FF_PSI", f32v(psi), phys(psi, "Wb"), "ψ_M in the back-EMF term ω_e·ψ_M", "thesis A (5.3)", psi_in.clone()));
+    let iq_per_nm = ff.iq_per_nm.unwrap_or(0.0);
+    current.push(c("IQ_PER_NM", f32v(iq_per_nm), phys(iq_per_nm, "A/(N·m)"), "1/K_t, K_t = 3/2·n_p·ψ_M (0 if ψ_M unknown)", "thesis A (2.34)", format!("n_p = {} (datasheet), {psi_in}", m.pole_pairs)));
+
+    let o = &d.angle_observer;
+    let obs_in = format!("ω_n = {} (spec), ζ = {} (spec)", phys(o.natural_frequency_rad_s, "rad/s"), o.damping);
+    let norm = match o.error {
+        crate::spec::ObserverError::TrigIdentity => "π",
+        crate::spec::ObserverError::Atan2 => "1 (atan2 error already normalised by π)",
+    };
+    let mut observer = vec![
+        c("KP", q31v(o.kp_q31), phys(o.kp_scaled, ""), &format!("K̃_p = 2ζω_n/(f_s·{norm}), Q1.31"), "thesis A (4.15), (4.22)", format!("{obs_in}, {fs_in}")),
+        c("KI", q31v(o.ki_q31), phys(o.ki_scaled, ""), &format!("K̃_i = ω_n²/(f_s²·{norm}), Q1.31"), "thesis A (4.15), (4.22)", format!("{obs_in}, {fs_in}")),
+        c("MOTOR_POLE_PAIRS", intv(i64::from(o.motor_pole_pairs), "u32", "uint32_t"), o.motor_pole_pairs.to_string(), "n_p", "thesis A (4.5)", "n_p (datasheet)".into()),
+        c("RESOLVER_POLE_PAIRS", intv(i64::from(o.resolver_pole_pairs), "u32", "uint32_t"), o.resolver_pole_pairs.to_string(), "n_r", "thesis A (4.5)", "n_r (datasheet)".into()),
+        c("LEAD_Q16", intv(i64::from(o.lead_q16), "i32", "int32_t"), phys(o.lead_samples * o.electrical_per_resolver, "samples (electrical)"), "k·n_p/n_r in Q16.16: θ_e,lead = θ_e + (ω_r^i·LEAD) >> 16", "thesis A (4.19), (4.23)", format!("k = {} samples (spec)", o.lead_samples)),
+    ];
+    if let (Some(rad), Some(bits)) = (o.resolver_offset_rad, o.resolver_offset_q31) {
+        observer.push(c("RESOLVER_OFFSET", q31v(bits), phys(rad, "rad"), "θ_off/π, Q1.31 (wrapping)", "thesis A (4.5), (6.9)", format!("θ_off ({})", prov(m.provenance.get("resolver_offset")))));
+    }
+
+    let s = &d.scaling;
+    let mut scalings = Vec::new();
+    for (prefix, sc, what) in [
+        ("CURRENT", &s.phase_current, "phase current"),
+        ("VOLTAGE", &s.phase_voltage, "phase voltage"),
+        ("DC_LINK", &s.dc_link_voltage, "DC-link voltage"),
+        ("ANGLE", &s.angle, "angle"),
+        ("SPEED", &s.speed, "observer speed"),
+        ("OBSERVER_ERROR", &s.observer_error, "observer error"),
+    ] {
+        scalings.push(c(format!("{prefix}_FULL_SCALE"), f32v(sc.full_scale), phys(sc.full_scale, sc.unit), &format!("A of {what}: {}", sc.rule), "thesis A (4.16), (4.20), Table 4.1", format!("{} (spec)", sc.q_format)));
+        scalings.push(c(format!("{prefix}_PER_LSB"), f32v(sc.si_per_lsb), phys(sc.si_per_lsb, sc.unit), &format!("A/2^{} ({})", sc.fractional_bits, sc.q_format), "thesis A (4.16)", format!("A = {}", phys(sc.full_scale, sc.unit))));
+    }
+
+    let f = &d.fir;
+    let fir_in = format!("order {}, {fs_in}", f.order);
+    let filter = vec![
+        c("TAPS_Q15", i16_array(&f.taps_q15), format!("{} taps, Σ = 32768 (DC gain 1)", f.taps_q15.len()), "equiripple low-pass (Parks–McClellan), Q1.15, symmetric", "thesis A §6.2", fir_in.clone()),
+        c("ORDER", intv(f.order as i64, "usize", "uint32_t"), f.order.to_string(), "N − 1", "thesis A §6.2", fir_in.clone()),
+        c("GROUP_DELAY_SAMPLES", f32v(f.group_delay_samples), phys(f.group_delay_samples, "samples"), "order/2 (linear phase)", "thesis A §6.2", fir_in.clone()),
+    ];
+
+    let md = &d.modulation;
+    let mut limits = vec![
+        c("SWITCHING_FREQUENCY_HZ", f32v(fs), phys(fs, "Hz"), "f_s = sampling frequency", "thesis A (1.1)", fs_in.clone()),
+        c("SAMPLE_PERIOD_S", f32v(d.drive.sample_period_s), phys(d.drive.sample_period_s, "s"), "T_s = 1/f_s", "thesis A (4.17)", fs_in.clone()),
+        c("VOLTAGE_LIMIT_V", f32v(cl.voltage_limit_v), phys(cl.voltage_limit_v, "V"), "U_dc/√3 (voltage circle)", "thesis B (2.50)", format!("U_dc = {} (spec)", phys(d.drive.dc_link_voltage_v, "V"))),
+        c("DC_LINK_MIN_V", f32v(d.drive.dc_link_voltage_min_v), phys(d.drive.dc_link_voltage_min_v, "V"), "lowest U_dc for the 1/U_dc feed-forward (5.1)", "thesis A (5.1)", "spec".into()),
+        c("THPWM_COMMON_MODE", f32v(md.thpwm_common_mode_ratio), phys(md.thpwm_common_mode_ratio, ""), "u_NM/U_dc amplitude 1/(6√3)", "thesis A (3.7)", "—".into()),
+        c("PEAK_CURRENT_A", f32v(std::f64::consts::SQRT_2 * m.peak_current_a_rms), phys(std::f64::consts::SQRT_2 * m.peak_current_a_rms, "A"), "√2·I_peak,rms (current-circle radius)", "thesis B (2.51)", format!("I_peak = {} rms ({})", phys(m.peak_current_a_rms, "A"), pv("peak_current"))),
+        c("MAX_ELECTRICAL_SPEED", f32v(2.0 * std::f64::consts::PI * m.max_electrical_frequency_hz), phys(2.0 * std::f64::consts::PI * m.max_electrical_frequency_hz, "rad/s"), "ω_e,max = n_p·ω_m,max", "thesis A (2.19)", format!("n_max ({})", pv("max_speed"))),
+        c("ADC_SETTLING_TIME_CONSTANTS", intv(i64::from(d.adc.settling_multiple), "u32", "uint32_t"), d.adc.settling_multiple.to_string(), "⌈−ln 2^−N⌉", "thesis A (7.4)", format!("N = {} bits", d.adc.resolution_bits)),
+    ];
+    if let Some(t) = &d.adc.sample_time {
+        limits.push(c("ADC_SMP_CODE", intv(i64::from(t.smp_code), "u8", "uint8_t"), format!("{} cycles = {}", t.cycles, phys(t.sample_time_s, "s")), "smallest STM32G4 SMP ≥ multiple·(R_ADC + R_EXT)·C_ADC", "thesis A (7.2), (7.4)", "adc section (spec)".into()));
+    }
+
+    vec![
+        Group { name: "current_loop", title: "Current loop: PI gains per axis, feed-forward, torque → i_q", constants: current },
+        Group { name: "observer", title: "Angle tracking observer (Q1.31) and resolver → electrical angle", constants: observer },
+        Group { name: "scaling", title: "Per-unit fixed-point scalings (full scale A and SI per LSB)", constants: scalings },
+        Group { name: "filter", title: "Identification FIR low-pass for the FMAC", constants: filter },
+        Group { name: "limits", title: "Sampling, voltage and current limits, modulator and ADC", constants: limits },
+    ]
+}

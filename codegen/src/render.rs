@@ -1,0 +1,150 @@
+//! Renders the constants of a design through minijinja templates (strict undefined).
+//!
+//! The built-in templates are the files in `templates/`, embedded at compile
+//! time; `motorgen --templates DIR` supplies the same names from another
+//! directory. Rendering does no file I/O: callers pass template sources in.
+
+use minijinja::syntax::SyntaxConfig;
+use minijinja::value::{Serde, Value};
+use minijinja::{Environment, UndefinedBehavior, context};
+use serde::Serialize;
+
+use crate::Design;
+use crate::constants::{Constant, Group, constants};
+
+/// Output formats and their template file names.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Output {
+    /// Rust module of `const` items.
+    Rust,
+    /// C header.
+    C,
+    /// Markdown summary.
+    Markdown,
+}
+
+impl Output {
+    /// All outputs.
+    pub const ALL: [Output; 3] = [Output::Rust, Output::C, Output::Markdown];
+
+    /// Template file name in `templates/`.
+    pub fn template(self) -> &'static str {
+        match self {
+            Output::Rust => "motor.rs.j2",
+            Output::C => "motor.h.j2",
+            Output::Markdown => "motor.md.j2",
+        }
+    }
+
+    /// Generated file name for a motor stem.
+    pub fn file_name(self, stem: &str) -> String {
+        match self {
+            Output::Rust => format!("{}.rs", stem.replace('-', "_")),
+            Output::C => format!("{}.h", stem.replace('-', "_")),
+            Output::Markdown => format!("{stem}.md"),
+        }
+    }
+
+    /// The built-in template source.
+    pub fn builtin(self) -> &'static str {
+        match self {
+            Output::Rust => include_str!("../../templates/motor.rs.j2"),
+            Output::C => include_str!("../../templates/motor.h.j2"),
+            Output::Markdown => include_str!("../../templates/motor.md.j2"),
+        }
+    }
+}
+
+/// rustfmt's default line width, which the Rust output is laid out for.
+pub const RUST_MAX_WIDTH: usize = 100;
+
+/// `pub const NAME: TYPE = EXPR;` at `indent`, laid out as rustfmt (default config) does:
+/// one line if it fits; a long array broken into rustfmt's mixed layout; otherwise the
+/// expression moved to the next line.
+pub fn rust_const(k: &Constant, indent: usize) -> String {
+    let pad = " ".repeat(indent);
+    let head = format!("{pad}pub const {}: {} = ", k.name, k.value.rust_type);
+    let expr = &k.value.rust_expr;
+    if head.chars().count() + expr.chars().count() < RUST_MAX_WIDTH {
+        return format!("{head}{expr};");
+    }
+    if let Some(inner) = expr.strip_prefix('[').and_then(|e| e.strip_suffix(']')) {
+        let items: Vec<&str> = inner.split(", ").collect();
+        let inner_pad = " ".repeat(indent + 4);
+        let mut out = format!("{head}[\n");
+        let mut line = inner_pad.clone();
+        for (i, item) in items.iter().enumerate() {
+            let piece = format!("{item},");
+            let sep = if line.len() > inner_pad.len() { " " } else { "" };
+            if line.len() + sep.len() + piece.len() > RUST_MAX_WIDTH {
+                out.push_str(&line);
+                out.push('\n');
+                line = format!("{inner_pad}{piece}");
+            } else {
+                line.push_str(sep);
+                line.push_str(&piece);
+            }
+            if i + 1 == items.len() {
+                out.push_str(&line);
+                out.push('\n');
+            }
+        }
+        out.push_str(&format!("{pad}];"));
+        return out;
+    }
+    format!("{}\n{pad}    {expr};", head.trim_end())
+}
+
+/// Why rendering failed.
+#[derive(Debug)]
+pub struct RenderError {
+    /// Template file name.
+    pub template: String,
+    /// Line in the template, if known.
+    pub line: Option<usize>,
+    /// The message.
+    pub message: String,
+}
+
+impl std::fmt::Display for RenderError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self.line {
+            Some(l) => write!(f, "error: template {}:{l}: {}", self.template, self.message),
+            None => write!(f, "error: template {}: {}", self.template, self.message),
+        }
+    }
+}
+
+impl std::error::Error for RenderError {}
+
+fn render_error(e: &minijinja::Error, fallback: &str) -> RenderError {
+    let mut message = e.kind().to_string();
+    if let Some(d) = e.detail() {
+        message = format!("{message}: {d}");
+    }
+    RenderError { template: e.name().unwrap_or(fallback).to_string(), line: e.line(), message }
+}
+
+/// Renders `source` (named `name` for messages) for the design `d`.
+pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, RenderError> {
+    let mut env = Environment::new();
+    env.set_undefined_behavior(UndefinedBehavior::Strict);
+    let syntax = SyntaxConfig::builder().keep_trailing_newline(true).build().map_err(|e| render_error(&e, name))?;
+    env.set_syntax(syntax);
+    env.add_filter("rust_const", |k: Serde<Constant>, indent: usize| rust_const(&k, indent));
+    env.add_template(name, source).map_err(|e| render_error(&e, name))?;
+    let groups: Vec<Group> = constants(d);
+    let tmpl = env.get_template(name).map_err(|e| render_error(&e, name))?;
+    tmpl.render(context! {
+        spec_file => d.spec_file.clone(),
+        name => d.name.clone(),
+        groups => Value::from(Serde(&groups)),
+        design => Value::from(Serde(d)),
+    })
+    .map_err(|e| render_error(&e, name))
+}
+
+/// Renders one output with the built-in template.
+pub fn render(d: &Design, out: Output) -> Result<String, RenderError> {
+    render_with(d, out.template(), out.builtin())
+}
