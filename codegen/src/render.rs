@@ -144,6 +144,16 @@ pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, Rende
     .map_err(|e| render_error(&e, name))
 }
 
+/// The commented starting spec written by `motorgen new <stem>`.
+pub fn new_spec(stem: &str) -> Result<String, RenderError> {
+    let name = "new-motor.toml.j2";
+    let mut env = Environment::new();
+    env.set_undefined_behavior(UndefinedBehavior::Strict);
+    env.add_template(name, include_str!("../../templates/new-motor.toml.j2")).map_err(|e| render_error(&e, name))?;
+    let tmpl = env.get_template(name).map_err(|e| render_error(&e, name))?;
+    tmpl.render(context! { stem => stem }).map(|s| s + "\n").map_err(|e| render_error(&e, name))
+}
+
 /// Renders one output with the built-in template.
 pub fn render(d: &Design, out: Output) -> Result<String, RenderError> {
     render_with(d, out.template(), out.builtin())

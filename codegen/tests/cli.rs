@@ -317,3 +317,50 @@ fn missing_file() {
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("motors/no-such-motor.toml:1:1"));
 }
+
+#[test]
+fn new_writes_a_spec_that_designs_and_never_overwrites() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("new");
+    let _ = std::fs::remove_dir_all(&dir);
+    let d = dir.to_str().unwrap();
+    let out = motorgen(&["new", "test-motor", "--dir", d]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let path = dir.join("test-motor.toml");
+    let out = motorgen(&["check", path.to_str().unwrap()]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let out = motorgen(&["list", "--dir", d]);
+    assert!(String::from_utf8_lossy(&out.stdout).contains("test-motor"));
+    let out = motorgen(&["new", "test-motor", "--dir", d]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("already exists"));
+    let out = motorgen(&["new", "Bad Name", "--dir", d]);
+    assert_eq!(out.status.code(), Some(1));
+}
+
+#[test]
+fn generate_writes_only_changed_files_and_templates_errors_name_the_file() {
+    let out_dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("generate");
+    let _ = std::fs::remove_dir_all(&out_dir);
+    let o = out_dir.to_str().unwrap();
+    let first = motorgen(&["generate", "motors/fischer-ti085.toml", "--out", o]);
+    assert!(first.status.success());
+    assert_eq!(String::from_utf8_lossy(&first.stdout).matches("wrote").count(), 3);
+    let second = motorgen(&["generate", "motors/fischer-ti085.toml", "--out", o]);
+    assert_eq!(String::from_utf8_lossy(&second.stdout).matches("unchanged").count(), 3);
+    // A user template with an undefined variable on line 2: strict undefined, located error.
+    let tdir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("templates");
+    std::fs::create_dir_all(&tdir).unwrap();
+    std::fs::write(tdir.join("motor.rs.j2"), "// {{ name }}\n// {{ no_such_variable }}\n").unwrap();
+    let bad = motorgen(&[
+        "design",
+        "motors/fischer-ti085.toml",
+        "--format",
+        "rust",
+        "--templates",
+        tdir.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&bad.stderr);
+    assert_eq!(bad.status.code(), Some(1));
+    assert!(stderr.contains("motor.rs.j2:2"), "{stderr}");
+    assert!(bad.stdout.is_empty());
+}

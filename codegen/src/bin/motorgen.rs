@@ -46,6 +46,14 @@ enum Command {
         #[arg(required = true)]
         specs: Vec<PathBuf>,
     },
+    /// Write a commented starting spec to motors/<stem>.toml (never overwrites).
+    New {
+        /// File stem: lowercase letters, digits and '-'.
+        stem: String,
+        /// Directory of motor specs.
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
     /// List the motors in a directory (default: motors/).
     List {
         /// Directory of motor specs.
@@ -84,7 +92,8 @@ fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String
     match dir {
         Some(dir) => {
             let path = dir.join(out.template());
-            let source = std::fs::read_to_string(&path).map_err(|e| format!("error: cannot read template {}: {e}", path.display()))?;
+            let source = std::fs::read_to_string(&path)
+                .map_err(|e| format!("error: cannot read template {}: {e}", path.display()))?;
             render_with(d, &path.display().to_string(), &source).map_err(|e| e.to_string())
         }
         None => codegen::render::render(d, out).map_err(|e| e.to_string()),
@@ -150,11 +159,17 @@ fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     match cli.command {
-        Command::Design { spec, format, templates } => match design(&spec) {
+        Command::Design {
+            spec,
+            format,
+            templates,
+        } => match design(&spec) {
             Ok(d) => {
                 let out = match format {
                     Format::Rust | Format::C | Format::Markdown => {
-                        let Some(o) = format.output() else { return ExitCode::FAILURE };
+                        let Some(o) = format.output() else {
+                            return ExitCode::FAILURE;
+                        };
                         match render(&d, o, templates.as_deref()) {
                             Ok(s) => s,
                             Err(e) => {
@@ -188,7 +203,10 @@ fn main() -> ExitCode {
                     return ExitCode::FAILURE;
                 }
             };
-            let stem = spec.file_stem().map(|s| s.to_string_lossy().into_owned()).unwrap_or_else(|| "motor".into());
+            let stem = spec
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "motor".into());
             // Render everything first: nothing is written unless every output renders.
             let mut files = Vec::new();
             for o in Output::ALL {
@@ -233,6 +251,49 @@ fn main() -> ExitCode {
                 }
             }
             if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+        }
+        Command::New { stem, dir } => {
+            if stem.is_empty()
+                || !stem
+                    .chars()
+                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+                || stem.starts_with('-')
+            {
+                eprintln!(
+                    "error: `{stem}` is not a valid motor stem\n  accepted: lowercase letters, digits and '-', e.g. my-motor-80kw"
+                );
+                return ExitCode::FAILURE;
+            }
+            let dir = motors_dir(dir);
+            let path = dir.join(format!("{stem}.toml"));
+            if path.exists() {
+                eprintln!(
+                    "error: {} already exists\n  accepted: a new stem, or edit the existing file",
+                    path.display()
+                );
+                return ExitCode::FAILURE;
+            }
+            let text = match codegen::render::new_spec(&stem) {
+                Ok(t) => t,
+                Err(e) => {
+                    eprintln!("{e}");
+                    return ExitCode::FAILURE;
+                }
+            };
+            match std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, text)) {
+                Ok(()) => {
+                    println!(
+                        "wrote {}; edit it, then run `motorgen check {}`",
+                        path.display(),
+                        path.display()
+                    );
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    eprintln!("error: cannot write {}: {e}", path.display());
+                    ExitCode::FAILURE
+                }
+            }
         }
         Command::List { dir } => {
             let dir = motors_dir(dir);

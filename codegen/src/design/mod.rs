@@ -79,6 +79,10 @@ pub struct MotorOut {
     pub max_speed_rpm: f64,
     /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).
     pub max_electrical_frequency_hz: f64,
+    /// ω_e,max = 2π·f_e,max [rad/s] (2.19).
+    pub max_electrical_speed_rad_s: f64,
+    /// Peak phase-current amplitude √2·I_peak,rms [A] (current-circle radius, thesis B 2.51).
+    pub peak_current_a: f64,
     /// Where each value came from.
     pub provenance: BTreeMap<&'static str, Origin>,
 }
@@ -569,6 +573,8 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
             max_speed_rad_s: m.max_speed.value,
             max_speed_rpm: m.max_speed.value * 30.0 / PI,
             max_electrical_frequency_hz: fe_max,
+            max_electrical_speed_rad_s: 2.0 * PI * fe_max,
+            peak_current_a: i_peak,
             provenance,
         },
         drive: DriveOut {

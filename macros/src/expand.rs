@@ -1,0 +1,328 @@
+//! Expansion logic on `proc_macro2`, unit-testable outside the compiler.
+
+use std::collections::BTreeMap;
+use std::path::PathBuf;
+
+use codegen::design::{angle_observer, current_loop};
+use codegen::render::{Output, render};
+use codegen::spec::{Method, ObserverError};
+use codegen::units::{self, Kind};
+use proc_macro2::{Span, TokenStream};
+use quote::quote;
+use syn::parse::{Parse, ParseStream};
+use syn::punctuated::Punctuated;
+use syn::{Expr, ExprLit, ExprUnary, Ident, Lit, LitStr, Token, UnOp};
+
+/// `motor_constants!("path")`.
+pub fn motor_constants(input: TokenStream) -> syn::Result<TokenStream> {
+    let lit: LitStr = syn::parse2(input)?;
+    let rel = lit.value();
+    let root = std::env::var("CARGO_MANIFEST_DIR")
+        .map_err(|_| syn::Error::new(lit.span(), "CARGO_MANIFEST_DIR is not set"))?;
+    let path = PathBuf::from(root).join(&rel);
+    let text = std::fs::read_to_string(&path).map_err(|e| {
+        syn::Error::new(
+            lit.span(),
+            format!("cannot read {} (relative to CARGO_MANIFEST_DIR): {e}", path.display()),
+        )
+    })?;
+    let design = codegen::design_source(&rel, &text).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
+    let code = render(&design, Output::Rust).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
+    let items: TokenStream = code
+        .parse()
+        .map_err(|e| syn::Error::new(lit.span(), format!("generated code does not parse: {e}")))?;
+    let abs = path.canonicalize().unwrap_or(path).display().to_string();
+    Ok(quote! {
+        const _: &str = include_str!(#abs);
+        #items
+    })
+}
+
+/// Reads a possibly negated numeric literal as f64.
+fn number(e: &Expr) -> syn::Result<f64> {
+    match e {
+        Expr::Lit(ExprLit { lit: Lit::Float(f), .. }) => f.base10_parse::<f64>(),
+        Expr::Lit(ExprLit { lit: Lit::Int(i), .. }) => i.base10_parse::<f64>(),
+        Expr::Unary(ExprUnary {
+            op: UnOp::Neg(_), expr, ..
+        }) => number(expr).map(|x| -x),
+        Expr::Group(g) => number(&g.expr),
+        Expr::Paren(p) => number(&p.expr),
+        other => Err(syn::Error::new_spanned(
+            other,
+            "expected a number literal such as 0.25 or -0.5",
+        )),
+    }
+}
+
+/// `q31!(x)` / `q15!(x)`.
+pub fn q_literal(input: TokenStream, frac: u32) -> syn::Result<TokenStream> {
+    let e: Expr = syn::parse2(input)?;
+    let x = number(&e)?;
+    let scale = 2f64.powi(frac as i32);
+    let bits = (x * scale).round();
+    if !x.is_finite() || bits < -scale || bits >= scale {
+        return Err(syn::Error::new_spanned(
+            &e,
+            format!("{x} is outside the Q1.{frac} range [−1, 1)"),
+        ));
+    }
+    let bits = bits as i64;
+    Ok(if frac == 31 {
+        let b = bits as i32;
+        quote!(::fixed::types::I1F31::from_bits(#b))
+    } else {
+        let b = bits as i16;
+        quote!(::fixed::types::I1F15::from_bits(#b))
+    })
+}
+
+/// `name = value` arguments.
+struct Args(Punctuated<Arg, Token![,]>);
+
+struct Arg {
+    name: Ident,
+    value: Expr,
+}
+
+impl Parse for Arg {
+    fn parse(input: ParseStream<'_>) -> syn::Result<Self> {
+        let name: Ident = input.parse()?;
+        input.parse::<Token![=]>()?;
+        Ok(Arg {
+            name,
+            value: input.parse()?,
+        })
+    }
+}
+
+impl Parse for Args {
+    fn parse(input: ParseStream<'_>) -> syn::Result<Self> {
+        Ok(Args(Punctuated::parse_terminated(input)?))
+    }
+}
+
+/// Arguments by name, with the call's span for "missing" errors.
+struct Named {
+    args: BTreeMap<String, Arg>,
+    span: Span,
+}
+
+impl Named {
+    fn parse(input: TokenStream, allowed: &[&str]) -> syn::Result<Named> {
+        let span = Span::call_site();
+        let Args(list) = syn::parse2(input)?;
+        let mut args = BTreeMap::new();
+        let mut errors: Option<syn::Error> = None;
+        let mut push = |e: syn::Error| match &mut errors {
+            Some(all) => all.combine(e),
+            None => errors = Some(e),
+        };
+        for a in list {
+            let key = a.name.to_string();
+            if !allowed.contains(&key.as_str()) {
+                push(syn::Error::new_spanned(
+                    &a.name,
+                    format!("unknown argument `{key}`; accepted: {}", allowed.join(", ")),
+                ));
+            } else if args.contains_key(&key) {
+                push(syn::Error::new_spanned(
+                    &a.name,
+                    format!("argument `{key}` given twice"),
+                ));
+            } else {
+                args.insert(key, a);
+            }
+        }
+        match errors {
+            Some(e) => Err(e),
+            None => Ok(Named { args, span }),
+        }
+    }
+
+    fn get(&self, key: &str) -> syn::Result<&Arg> {
+        self.args
+            .get(key)
+            .ok_or_else(|| syn::Error::new(self.span, format!("missing argument `{key} = …`")))
+    }
+
+    fn quantity(&self, key: &str, kind: Kind) -> syn::Result<f64> {
+        let a = self.get(key)?;
+        match &a.value {
+            Expr::Lit(ExprLit { lit: Lit::Str(s), .. }) => match units::parse(kind, &s.value()) {
+                Ok(v) if v > 0.0 => Ok(v),
+                Ok(_) => Err(syn::Error::new_spanned(
+                    s,
+                    format!("`{key}` must be greater than zero; accepted: {}", kind.accepted()),
+                )),
+                Err(e) => Err(syn::Error::new_spanned(
+                    s,
+                    format!("{}; accepted: {}", e.problem, kind.accepted()),
+                )),
+            },
+            other => Err(syn::Error::new_spanned(
+                other,
+                format!("`{key}` takes a quoted quantity with its unit: {}", kind.accepted()),
+            )),
+        }
+    }
+
+    fn positive(&self, key: &str) -> syn::Result<f64> {
+        let a = self.get(key)?;
+        let x = number(&a.value)?;
+        if x > 0.0 && x.is_finite() {
+            Ok(x)
+        } else {
+            Err(syn::Error::new_spanned(
+                &a.value,
+                format!("`{key}` must be a positive number"),
+            ))
+        }
+    }
+
+    fn ident(&self, key: &str, allowed: &[&str]) -> syn::Result<(String, &Expr)> {
+        let a = self.get(key)?;
+        match &a.value {
+            Expr::Path(p)
+                if p.path
+                    .get_ident()
+                    .is_some_and(|i| allowed.contains(&i.to_string().as_str())) =>
+            {
+                Ok((
+                    p.path.get_ident().map(ToString::to_string).unwrap_or_default(),
+                    &a.value,
+                ))
+            }
+            other => Err(syn::Error::new_spanned(
+                other,
+                format!("`{key}` must be one of: {}", allowed.join(", ")),
+            )),
+        }
+    }
+}
+
+/// `ato_gains!(natural_frequency = "…", damping = …, fs = "…", error = trig_identity|atan2)`.
+pub fn ato_gains(input: TokenStream) -> syn::Result<TokenStream> {
+    let n = Named::parse(input, &["natural_frequency", "damping", "fs", "error"])?;
+    let wn = n.quantity("natural_frequency", Kind::AngularFrequency)?;
+    let zeta = n.positive("damping")?;
+    let fs = n.quantity("fs", Kind::Frequency)?;
+    let (err, _) = n.ident("error", &["trig_identity", "atan2"])?;
+    let error = if err == "atan2" {
+        ObserverError::Atan2
+    } else {
+        ObserverError::TrigIdentity
+    };
+    let g = angle_observer::design(wn, zeta, fs, error).map_err(|e| {
+        let what = match e {
+            angle_observer::ObserverGainError::Overflow { gain, scaled } => {
+                format!("K̃_{} = {scaled:.3e} does not fit Q1.31 (4.22)", &gain[1..])
+            }
+            angle_observer::ObserverGainError::Underflow { gain, scaled } => {
+                format!("K̃_{} = {scaled:.3e} rounds to zero in Q1.31 (4.22)", &gain[1..])
+            }
+        };
+        syn::Error::new_spanned(&n.args["natural_frequency"].value, what)
+    })?;
+    let (kp, ki) = (g.kp_q31, g.ki_q31);
+    Ok(quote!((::fixed::types::I1F31::from_bits(#kp), ::fixed::types::I1F31::from_bits(#ki))))
+}
+
+/// `pi_gains!(method = imc|pole_placement|imc_active_damping, resistance = "…", inductance = "…", bandwidth = "…", fs = "…"[, damping = …])`.
+pub fn pi_gains(input: TokenStream) -> syn::Result<TokenStream> {
+    let n = Named::parse(
+        input,
+        &["method", "resistance", "inductance", "bandwidth", "fs", "damping"],
+    )?;
+    let (m, _) = n.ident("method", &["imc", "pole_placement", "imc_active_damping"])?;
+    let method = match m.as_str() {
+        "pole_placement" => Method::PolePlacement,
+        "imc_active_damping" => Method::ImcActiveDamping,
+        _ => Method::Imc,
+    };
+    let r = n.quantity("resistance", Kind::Resistance)?;
+    let l = n.quantity("inductance", Kind::Inductance)?;
+    let alpha = n.quantity("bandwidth", Kind::AngularFrequency)?;
+    let fs = n.quantity("fs", Kind::Frequency)?;
+    let zeta = match (method, n.args.get("damping")) {
+        (Method::PolePlacement, _) => n.positive("damping")?,
+        (_, Some(a)) => {
+            return Err(syn::Error::new_spanned(
+                &a.name,
+                "`damping` is only used by method = pole_placement",
+            ));
+        }
+        (_, None) => 0.0,
+    };
+    let g = current_loop::design_axis(method, 'd', r, l, alpha, zeta, 1.0 / fs).map_err(|e| {
+        let msg = match e {
+            current_loop::CurrentLoopError::RhpZero { min_bandwidth_rad_s, .. } => format!("right-half-plane zero (ω_n·ζ < R/(2L), thesis A §5.4.1); accepted: a bandwidth above {min_bandwidth_rad_s:.1} rad/s"),
+            current_loop::CurrentLoopError::NegativeActiveDamping { min_bandwidth_rad_s, .. } => format!("negative active damping (α·L < R, thesis B 2.43); accepted: a bandwidth above {min_bandwidth_rad_s:.1} rad/s"),
+        };
+        syn::Error::new_spanned(&n.args["bandwidth"].value, msg)
+    })?;
+    let limit = current_loop::bandwidth_limit(method, fs);
+    if alpha >= limit {
+        return Err(syn::Error::new_spanned(
+            &n.args["bandwidth"].value,
+            format!("bandwidth is not below the guideline {limit:.0} rad/s (thesis A §5.4.1)"),
+        ));
+    }
+    let (kp, ki) = (g.kp as f32, g.ki as f32);
+    Ok(quote!((#kp, #ki)))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use quote::quote;
+
+    /// 0.25·2^31 = 536 870 912; −0.5·2^15 = −16 384.
+    #[test]
+    fn q_literals() {
+        assert_eq!(
+            q_literal(quote!(0.25), 31).unwrap().to_string(),
+            quote!(::fixed::types::I1F31::from_bits(536870912i32)).to_string()
+        );
+        assert_eq!(
+            q_literal(quote!(-0.5), 15).unwrap().to_string(),
+            quote!(::fixed::types::I1F15::from_bits(-16384i16)).to_string()
+        );
+        assert!(q_literal(quote!(1.0), 31).is_err());
+        assert!(q_literal(quote!(-1.0), 15).is_ok());
+    }
+
+    /// Same numbers as thesis A §4.4.2 via codegen: 4 784 957 and 8 374.
+    #[test]
+    fn ato_gains_match_codegen() {
+        let t = ato_gains(quote!(
+            natural_frequency = "70 rad/s",
+            damping = 1.0,
+            fs = "20 kHz",
+            error = trig_identity
+        ))
+        .unwrap();
+        assert_eq!(
+            t.to_string(),
+            quote!((
+                ::fixed::types::I1F31::from_bits(4784957i32),
+                ::fixed::types::I1F31::from_bits(8374i32)
+            ))
+            .to_string()
+        );
+    }
+
+    #[test]
+    fn pi_gains_imc() {
+        // K_p = L·α = 0.0393, K_i = R·α = 12.6 (thesis A 5.9, Fischer).
+        let t = pi_gains(quote!(
+            method = imc,
+            resistance = "0.126 Ω",
+            inductance = "0.393 mH",
+            bandwidth = "100 rad/s",
+            fs = "20 kHz"
+        ))
+        .unwrap();
+        assert_eq!(t.to_string(), quote!((0.0393f32, 12.6f32)).to_string());
+    }
+}

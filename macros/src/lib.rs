@@ -1,0 +1,62 @@
+//! Proc-macros over `codegen`: firmware code states the physical intent and the
+//! compiler produces the constant, through the same functions as `motorgen`.
+//!
+//! * [`motor_constants!`] — the generated module of a motor spec.
+//! * [`q31!`], [`q15!`] — fixed-point literals (`fixed::types::I1F31` / `I1F15`).
+//! * [`ato_gains!`] — angle-tracking-observer gains in Q1.31 (thesis A 4.15, 4.22).
+//! * [`pi_gains!`] — current-loop PI gains (thesis A 5.9, 5.14; thesis B 2.38).
+//!
+//! Errors are `compile_error!`s spanned at the offending argument.
+
+mod expand;
+
+use proc_macro::TokenStream;
+
+/// Expands to the constant modules of a motor spec (path relative to `CARGO_MANIFEST_DIR`),
+/// identical to `motorgen design <spec> --format rust`; editing the spec recompiles.
+///
+/// ```ignore
+/// motor_macros::motor_constants!("../motors/fischer-ti085.toml");
+/// let kp: f32 = current_loop::D_KP;
+/// ```
+#[proc_macro]
+pub fn motor_constants(input: TokenStream) -> TokenStream {
+    expand::motor_constants(input.into())
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
+
+/// A Q1.31 literal: `q31!(0.25)` → `::fixed::types::I1F31::from_bits(536870912)`; the value must be in [−1, 1).
+#[proc_macro]
+pub fn q31(input: TokenStream) -> TokenStream {
+    expand::q_literal(input.into(), 31)
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
+
+/// A Q1.15 literal: `q15!(-0.5)` → `::fixed::types::I1F15::from_bits(-16384)`; the value must be in [−1, 1).
+#[proc_macro]
+pub fn q15(input: TokenStream) -> TokenStream {
+    expand::q_literal(input.into(), 15)
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
+
+/// Observer gains `(K̃_p, K̃_i)` as `I1F31` (thesis A 4.15, 4.22):
+/// `ato_gains!(natural_frequency = "70 rad/s", damping = 1.0, fs = "20 kHz", error = trig_identity)`.
+#[proc_macro]
+pub fn ato_gains(input: TokenStream) -> TokenStream {
+    expand::ato_gains(input.into())
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
+
+/// Current-loop PI gains `(K_p, K_i)` as `f32` for one axis:
+/// `pi_gains!(method = imc, resistance = "0.126 Ω", inductance = "0.393 mH", bandwidth = "100 rad/s", fs = "20 kHz")`
+/// (`damping = 0.7071` for `pole_placement`).
+#[proc_macro]
+pub fn pi_gains(input: TokenStream) -> TokenStream {
+    expand::pi_gains(input.into())
+        .unwrap_or_else(syn::Error::into_compile_error)
+        .into()
+}
