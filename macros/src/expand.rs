@@ -23,10 +23,14 @@ pub fn motor_constants(input: TokenStream) -> syn::Result<TokenStream> {
     let text = std::fs::read_to_string(&path).map_err(|e| {
         syn::Error::new(
             lit.span(),
-            format!("cannot read {} (relative to CARGO_MANIFEST_DIR): {e}", path.display()),
+            format!("cannot read `{rel}` (relative to CARGO_MANIFEST_DIR): {e}"),
         )
     })?;
-    let design = codegen::design_source(&rel, &text).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
+    let design = codegen::design_source(&rel, &text).map_err(|e| {
+        // compile_error! already says "error:".
+        let msg = e.to_string();
+        syn::Error::new(lit.span(), msg.strip_prefix("error: ").unwrap_or(&msg).trim_end().to_string())
+    })?;
     let code = render(&design, Output::Rust).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
     let items: TokenStream = code
         .parse()
