@@ -196,7 +196,7 @@ pub fn constants(d: &Design) -> Vec<Group> {
         c("KI", q31v(o.ki_q31), phys(o.ki_scaled, ""), &format!("K̃_i = ω_n²/(f_s²·{norm}), Q1.31"), "thesis A (4.15), (4.22)", format!("{obs_in}, {fs_in}")).at("/angle_observer/ki_q31"),
         c("MOTOR_POLE_PAIRS", intv(i64::from(o.motor_pole_pairs), "u32", "uint32_t"), o.motor_pole_pairs.to_string(), "n_p", "thesis A (4.5)", "n_p (datasheet)".into()).at("/angle_observer/motor_pole_pairs"),
         c("RESOLVER_POLE_PAIRS", intv(i64::from(o.resolver_pole_pairs), "u32", "uint32_t"), o.resolver_pole_pairs.to_string(), "n_r", "thesis A (4.5)", "n_r (datasheet)".into()).at("/angle_observer/resolver_pole_pairs"),
-        c("LEAD_Q16", intv(i64::from(o.lead_q16), "i32", "int32_t"), phys(o.lead_samples * o.electrical_per_resolver, "samples (electrical)"), "k·n_p/n_r in Q16.16: θ_e,lead = θ_e + (ω_r^i·LEAD) >> 16", "thesis A (4.19), (4.23)", format!("k = {} samples (spec)", o.lead_samples)).at("/angle_observer/lead_q16"),
+        c("LEAD_Q16", intv(i64::from(o.lead_q16), "i32", "int32_t"), phys(o.lead_samples, "samples"), "k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16", "thesis A (4.19), (4.23)", format!("k = {} samples (spec)", o.lead_samples)).at("/angle_observer/lead_q16"),
     ];
     if let (Some(rad), Some(bits)) = (o.resolver_offset_rad, o.resolver_offset_q31) {
         observer.push(c("RESOLVER_OFFSET", q31v(bits), phys(rad, "rad"), "θ_off/π, Q1.31 (wrapping)", "thesis A (4.5), (6.9)", format!("θ_off ({})", prov(m.provenance.get("resolver_offset")))).at("/angle_observer/resolver_offset_q31"));

@@ -196,7 +196,7 @@ pub struct ObserverOut {
     pub resolver_offset_q31: Option<i32>,
     /// Delay k in samples compensated by the angle lead (4.23).
     pub lead_samples: f64,
-    /// k·n_p/n_r in Q16.16: θ_e,lead^i = θ_e^i + (ω_r^i·LEAD) >> 16.
+    /// k in Q16.16: θ_e,lead^i = θ_e^i + (ω_e^i·LEAD) >> 16, ω_e^i the per-sample electrical angle step (4.19), (4.23).
     pub lead_q16: i32,
     /// Lag k·ω_e,max·T_s at maximum speed [deg] (4.23).
     pub lead_at_max_speed_deg: f64,
@@ -629,7 +629,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
                     as i32
             }),
             lead_samples: lead,
-            lead_q16: (lead * ratio * 65_536.0).round() as i32,
+            lead_q16: (lead * 65_536.0).round() as i32,
             lead_at_max_speed_deg: angle_observer::lag_angle(lead, 2.0 * PI * fe_max, fs).to_degrees(),
         },
         scaling: ScalingsOut {

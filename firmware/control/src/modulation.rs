@@ -1,0 +1,177 @@
+//! Third-harmonic-injection PWM (THPWM), thesis A §3.2, in `f32`.
+//!
+//! 1. phase voltages from the inverse Clarke transformation of u_αβ (the αβ vector
+//!    is the inverse Park of u_dq at the angle used for modulation);
+//! 2. common-mode term (3.7) `u_NM = −U_dc/(6√3)·cos 3(θ_e + atan2(u_q, u_d))`;
+//!    `θ_e + atan2(u_q, u_d)` is the angle φ of the αβ voltage vector, so we evaluate
+//!    `cos 3φ = 4·cos³φ − 3·cos φ` with `cos φ = u_α/|u_αβ|` (no trigonometric call);
+//! 3. (3.8) `u_x = ũ_x + u_NM`;
+//! 4. duty (3.4)/(5.1): `DC_x = 1/2 + u_x/U_dc`, saturated to \[0, 1\].
+//!
+//! Linear range: |u_αβ| ≤ U_dc/√3 (modulation index M = 1.15, (3.6)). There the
+//! duties stay inside \[0, 1\] for every angle: the phase peak is
+//! `max_x(a·cos x − b·cos 3x)` with `b = U_dc/(6√3)` fixed; it is convex in the
+//! amplitude a, equal to b ≤ U_dc/2 at a = 0 and to U_dc/2 at a = 6b = U_dc/√3.
+
+use crate::transforms::{AlphaBeta, Uvw, inverse_clarke};
+
+/// 1/(6√3), the common-mode amplitude per volt of DC link (3.7).
+pub const THIRD_HARMONIC_PER_VOLT: f32 = 0.096_225_045;
+
+/// Common-mode voltage u_NM of (3.7) \[V\] for the αβ voltage `u` and DC-link `u_dc`
+/// \[V\]; 0 for a zero vector (its angle is undefined).
+pub fn common_mode(u: AlphaBeta, u_dc: f32) -> f32 {
+    let mag = libm::sqrtf(u.alpha * u.alpha + u.beta * u.beta);
+    if !(mag > 0.0 && mag.is_finite()) {
+        return 0.0;
+    }
+    let c = (u.alpha / mag).clamp(-1.0, 1.0);
+    let cos3 = (4.0 * c * c - 3.0) * c;
+    -u_dc * THIRD_HARMONIC_PER_VOLT * cos3
+}
+
+/// Phase voltages with third-harmonic injection (3.8) \[V\], referred to the DC-link
+/// midpoint M.
+pub fn phase_voltages(u: AlphaBeta, u_dc: f32) -> Uvw {
+    let base = inverse_clarke(u);
+    let nm = common_mode(u, u_dc);
+    Uvw {
+        u: base.u + nm,
+        v: base.v + nm,
+        w: base.w + nm,
+    }
+}
+
+/// Saturates to \[0, 1\]; NaN gives 0.
+fn unit(x: f32) -> f32 {
+    if x >= 1.0 {
+        1.0
+    } else if x > 0.0 {
+        x
+    } else {
+        0.0
+    }
+}
+
+/// Duty cycles `1/2 + u_x·(1/U_dc)` (3.4 inverted, DC-link feed-forward (5.1)),
+/// saturated to \[0, 1\]. `inv_u_dc` comes from [`crate::feedforward::dc_link_gain`].
+pub fn duties(phase: Uvw, inv_u_dc: f32) -> [f32; 3] {
+    [
+        unit(0.5 + phase.u * inv_u_dc),
+        unit(0.5 + phase.v * inv_u_dc),
+        unit(0.5 + phase.w * inv_u_dc),
+    ]
+}
+
+/// THPWM duties for the αβ voltage `u` \[V\] at the DC-link voltage `u_dc` \[V\]
+/// (already guarded, see [`crate::feedforward::effective_dc_link`]) with
+/// `inv_u_dc = 1/u_dc`.
+pub fn thpwm(u: AlphaBeta, u_dc: f32, inv_u_dc: f32) -> [f32; 3] {
+    duties(phase_voltages(u, u_dc), inv_u_dc)
+}
+
+/// Timer compare values `round(DC·period)` for centre-aligned PWM with auto-reload
+/// `period`, each in `0..=period`.
+pub fn compare_values(duties: [f32; 3], period: u16) -> [u16; 3] {
+    let p = f32::from(period);
+    // `as u16` saturates (NaN → 0); `min` keeps rounding from exceeding the period.
+    duties.map(|d| ((unit(d) * p + 0.5) as u16).min(period))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use core::f64::consts::PI;
+    use proptest::prelude::*;
+
+    /// f64 reference of (3.7), (3.8), (3.4) with the thesis' formula literally:
+    /// u_NM = −U_dc/(6√3)·cos 3(θ + atan2(u_q, u_d)).
+    fn reference(ud: f64, uq: f64, th: f64, udc: f64) -> [f64; 3] {
+        let alpha = th.cos() * ud - th.sin() * uq;
+        let beta = th.sin() * ud + th.cos() * uq;
+        let s = 3f64.sqrt() / 2.0;
+        let ph = [alpha, -0.5 * alpha + s * beta, -0.5 * alpha - s * beta];
+        let nm = -udc / (6.0 * 3f64.sqrt()) * (3.0 * (th + uq.atan2(ud))).cos();
+        ph.map(|p| 0.5 + (p + nm) / udc)
+    }
+
+    proptest! {
+        /// Inside the linear range |u| ≤ U_dc/√3 the duties match the f64 reference
+        /// (f32 operands ≤ U_dc: error ≤ ~16·ε_f32 in duty ≈ 1e-6; we allow 1e-5 since
+        /// sin/cos of θ are rounded to f32 before the inverse Park) and lie in \[0, 1\].
+        #[test]
+        fn duties_match_f64_and_stay_in_range(m in 0f64..=1.0, phi in -PI..PI, th in -PI..PI, udc in 50f64..800.0) {
+            let mag = m * udc / 3f64.sqrt();
+            let (ud, uq) = (mag * phi.cos(), mag * phi.sin());
+            let sc = crate::transforms::SinCos { sin: th.sin() as f32, cos: th.cos() as f32 };
+            let ab = crate::transforms::inverse_park(crate::transforms::Dq { d: ud as f32, q: uq as f32 }, sc);
+            let d = thpwm(ab, udc as f32, 1.0 / udc as f32);
+            let r = reference(ud, uq, th, udc);
+            for k in 0..3 {
+                prop_assert!(d[k] >= 0.0 && d[k] <= 1.0);
+                // The reference may exceed [0, 1] by rounding only at the boundary.
+                prop_assert!((f64::from(d[k]) - r[k].clamp(0.0, 1.0)).abs() < 1e-5, "{k}: {} vs {}", d[k], r[k]);
+            }
+        }
+
+        /// The duties reproduce the requested line-to-line voltages:
+        /// (DC_u − DC_v)·U_dc = ũ_u − ũ_v for |u| ≤ U_dc/√3 (common mode cancels).
+        #[test]
+        fn line_to_line_voltages(m in 0f64..=0.999, phi in -PI..PI, udc in 50f64..800.0) {
+            let mag = m * udc / 3f64.sqrt();
+            let ab = AlphaBeta { alpha: (mag * phi.cos()) as f32, beta: (mag * phi.sin()) as f32 };
+            let d = thpwm(ab, udc as f32, 1.0 / udc as f32);
+            let ph = inverse_clarke(ab);
+            let want = [ph.u - ph.v, ph.v - ph.w, ph.w - ph.u];
+            let got = [d[0] - d[1], d[1] - d[2], d[2] - d[0]];
+            for k in 0..3 {
+                // f32 duty resolution near 0.5: 2^-24 → ×U_dc, a few roundings.
+                let err = (f64::from(got[k]) * udc - f64::from(want[k])).abs();
+                prop_assert!(err <= 8.0 * f64::from(f32::EPSILON) * udc, "{k}: {err}");
+            }
+        }
+
+        /// Beyond the linear range the duties saturate but stay in \[0, 1\]; also for
+        /// non-finite inputs.
+        #[test]
+        fn saturates(alpha in proptest::num::f32::ANY, beta in proptest::num::f32::ANY) {
+            let d = thpwm(AlphaBeta { alpha, beta }, 600.0, 1.0 / 600.0);
+            for x in d {
+                prop_assert!((0.0..=1.0).contains(&x));
+            }
+            for c in compare_values(d, 4250) {
+                prop_assert!(c <= 4250);
+            }
+        }
+    }
+
+    /// At exactly |u| = U_dc/√3 the largest duty reaches 1 (full DC-link use) and the
+    /// smallest 0, up to f32 rounding.
+    #[test]
+    fn linear_limit_uses_full_dc_link() {
+        let udc = 600.0f32;
+        let mag = udc * crate::transforms::INV_SQRT_3;
+        let mut hi = 0.0f32;
+        let mut lo = 1.0f32;
+        for k in 0..3600 {
+            let phi = (k as f32 / 10.0).to_radians();
+            let d = thpwm(
+                AlphaBeta {
+                    alpha: mag * phi.cos(),
+                    beta: mag * phi.sin(),
+                },
+                udc,
+                1.0 / udc,
+            );
+            hi = hi.max(d[0].max(d[1]).max(d[2]));
+            lo = lo.min(d[0].min(d[1]).min(d[2]));
+        }
+        assert!(hi > 0.9999 && lo < 1e-4, "{lo} {hi}");
+    }
+
+    #[test]
+    fn compare_values_round() {
+        assert_eq!(compare_values([0.0, 0.5, 1.0], 4250), [0, 2125, 4250]);
+        assert_eq!(compare_values([f32::NAN, -1.0, 2.0], 100), [0, 0, 100]);
+    }
+}
