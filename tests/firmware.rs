@@ -30,3 +30,36 @@ fn firmware_control_core_host_tests_pass() {
 fn firmware_control_core_builds_for_the_cortex_m4f() {
     cargo_in_firmware(&["build", "--locked", "--release", "--target", "thumbv7em-none-eabihf"], "firmware-target");
 }
+
+/// A bad spec fails the firmware build with the CLI's located message (`cargo::error=`),
+/// and an unknown `MOTOR` lists the motors that exist; never a build-script panic.
+#[test]
+fn firmware_build_reports_spec_errors_like_the_cli() {
+    let repo = motor_tests::repo();
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("bad-motors");
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = std::fs::read_to_string(repo.join("motors/fischer-ti085.toml")).unwrap();
+    let bad = good.replacen("inductance = \"0.393 mH\"", "inductance = 0.000393", 1);
+    let line = bad[..bad.find("inductance = 0.000393").unwrap()].matches('\n').count() + 1;
+    std::fs::write(dir.join("bad-motor.toml"), bad).unwrap();
+    std::fs::write(dir.join("good-motor.toml"), good).unwrap();
+    for (motor, expect) in [
+        ("bad-motor", vec![format!("motors/bad-motor.toml:{line}:14"), "`motor.datasheet.inductance`".into(), "bare number".into(), "accepted:".into()]),
+        ("no-such-motor", vec!["MOTOR=no-such-motor".into(), "bad-motor, good-motor".into()]),
+    ] {
+        let out = Command::new(env!("CARGO"))
+            .args(["build", "--locked", "-p", "motor-firmware"])
+            .current_dir(repo.join("firmware"))
+            .env("CARGO_TARGET_DIR", repo.join("target").join("firmware-host"))
+            .env("MOTOR", motor)
+            .env("MOTORS_DIR", &dir)
+            .output()
+            .unwrap();
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{motor}: build succeeded");
+        assert!(!stderr.contains("panicked"), "{motor}: build script panicked:\n{stderr}");
+        for e in expect {
+            assert!(stderr.contains(&e), "{motor}: expected {e:?} in\n{stderr}");
+        }
+    }
+}
