@@ -14,7 +14,10 @@ fn cargo_in_firmware(args: &[&str], target_dir: &str) {
         .expect("cargo runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "cargo {args:?} in firmware/ failed:\n{stdout}\n{stderr}");
+    assert!(
+        out.status.success(),
+        "cargo {args:?} in firmware/ failed:\n{stdout}\n{stderr}"
+    );
     // Echo the inner test summary so it shows in the outer log.
     for line in stdout.lines().filter(|l| l.starts_with("test result:")) {
         println!("firmware: {line}");
@@ -28,7 +31,10 @@ fn firmware_control_core_host_tests_pass() {
 
 #[test]
 fn firmware_control_core_builds_for_the_cortex_m4f() {
-    cargo_in_firmware(&["build", "--locked", "--release", "--target", "thumbv7em-none-eabihf"], "firmware-target");
+    cargo_in_firmware(
+        &["build", "--locked", "--release", "--target", "thumbv7em-none-eabihf"],
+        "firmware-target",
+    );
 }
 
 /// A bad spec fails the firmware build with the CLI's located message (`cargo::error=`),
@@ -44,8 +50,19 @@ fn firmware_build_reports_spec_errors_like_the_cli() {
     std::fs::write(dir.join("bad-motor.toml"), bad).unwrap();
     std::fs::write(dir.join("good-motor.toml"), good).unwrap();
     for (motor, expect) in [
-        ("bad-motor", vec![format!("motors/bad-motor.toml:{line}:14"), "`motor.datasheet.inductance`".into(), "bare number".into(), "accepted:".into()]),
-        ("no-such-motor", vec!["MOTOR=no-such-motor".into(), "bad-motor, good-motor".into()]),
+        (
+            "bad-motor",
+            vec![
+                format!("motors/bad-motor.toml:{line}:14"),
+                "`motor.datasheet.inductance`".into(),
+                "bare number".into(),
+                "accepted:".into(),
+            ],
+        ),
+        (
+            "no-such-motor",
+            vec!["MOTOR=no-such-motor".into(), "bad-motor, good-motor".into()],
+        ),
     ] {
         let out = Command::new(env!("CARGO"))
             .args(["build", "--locked", "-p", "motor-firmware"])
@@ -57,7 +74,10 @@ fn firmware_build_reports_spec_errors_like_the_cli() {
             .unwrap();
         let stderr = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{motor}: build succeeded");
-        assert!(!stderr.contains("panicked"), "{motor}: build script panicked:\n{stderr}");
+        assert!(
+            !stderr.contains("panicked"),
+            "{motor}: build script panicked:\n{stderr}"
+        );
         for e in expect {
             assert!(stderr.contains(&e), "{motor}: expected {e:?} in\n{stderr}");
         }

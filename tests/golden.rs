@@ -52,8 +52,10 @@ fn rendered_outputs_match_golden_files() {
 
 #[test]
 fn rust_output_is_rustfmt_clean() {
-    // Checked with rustfmt's default configuration (no rustfmt.toml in that directory).
+    // Checked with rustfmt's default configuration: an empty rustfmt.toml beside the file
+    // shadows the repository's own (max_width = 120), which rustfmt would otherwise find.
     let dir = tmp("rustfmt");
+    std::fs::write(dir.join("rustfmt.toml"), "").unwrap();
     for (stem, _, _) in motor_tests::motors() {
         let path = dir.join(Output::Rust.file_name(&stem));
         std::fs::write(&path, render(&design(&stem), Output::Rust).unwrap()).unwrap();

@@ -5,8 +5,8 @@
 //! CLI, the firmware's build script and the proc-macros all call it, so a
 //! constant cannot differ between the three paths.
 
-pub mod design;
 pub mod constants;
+pub mod design;
 pub mod diagnostic;
 pub mod render;
 pub mod spec;

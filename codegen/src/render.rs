@@ -122,14 +122,21 @@ fn render_error(e: &minijinja::Error, fallback: &str) -> RenderError {
     if let Some(d) = e.detail() {
         message = format!("{message}: {d}");
     }
-    RenderError { template: e.name().unwrap_or(fallback).to_string(), line: e.line(), message }
+    RenderError {
+        template: e.name().unwrap_or(fallback).to_string(),
+        line: e.line(),
+        message,
+    }
 }
 
 /// Renders `source` (named `name` for messages) for the design `d`.
 pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, RenderError> {
     let mut env = Environment::new();
     env.set_undefined_behavior(UndefinedBehavior::Strict);
-    let syntax = SyntaxConfig::builder().keep_trailing_newline(true).build().map_err(|e| render_error(&e, name))?;
+    let syntax = SyntaxConfig::builder()
+        .keep_trailing_newline(true)
+        .build()
+        .map_err(|e| render_error(&e, name))?;
     env.set_syntax(syntax);
     env.add_filter("rust_const", |k: Serde<Constant>, indent: usize| rust_const(&k, indent));
     env.add_template(name, source).map_err(|e| render_error(&e, name))?;
@@ -149,9 +156,12 @@ pub fn new_spec(stem: &str) -> Result<String, RenderError> {
     let name = "new-motor.toml.j2";
     let mut env = Environment::new();
     env.set_undefined_behavior(UndefinedBehavior::Strict);
-    env.add_template(name, include_str!("../../templates/new-motor.toml.j2")).map_err(|e| render_error(&e, name))?;
+    env.add_template(name, include_str!("../../templates/new-motor.toml.j2"))
+        .map_err(|e| render_error(&e, name))?;
     let tmpl = env.get_template(name).map_err(|e| render_error(&e, name))?;
-    tmpl.render(context! { stem => stem }).map(|s| s + "\n").map_err(|e| render_error(&e, name))
+    tmpl.render(context! { stem => stem })
+        .map(|s| s + "\n")
+        .map_err(|e| render_error(&e, name))
 }
 
 /// Renders one output with the built-in template.

@@ -179,9 +179,10 @@ fn normalise(unit: &str) -> String {
     }
     // `uH`, `uWb`, `us`, … : a leading ASCII `u` before a unit letter means micro.
     if let Some(rest) = u.strip_prefix('u')
-        && rest.starts_with(|c: char| c.is_ascii_uppercase() || c == 's' || c == 'Ω') {
-            u = format!("µ{rest}");
-        }
+        && rest.starts_with(|c: char| c.is_ascii_uppercase() || c == 's' || c == 'Ω')
+    {
+        u = format!("µ{rest}");
+    }
     u
 }
 

@@ -36,7 +36,8 @@ fn main() {
                 rd.flatten()
                     .filter_map(|e| {
                         let p = e.path();
-                        (p.extension().is_some_and(|x| x == "toml")).then(|| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+                        (p.extension().is_some_and(|x| x == "toml"))
+                            .then(|| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
                     })
                     .flatten()
                     .collect()
@@ -48,7 +49,13 @@ fn main() {
     let text = match std::fs::read(&spec) {
         Ok(bytes) => match String::from_utf8(bytes) {
             Ok(t) => t,
-            Err(e) => return fail(&format!("{}: the file is not valid UTF-8 (byte {})", spec.display(), e.utf8_error().valid_up_to())),
+            Err(e) => {
+                return fail(&format!(
+                    "{}: the file is not valid UTF-8 (byte {})",
+                    spec.display(),
+                    e.utf8_error().valid_up_to()
+                ));
+            }
         },
         Err(e) => {
             return fail(&format!(
@@ -69,9 +76,9 @@ fn main() {
     };
     let out = PathBuf::from(std::env::var("OUT_DIR").unwrap_or_default()).join("motor.rs");
     // Write only when the bytes change, so an unchanged design causes no rebuild.
-    if std::fs::read(&out).ok().as_deref() != Some(code.as_bytes()) {
-        if let Err(e) = std::fs::write(&out, code) {
-            fail(&format!("cannot write {}: {e}", Path::new(&out).display()));
-        }
+    if std::fs::read(&out).ok().as_deref() != Some(code.as_bytes())
+        && let Err(e) = std::fs::write(&out, code)
+    {
+        fail(&format!("cannot write {}: {e}", Path::new(&out).display()));
     }
 }

@@ -29,7 +29,10 @@ pub fn motor_constants(input: TokenStream) -> syn::Result<TokenStream> {
     let design = codegen::design_source(&rel, &text).map_err(|e| {
         // compile_error! already says "error:".
         let msg = e.to_string();
-        syn::Error::new(lit.span(), msg.strip_prefix("error: ").unwrap_or(&msg).trim_end().to_string())
+        syn::Error::new(
+            lit.span(),
+            msg.strip_prefix("error: ").unwrap_or(&msg).trim_end().to_string(),
+        )
     })?;
     let code = render(&design, Output::Rust).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
     let items: TokenStream = code
@@ -129,13 +132,16 @@ impl Named {
                     &a.name,
                     format!("unknown argument `{key}`; accepted: {}", allowed.join(", ")),
                 ));
-            } else if args.contains_key(&key) {
-                push(syn::Error::new_spanned(
-                    &a.name,
-                    format!("argument `{key}` given twice"),
-                ));
             } else {
-                args.insert(key, a);
+                match args.entry(key) {
+                    std::collections::btree_map::Entry::Vacant(slot) => {
+                        slot.insert(a);
+                    }
+                    std::collections::btree_map::Entry::Occupied(slot) => {
+                        let message = format!("argument `{}` given twice", slot.key());
+                        push(syn::Error::new_spanned(&a.name, message));
+                    }
+                }
             }
         }
         match errors {

@@ -484,12 +484,13 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     };
 
     if let Some(check) = &m.flux_cross_check
-        && check.disagreement_percent > 10.0 {
-            warnings.push(format!(
-                "ψ_M from K_t ({:.4} Wb) and from K_e ({:.4} Wb) disagree by {:.1} %",
-                check.from_torque_constant_wb, check.from_back_emf_constant_wb, check.disagreement_percent
-            ));
-        }
+        && check.disagreement_percent > 10.0
+    {
+        warnings.push(format!(
+            "ψ_M from K_t ({:.4} Wb) and from K_e ({:.4} Wb) disagree by {:.1} %",
+            check.from_torque_constant_wb, check.from_back_emf_constant_wb, check.disagreement_percent
+        ));
+    }
     if m.flux_linkage.is_none() {
         warnings.push("ψ_M is unknown: the back-EMF feed-forward term and torque → i_q conversion are omitted".into());
     }

@@ -817,31 +817,31 @@ impl<'a> Resolver_<'a> {
             let Some(s) = section else { continue };
             let p = s.get_ref();
             if from_kt.is_none()
-                && let Some(kt) = &p.torque_constant {
-                    let k = kt.get_ref();
-                    let key = format!("motor.{name}.torque_constant");
-                    if let Some(v) = self.quantity(&format!("{key}.value"), &k.value, Kind::TorqueConstant, prov, true)
-                    {
-                        let psi = crate::design::flux_linkage::from_torque_constant(v.value, *k.current.get_ref(), np);
-                        from_kt = Some((psi, key, kt.span(), prov));
-                    }
+                && let Some(kt) = &p.torque_constant
+            {
+                let k = kt.get_ref();
+                let key = format!("motor.{name}.torque_constant");
+                if let Some(v) = self.quantity(&format!("{key}.value"), &k.value, Kind::TorqueConstant, prov, true) {
+                    let psi = crate::design::flux_linkage::from_torque_constant(v.value, *k.current.get_ref(), np);
+                    from_kt = Some((psi, key, kt.span(), prov));
                 }
+            }
             if from_ke.is_none()
-                && let Some(ke) = &p.back_emf_constant {
-                    let k = ke.get_ref();
-                    let key = format!("motor.{name}.back_emf_constant");
-                    if let Some(v) = self.quantity(&format!("{key}.value"), &k.value, Kind::BackEmfConstant, prov, true)
-                    {
-                        let psi = crate::design::flux_linkage::from_back_emf_constant(
-                            v.value,
-                            *k.voltage.get_ref(),
-                            *k.measured.get_ref(),
-                            *k.speed.get_ref(),
-                            np,
-                        );
-                        from_ke = Some((psi, key, ke.span(), prov));
-                    }
+                && let Some(ke) = &p.back_emf_constant
+            {
+                let k = ke.get_ref();
+                let key = format!("motor.{name}.back_emf_constant");
+                if let Some(v) = self.quantity(&format!("{key}.value"), &k.value, Kind::BackEmfConstant, prov, true) {
+                    let psi = crate::design::flux_linkage::from_back_emf_constant(
+                        v.value,
+                        *k.voltage.get_ref(),
+                        *k.measured.get_ref(),
+                        *k.speed.get_ref(),
+                        np,
+                    );
+                    from_ke = Some((psi, key, ke.span(), prov));
                 }
+            }
         }
         let check = match (&from_kt, &from_ke) {
             (Some((a, ..)), Some((b, ..))) => Some(FluxCrossCheck {
@@ -996,17 +996,18 @@ impl<'a> Resolver_<'a> {
             true,
         );
         if let (Some(lo), Some(hi)) = (&umin, &udc)
-            && lo.value > hi.value {
-                self.err(
-                    lo.span.clone(),
-                    "drive.dc_link_voltage_min",
-                    format!(
-                        "minimum DC-link voltage {} V is above the nominal {} V",
-                        lo.value, hi.value
-                    ),
-                    "a voltage ≤ drive.dc_link_voltage",
-                );
-            }
+            && lo.value > hi.value
+        {
+            self.err(
+                lo.span.clone(),
+                "drive.dc_link_voltage_min",
+                format!(
+                    "minimum DC-link voltage {} V is above the nominal {} V",
+                    lo.value, hi.value
+                ),
+                "a voltage ≤ drive.dc_link_voltage",
+            );
+        }
         let dead_time = self.opt_quantity("drive.dead_time", d.dead_time.as_ref(), Kind::Time, true);
         let udc = udc?;
         let dc_link_voltage_min = umin.unwrap_or_else(|| Param {

@@ -24,6 +24,9 @@ mod tests {
         assert_eq!(motor::observer::KP.to_bits(), 4_784_957);
         assert_eq!(motor::observer::KI.to_bits(), 8_374);
         assert_eq!(motor::current_loop::D_KP, 0.0393);
-        assert_eq!(motor::filter::TAPS_Q15.iter().map(|&t| i32::from(t)).sum::<i32>(), 32768);
+        assert_eq!(
+            motor::filter::TAPS_Q15.iter().map(|&t| i32::from(t)).sum::<i32>(),
+            32768
+        );
     }
 }
