@@ -8,4 +8,6 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+pub mod icount;
+pub mod motor_config;
 pub mod vectors;
