@@ -7,6 +7,9 @@ use clap::{Parser, Subcommand, ValueEnum};
 use codegen::render::{Output, render_with};
 use codegen::{Diagnostic, Diagnostics};
 
+#[path = "motorgen/firmware.rs"]
+mod firmware;
+
 /// Motor description (TOML) → tuned motor-controller constants.
 #[derive(Parser)]
 #[command(name = "motorgen", version, about)]
@@ -51,6 +54,19 @@ enum Command {
         /// File stem: lowercase letters, digits and '-'.
         stem: String,
         /// Directory of motor specs.
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
+    /// Build the STM32G474 image of one motor (or --all) into target/firmware/<stem>.elf
+    /// and .bin and print its flash and RAM use (fails above 64 KiB of flash).
+    Firmware {
+        /// Motor file stem in the motors folder, e.g. fischer-ti085.
+        #[arg(required_unless_present = "all", conflicts_with = "all")]
+        stem: Option<String>,
+        /// Every motor in the motors folder.
+        #[arg(long)]
+        all: bool,
+        /// Directory of motor specs (default: motors/).
         #[arg(long)]
         dir: Option<PathBuf>,
     },
@@ -294,6 +310,13 @@ fn main() -> ExitCode {
                     ExitCode::FAILURE
                 }
             }
+        }
+        Command::Firmware { stem, all, dir } => {
+            let which = match stem {
+                Some(stem) if !all => firmware::Which::One(stem),
+                _ => firmware::Which::All,
+            };
+            firmware::run(which, &motors_dir(dir))
         }
         Command::List { dir } => {
             let dir = motors_dir(dir);
