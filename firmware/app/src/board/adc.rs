@@ -27,8 +27,10 @@ const ADC2_SEQUENCE: Sequence = Sequence([4, 3, 17]);
 
 /// Regulator start-up, calibration and enable of one converter (RM0440 §21.4.6–9).
 fn power_up(adc: &pac::adc1::RegisterBlock) -> bool {
-    adc.cr().write(|w| w.deeppwd().clear_bit());
-    adc.cr().write(|w| w.advregen().set_bit());
+    // Leave deep power-down, then enable the regulator (CR bits must be changed
+    // one at a time with read-modify-write: DEEPPWD resets to 1).
+    adc.cr().modify(|_, w| w.deeppwd().clear_bit());
+    adc.cr().modify(|_, w| w.advregen().set_bit());
     delay_us(hw::ADC_VREG_STARTUP_US);
     adc.cr().modify(|_, w| w.adcaldif().clear_bit().adcal().set_bit());
     if !wait_for(POLL_LIMIT, || adc.cr().read().adcal().bit_is_clear()) {
