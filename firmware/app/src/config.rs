@@ -8,12 +8,13 @@ use motor_control::adc::{CurrentSense, DcLinkSense, MeasuredPhases};
 use motor_control::angle::ResolverToElectrical;
 use motor_control::ato::AtoConfig;
 use motor_control::feedforward::FeedForwardConfig;
+use motor_control::fir::FmacFir;
 use motor_control::pi::{CurrentPiConfig, PiConfig, VoltageLimit};
 use motor_control::setpoint::SetpointConfig;
 
 use crate::design;
 use crate::hw;
-use crate::motor::{current_loop as cl, limits, observer, scaling};
+use crate::motor::{current_loop as cl, filter, limits, observer, scaling};
 use crate::timing;
 
 /// TIM1 auto-reload: centre-aligned carrier at f_s from the 170 MHz timer clock
@@ -132,6 +133,14 @@ pub const WATCHDOG: (u8, u16) = {
     }
 };
 
+/// Taps of the identification FIR.
+pub const FILTER_TAPS: usize = filter::ORDER + 1;
+
+/// The identification low-pass of thesis A §6.2 for the FMAC: the generated Q1.15
+/// taps, whose sum is 2^15 (DC gain exactly 1), so the output gain is 2^0 (R = 0),
+/// with clipping.
+pub const FILTER: FmacFir<FILTER_TAPS> = FmacFir::new(filter::TAPS_Q15);
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -199,6 +208,21 @@ mod tests {
         assert_eq!(WATCHDOG, (0, 40));
         assert_eq!(ADC_SMP, 0);
         assert!(close(IQ_PER_NM, motor::current_loop::IQ_PER_NM, 0.0));
+        // Thesis A §6.2: order 20 → 21 taps.
+        assert_eq!(FILTER_TAPS, 21);
+    }
+
+    /// The FIR has DC gain exactly 1 (Σ taps = 2^15, output gain 2^0): a constant
+    /// input comes out unchanged once the history is full (the FMAC model).
+    #[test]
+    fn filter_has_unity_dc_gain() {
+        let mut st = motor_control::fir::FirState::new();
+        let mut y = 0;
+        for _ in 0..FILTER_TAPS {
+            y = FILTER.process(&mut st, 8192);
+        }
+        assert_eq!(y, 8192);
+        assert_eq!(FILTER.gain_shift, 0);
     }
 
     /// Every motor: the configuration is consistent with its own constants (the

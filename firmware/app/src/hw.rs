@@ -46,3 +46,42 @@ pub const WATCHDOG_CONTROL_PERIODS: u32 = 100;
 /// Torque resolution of the setpoint frame \[mN·m per LSB\]: bytes 0–1 hold a
 /// little-endian `i16`, so ±327.67 N·m in 0.01 N·m steps.
 pub const SETPOINT_TORQUE_MNM_PER_LSB: u32 = 10;
+
+/// PLL input divider M (HSI16/4 = 4 MHz, within RM0440's 2.66–8 MHz).
+pub const PLL_M: u32 = 4;
+/// PLL multiplier N (VCO 4 MHz·85 = 340 MHz, within 96–344 MHz).
+pub const PLL_N: u32 = 85;
+/// PLL output divider R (340/2 = 170 MHz = SYSCLK).
+pub const PLL_R: u32 = 2;
+/// HSI16 oscillator \[Hz\].
+pub const HSI_HZ: u32 = 16_000_000;
+const _: () = assert!(HSI_HZ / PLL_M * PLL_N / PLL_R == SYSCLK_HZ);
+/// Flash wait states at 170 MHz in range-1 boost mode (RM0440 Table 9).
+pub const FLASH_WAIT_STATES: u8 = 4;
+/// ADC voltage-regulator start-up time t_ADCVREG_STUP \[µs\] (DS12288 Table 66).
+pub const ADC_VREG_STARTUP_US: u32 = 20;
+/// Microseconds per second.
+pub const US_PER_S: u32 = 1_000_000;
+
+/// FDCAN nominal bit rate \[bit/s\] of the vehicle bus.
+pub const CAN_BITRATE: u32 = 500_000;
+/// Time quanta per CAN bit: 1 (sync) + 15 (TSEG1) + 4 (TSEG2), sample point 80 %.
+pub const CAN_TQ_PER_BIT: u32 = 20;
+/// TSEG2 and the resynchronisation jump width \[tq\].
+pub const CAN_TSEG2: u32 = 4;
+/// FDCAN1 message RAM (SRAMCAN) base address (RM0440 §44.3.3).
+pub const FDCAN1_RAM: usize = 0x4000_A400;
+/// Offset of RX FIFO 0 in the message RAM \[bytes\] (fixed layout, RM0440 §44.3.3).
+pub const FDCAN_RXF0_OFFSET: usize = 0xB0;
+/// Size of one RX FIFO element \[bytes\]: 18 words (header + 64 data bytes).
+pub const FDCAN_RX_ELEMENT_BYTES: usize = 72;
+
+/// TIM1 break-input digital filter BKF: f_DTS, N = 8 samples (RM0440 §28.6.20,
+/// code 0b0011 = f_CK_INT, N = 8): ignores glitches shorter than 47 ns.
+pub const BREAK_FILTER: u8 = 0b0011;
+/// Polls of ADC2's end-of-sequence flag after ADC1's (they finish together; a few
+/// polls cover bus timing).
+pub const ADC_SLAVE_POLLS: u32 = 16;
+/// CORDIC start-up check tolerance against the software reference \[LSB of Q1.31\]:
+/// 2^13 ≈ 3.8·10⁻⁶, above the 24-iteration residual error (order 2^-19 = 2^12 LSB).
+pub const CORDIC_TOLERANCE_LSB: u32 = 1 << 13;
