@@ -12,6 +12,8 @@ pub mod render;
 pub mod spec;
 pub mod summary;
 pub mod units;
+#[cfg(feature = "verify")]
+pub mod verify;
 
 pub use design::Design;
 pub use diagnostic::{Diagnostic, Diagnostics, Source};

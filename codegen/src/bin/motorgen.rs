@@ -1,5 +1,8 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
+#[path = "motorgen/verify.rs"]
+mod verify;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
@@ -53,6 +56,12 @@ enum Command {
         /// Directory of motor specs.
         #[arg(long)]
         dir: Option<PathBuf>,
+    },
+    /// Simulate the firmware's current loop and observer with the motor and print a
+    /// pass/fail table of measured vs designed figures (non-zero exit on a failure).
+    Verify {
+        /// The motor spec.
+        spec: PathBuf,
     },
     /// List the motors in a directory (default: motors/).
     List {
@@ -295,6 +304,7 @@ fn main() -> ExitCode {
                 }
             }
         }
+        Command::Verify { spec } => verify::run(&spec),
         Command::List { dir } => {
             let dir = motors_dir(dir);
             let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {
