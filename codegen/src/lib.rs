@@ -9,6 +9,8 @@ pub mod constants;
 pub mod design;
 pub mod diagnostic;
 pub mod render;
+#[cfg(feature = "verify")]
+pub mod report;
 pub mod spec;
 pub mod summary;
 pub mod units;

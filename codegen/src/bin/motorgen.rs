@@ -1,5 +1,7 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
+#[path = "motorgen/report.rs"]
+mod report;
 #[path = "motorgen/verify.rs"]
 mod verify;
 
@@ -62,6 +64,15 @@ enum Command {
     Verify {
         /// The motor spec.
         spec: PathBuf,
+    },
+    /// Write a self-contained HTML report (verification table, SVG plots, every constant
+    /// with formula and provenance) to DIR/<stem>.html.
+    Report {
+        /// The motor spec.
+        spec: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// List the motors in a directory (default: motors/).
     List {
@@ -305,6 +316,7 @@ fn main() -> ExitCode {
             }
         }
         Command::Verify { spec } => verify::run(&spec),
+        Command::Report { spec, out } => report::run(&spec, &out),
         Command::List { dir } => {
             let dir = motors_dir(dir);
             let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {

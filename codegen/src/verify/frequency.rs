@@ -100,6 +100,28 @@ pub fn current_loop(g: &AxisGains, r: f64, l: f64, ts: f64, omega: &[f64]) -> (R
     )
 }
 
+/// Unit step response of the same discrete loop as [`current_loop`], sampled at t_n
+/// (`n` samples; index 0 is the sample at which the reference steps), by its
+/// difference equations: `v(n) = k_p·(r_f(n) − i(n)) + k_i·I(n) − R_a·i(n)`,
+/// `I(n+1) = I(n) + T_s·(r_f(n) − i(n))`, `i(n+1) = a·i(n) + b·v(n−1)`.
+pub fn current_loop_step(g: &AxisGains, r: f64, l: f64, ts: f64, n: usize) -> Vec<f64> {
+    let a = (-r * ts / l).exp();
+    let b = (1.0 - a) / r;
+    let c = g.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient);
+    let (mut i, mut integral, mut rf, mut v_prev) = (0.0, 0.0, 0.0, 0.0);
+    let mut out = Vec::with_capacity(n);
+    for _ in 0..n {
+        out.push(i);
+        rf += c * (1.0 - rf);
+        let e = rf - i;
+        let v = g.kp * e + g.ki * integral - g.active_damping_ohm * i;
+        integral += ts * e;
+        i = a * i + b * v_prev;
+        v_prev = v;
+    }
+    out
+}
+
 /// The designed continuous closed loop of the current controller: α/(s + α) (IMC,
 /// thesis A (5.8), thesis B (2.41)) or ω_n²/(s² + 2ζω_n·s + ω_n²) (pole placement with
 /// prefilter, (4.14), (5.16)).
@@ -240,6 +262,23 @@ mod tests {
         );
         let db = t.magnitude_db()[0];
         assert!((db + 3.0103).abs() < 0.1, "{db}");
+    }
+
+    /// The step response's final value is the closed loop's DC gain 1, and its first two
+    /// samples are 0 (one period of computation delay, then the PWM period itself).
+    #[test]
+    fn discrete_step_settles_at_one_after_the_delay() {
+        let d = fischer();
+        let y = current_loop_step(
+            &d.current_loop.q,
+            d.motor.phase_resistance_ohm,
+            d.motor.q_inductance_h,
+            d.drive.sample_period_s,
+            20_000,
+        );
+        assert_eq!((y[0], y[1]), (0.0, 0.0));
+        assert!(y[2] > 0.0);
+        assert!((y[19_999] - 1.0).abs() < 1e-6, "{}", y[19_999]);
     }
 
     /// Phase unwrapping keeps a linear-phase FIR's phase monotonic: −ω·N/2·T_s.

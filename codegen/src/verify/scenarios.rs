@@ -19,8 +19,9 @@ use motor_control::ato::AtoState;
 use motor_control::step::Demand;
 
 use super::figures::{designed_rise_time, designed_step, settling_time, step_figures};
+use super::frequency::current_loop_step;
 use super::plant::{SpeedProfile, wrap};
-use super::sim::{Bench, Q31, angle_q31, q31_angle};
+use super::sim::{Bench, angle_q31, q31_angle};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use crate::spec::{Method, ObserverError};
 
@@ -169,7 +170,29 @@ pub fn current_step(s: &Setup<'_>) -> ScenarioResult {
         let rise_ok = (f.rise_time / rise_design - 1.0).abs() <= 0.10;
         checks.push(
             check(format!("{axis}-axis rise time 10–90 %"), rise, Some(want), "ms")
-                .criterion("within 10 % of designed", rise_ok),
+                .criterion("within 10 % of designed (continuous)", rise_ok),
+        );
+        // The same gains in the discrete loop with the 1.5·T_s delay (frequency.rs): tells
+        // a sampling effect (both measured and predicted off the design) from an
+        // implementation fault (measured off the prediction).
+        let (g, l) = if k == 0 {
+            (&cl.d, d.motor.d_inductance_h)
+        } else {
+            (&cl.q, d.motor.q_inductance_h)
+        };
+        let z = current_loop_step(g, d.motor.phase_resistance_ohm, l, ts, n + 2);
+        let zf = step_figures(&z, ts, 0.0, 1.0);
+        checks.push(
+            check(
+                format!("{axis}-axis rise time vs the discrete loop (T_s, 1.5·T_s delay)"),
+                rise,
+                Some(zf.rise_time * 1e3),
+                "ms",
+            )
+            .criterion(
+                "within 5 % of the z-domain prediction",
+                (f.rise_time / zf.rise_time - 1.0).abs() <= 0.05,
+            ),
         );
         let (limit, why) = match cl.method {
             Method::PolePlacement => (0.05, "≤ 5 % (ζ = 1/√2 with prefilter: e^−π = 4.3 %, thesis A §5.4.1)"),
@@ -248,15 +271,21 @@ pub fn decoupling(s: &Setup<'_>) -> ScenarioResult {
     let a = step_amplitude(s);
     let we = operating_speed(s);
     let wm = we / f64::from(d.motor.pole_pairs);
-    // Let the integrators take over the back EMF before the step without feed-forward.
-    let settle = samples(s, 10.0 / disturbance_pole(s));
     let n = samples(s, 10.0 / d.current_loop.bandwidth_rad_s);
     let mut excursion = [0.0; 2];
     let mut traces_i = Vec::new();
     let mut t0 = Vec::new();
     for ff in [false, true] {
         let mut b = s.bench(wm);
-        let (t, i) = run(&mut b, settle, current(0.0, 0.0, ff), n, current(0.0, a, ff));
+        if !ff {
+            // Start from the steady state at i = 0: the q integrator holds the back EMF
+            // ω_e·ψ_M the feed-forward would otherwise supply (u_q = k_i·I_q). Settling
+            // into it from rest can take long: without decoupling, ω_e ≫ α leaves a
+            // lightly damped cross-coupled mode.
+            let psi = d.motor.flux_linkage_wb.unwrap_or(0.0);
+            b.state.current.q.integral = (we * psi / d.current_loop.q.ki) as f32;
+        }
+        let (t, i) = run(&mut b, 20, current(0.0, 0.0, ff), n, current(0.0, a, ff));
         excursion[usize::from(ff)] = i.iter().map(|x| x[0].abs()).fold(0.0, f64::max);
         traces_i.push(i);
         t0 = t.iter().map(|x| x - t[0]).collect();
@@ -416,15 +445,6 @@ pub fn dc_link_step(s: &Setup<'_>) -> ScenarioResult {
     }
 }
 
-/// Linear ATO loop gain of the Q1.31 integers: the error is sin(Δ) (trig identity, in
-/// rad) or Δ/π (atan2), so K̃·π resp. K̃ per rad (4.22).
-fn observer_gain_per_rad(s: &Setup<'_>) -> f64 {
-    match s.design.angle_observer.error {
-        ObserverError::TrigIdentity => PI,
-        ObserverError::Atan2 => 1.0,
-    }
-}
-
 /// Time [s] for the continuous ATO (thesis A (4.12)–(4.14)) started `e0` rad off at rest
 /// to stay within `threshold`: ë + K_p·ė + K_i·e = 0, e(0) = e0, ė(0) = −K_p·e0.
 pub fn designed_lock_time(kp: f64, ki: f64, e0: f64, threshold: f64) -> f64 {
@@ -545,14 +565,12 @@ pub const RAMP_LAG_FRACTION: f64 = 0.1;
 pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
     let d = s.design;
     let o = &d.angle_observer;
-    let ts = d.drive.sample_period_s;
     let nr = f64::from(o.resolver_pole_pairs);
-    // K_i the Q1.31 integer actually realises (4.22): K̃_i·g·f_s² per rad.
-    let ki_eff = f64::from(o.ki_q31) / Q31 * observer_gain_per_rad(s) / (ts * ts);
+    // Design intent K_i = ω_n² (4.15); the Q1.31 integer realises it to ki_quantisation_error.
     let acc_r = RAMP_LAG_FRACTION * o.ki;
     let lag_design = match o.error {
-        ObserverError::TrigIdentity => (acc_r / ki_eff).asin(),
-        ObserverError::Atan2 => acc_r / ki_eff,
+        ObserverError::TrigIdentity => RAMP_LAG_FRACTION.asin(),
+        ObserverError::Atan2 => RAMP_LAG_FRACTION,
     };
     let w_max = d.motor.max_speed_rad_s;
     let ramp = w_max / (acc_r / nr);
