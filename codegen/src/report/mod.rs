@@ -59,7 +59,8 @@ pub const SECTIONS: &[(&str, &str)] = &[
 /// Current circle and voltage ellipses (thesis B (2.50)–(2.53)): |i| = i_max and
 /// (L_d·i_d + ψ_M)² + (L_q·i_q)² = (V_max/ω_e)², V_max = U_dc/√3, at a quarter, half,
 /// three quarters and all of ω_e,max, and at the speed where the ellipse passes through
-/// (0, i_max) when that is below ω_e,max.
+/// (0, i_max) when that is below ω_e,max. Returns the lines and the half-width of the
+/// square view [A].
 pub fn dq_plane_lines(d: &Design) -> (Vec<Line>, f64) {
     let m = &d.motor;
     let i_max = m.peak_current_a;
@@ -75,7 +76,7 @@ pub fn dq_plane_lines(d: &Design) -> (Vec<Line>, f64) {
         .collect();
     let mut lines = vec![(format!("current circle |i| = {}", format_value(i_max, "A")), circle)];
     let w_max = m.max_electrical_speed_rad_s;
-    let w_corner = v_max / (psi * psi + (lq * i_max).powi(2)).sqrt();
+    let w_corner = corner_speed(d);
     let mut speeds: Vec<f64> = [0.25, 0.5, 0.75, 1.0].iter().map(|f| f * w_max).collect();
     if w_corner < w_max {
         speeds.push(w_corner);
@@ -99,7 +100,20 @@ pub fn dq_plane_lines(d: &Design) -> (Vec<Line>, f64) {
             pts,
         ));
     }
-    (lines, 1.6 * i_max)
+    // Room for the current circle and for the top-speed ellipse's part nearest the
+    // origin (its rightmost point and its i_q semi-axis), which a slow motor may place
+    // outside the circle.
+    let rho = v_max / w_max;
+    let half = (1.6 * i_max).max(1.1 * (rho - psi).abs() / ld).max(1.1 * rho / lq);
+    (lines, half)
+}
+
+/// Electrical speed [rad/s] at which the voltage ellipse passes through (0, i_max):
+/// ω = V_max/√(ψ_M² + (L_q·i_max)²) (thesis B (2.53) with i_d = 0, |i_q| = i_max).
+pub fn corner_speed(d: &Design) -> f64 {
+    let m = &d.motor;
+    let psi = m.flux_linkage_wb.unwrap_or(0.0);
+    d.current_loop.voltage_limit_v / (psi * psi + (m.q_inductance_h * m.peak_current_a).powi(2)).sqrt()
 }
 
 /// Every plot of the report for `d` and its verification `v`, in page order.
@@ -335,33 +349,27 @@ mod tests {
         assert_eq!(escape("a<b & \"c\"'"), "a&lt;b &amp; &quot;c&quot;&#39;");
     }
 
-    /// Fischer: ψ_M = 0.0604 Wb-ish, L = 0.393 mH: every ellipse is centred at
-    /// (−ψ_M/L_d, 0) with semi-axes ρ/L_d and ρ/L_q, ρ = V_max/ω_e — checked on the
-    /// points themselves: (L_d·i_d + ψ_M)² + (L_q·i_q)² = ρ².
+    /// Fischer by hand: ψ_M from K_e = 0.296 V·s/rad (rms, line to line, mechanical):
+    /// 0.296·√2/(√3·4) = 0.060421 Wb; i_max = √2·61 A = 86.267 A; V_max = 600/√3 =
+    /// 346.41 V; ω_e,max = 4·20000·2π/60 = 8377.6 rad/s.
+    /// Corner speed 346.41/√(0.060421² + (0.393e-3·86.267)²) = 346.41/0.069283 = 5000 rad/s.
+    /// At ω_e,max, ρ = 346.41/8377.6 = 0.041350 Wb and the ellipse's rightmost point is
+    /// i_d = (ρ − ψ_M)/L_d = (0.041350 − 0.060421)/0.393e-3 = −48.53 A, at i_q = 0.
     #[test]
-    fn ellipse_points_satisfy_the_voltage_limit() {
+    fn fischer_limits_by_hand() {
         let text =
             std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../motors/fischer-ti085.toml")).unwrap();
         let d = crate::design_source("f.toml", &text).unwrap();
-        let (lines, _) = dq_plane_lines(&d);
-        let (ld, lq, psi) = (
-            d.motor.d_inductance_h,
-            d.motor.q_inductance_h,
-            d.motor.flux_linkage_wb.unwrap(),
-        );
-        assert!(lines.len() >= 5, "circle + ≥ 4 ellipses");
-        for (label, pts) in &lines[1..] {
-            let r0 = (ld * pts[0].0 + psi).hypot(lq * pts[0].1);
-            for &(id, iq) in pts {
-                let r = (ld * id + psi).hypot(lq * iq);
-                assert!((r - r0).abs() < 1e-9 * r0, "{label}");
-            }
-        }
+        assert!((corner_speed(&d) - 5000.0).abs() < 1.0, "{}", corner_speed(&d));
+        let (lines, half) = dq_plane_lines(&d);
+        assert!((half - 1.6 * 86.267).abs() < 0.01);
         let (_, circle) = &lines[0];
-        assert!(
-            circle
-                .iter()
-                .all(|(x, y)| (x.hypot(*y) - d.motor.peak_current_a).abs() < 1e-9)
-        );
+        assert!(circle.iter().all(|(x, y)| (x.hypot(*y) - 86.267).abs() < 1e-3));
+        let (label, top) = lines.last().unwrap();
+        assert!(label.contains("8378 rad/s"), "{label}");
+        let right = top.iter().map(|p| p.0).fold(f64::NEG_INFINITY, f64::max);
+        assert!((right + 48.53).abs() < 0.01, "{right}");
+        // ¼, ½, ¾, 1 of ω_e,max and the corner speed.
+        assert_eq!(lines.len(), 6);
     }
 }
