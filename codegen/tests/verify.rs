@@ -249,7 +249,7 @@ fn controller_config_is_the_generated_constants() {
             (v_max / number(&g, "limits", "VOLTAGE_LIMIT_V") - 1.0).abs() < 1e-6,
             "{name}"
         );
-        // Centre-aligned TIM1 at 170 MHz: ARR = 170e6/(2·f_s) (4250 at 20 kHz, thesis A §7).
+        // Centre-aligned TIM1 at 170 MHz (STM32G474 maximum SYSCLK): ARR = 170e6/(2·f_s), 4250 at 20 kHz.
         assert_eq!(
             f64::from(cfg.pwm_period),
             (170e6 / (2.0 * number(&g, "limits", "SWITCHING_FREQUENCY_HZ"))).round(),

@@ -16,8 +16,10 @@ use crate::design::Design;
 use crate::design::current_loop::AxisGains;
 use crate::spec::ObserverError;
 
-/// STM32G474 timer kernel clock (TIM1 at SYSCLK, thesis A §7) [Hz]; with centre-aligned
-/// PWM the auto-reload is `TIMER_CLOCK_HZ/(2·f_s)` (4250 at 20 kHz).
+/// TIM1 kernel clock [Hz]: the STM32G474's maximum SYSCLK (170 MHz, STM32G474 datasheet),
+/// as the firmware bench assumes; with centre-aligned PWM the auto-reload is
+/// `TIMER_CLOCK_HZ/(2·f_s)` (4250 at 20 kHz). Only the telemetry compare values use it;
+/// the simulated inverter applies the duties.
 pub const TIMER_CLOCK_HZ: f64 = 170e6;
 
 /// Mid-scale code of a bipolar current channel read as a 16-bit (Q1.15 offset-binary) value.

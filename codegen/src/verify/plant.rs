@@ -324,7 +324,8 @@ mod tests {
             i: [0.0, 0.0],
             theta_m: 0.0,
             dc_link: 100.0,
-            // u_α = 2/3·(d_u − 1/2 − ...)·U_dc: duties (0.53, 0.485, 0.485) → u_α = 3 V at θ = 0 → u_d.
+            // Phase voltages (d − 1/2)·100 V = (3, −1.5, −1.5) V → u_α = 2/3·(3 + 0.75 + 0.75)
+            // = 3 V, u_β = 0; at θ = 0 that is u_d (f32 duties: computed from them below).
             pending: Some([0.53, 0.485, 0.485]),
         };
         for _ in 0..40 {
