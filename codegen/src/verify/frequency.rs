@@ -100,28 +100,6 @@ pub fn current_loop(g: &AxisGains, r: f64, l: f64, ts: f64, omega: &[f64]) -> (R
     )
 }
 
-/// Unit step response of the same discrete loop as [`current_loop`], sampled at t_n
-/// (`n` samples; index 0 is the sample at which the reference steps), by its
-/// difference equations: `v(n) = k_p·(r_f(n) − i(n)) + k_i·I(n) − R_a·i(n)`,
-/// `I(n+1) = I(n) + T_s·(r_f(n) − i(n))`, `i(n+1) = a·i(n) + b·v(n−1)`.
-pub fn current_loop_step(g: &AxisGains, r: f64, l: f64, ts: f64, n: usize) -> Vec<f64> {
-    let a = (-r * ts / l).exp();
-    let b = (1.0 - a) / r;
-    let c = g.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient);
-    let (mut i, mut integral, mut rf, mut v_prev) = (0.0, 0.0, 0.0, 0.0);
-    let mut out = Vec::with_capacity(n);
-    for _ in 0..n {
-        out.push(i);
-        rf += c * (1.0 - rf);
-        let e = rf - i;
-        let v = g.kp * e + g.ki * integral - g.active_damping_ohm * i;
-        integral += ts * e;
-        i = a * i + b * v_prev;
-        v_prev = v;
-    }
-    out
-}
-
 /// The designed continuous closed loop of the current controller: α/(s + α) (IMC,
 /// thesis A (5.8), thesis B (2.41)) or ω_n²/(s² + 2ζω_n·s + ω_n²) (pole placement with
 /// prefilter, (4.14), (5.16)).
@@ -269,7 +247,7 @@ mod tests {
     #[test]
     fn discrete_step_settles_at_one_after_the_delay() {
         let d = fischer();
-        let y = current_loop_step(
+        let y = crate::design::discrete_loop::step_response(
             &d.current_loop.q,
             d.motor.phase_resistance_ohm,
             d.motor.q_inductance_h,

@@ -19,10 +19,10 @@ use motor_control::ato::AtoState;
 use motor_control::step::Demand;
 
 use super::figures::{designed_rise_time, designed_step, settling_time, step_figures};
-use super::frequency::current_loop_step;
 use super::plant::{SpeedProfile, wrap};
 use super::sim::{Bench, angle_q31, q31_angle};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
+use crate::design::discrete_loop::step_response;
 use crate::spec::{Method, ObserverError};
 
 /// Most points kept per trace (the report plots them; more adds bytes, not information).
@@ -180,7 +180,7 @@ pub fn current_step(s: &Setup<'_>) -> ScenarioResult {
         } else {
             (&cl.q, d.motor.q_inductance_h)
         };
-        let z = current_loop_step(g, d.motor.phase_resistance_ohm, l, ts, n + 2);
+        let z = step_response(g, d.motor.phase_resistance_ohm, l, ts, n + 2);
         let zf = step_figures(&z, ts, 0.0, 1.0);
         checks.push(
             check(
