@@ -235,8 +235,16 @@ pub fn constants(d: &Design) -> Vec<Group> {
             crate::spec::Method::PolePlacement => ("K_p = 2ζω_n·L − R", "K_i = L·ω_n²", "thesis A (5.14), (5.15)"),
             crate::spec::Method::ImcActiveDamping => ("k_p = α_c·L", "k_i = α_c·(R + R_a)", "thesis B (2.38), (2.39)"),
         };
+        let alpha_axis = if cl.compensate_delay {
+            format!(
+                "α = {} (delay-compensated from {alpha_in}: the sampled loop with 1.5·T_s delay rises in ln 9/α_spec)",
+                phys(g.bandwidth_rad_s, "rad/s")
+            )
+        } else {
+            alpha_in.clone()
+        };
         let ins = format!(
-            "{l_in}, {r_in}, {alpha_in}{}",
+            "{l_in}, {r_in}, {alpha_axis}{}",
             cl.damping.map_or(String::new(), |z| format!(", ζ = {z} (spec)"))
         );
         current.push(

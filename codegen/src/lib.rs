@@ -9,9 +9,13 @@ pub mod constants;
 pub mod design;
 pub mod diagnostic;
 pub mod render;
+#[cfg(feature = "verify")]
+pub mod report;
 pub mod spec;
 pub mod summary;
 pub mod units;
+#[cfg(feature = "verify")]
+pub mod verify;
 
 pub use design::Design;
 pub use diagnostic::{Diagnostic, Diagnostics, Source};

@@ -47,6 +47,23 @@ pub fn summary(d: &Design) -> String {
             "current loop: {:?}, α = {:.3} rad/s (limit {:.0} rad/s)",
             c.method, c.bandwidth_rad_s, c.bandwidth_limit_rad_s
         )?;
+        if let Some([td, tq]) = c.sampled_rise_time_s {
+            writeln!(
+                s,
+                "  rise time 10–90 %: ln 9/α = {:.3} ms; sampled loop with 1.5·T_s delay: d {:.3} ms, q {:.3} ms{}",
+                9f64.ln() / c.bandwidth_rad_s * 1e3,
+                td * 1e3,
+                tq * 1e3,
+                if c.compensate_delay {
+                    format!(
+                        " (delay-compensated: α_d = {:.1}, α_q = {:.1} rad/s)",
+                        c.d.bandwidth_rad_s, c.q.bandwidth_rad_s
+                    )
+                } else {
+                    String::new()
+                }
+            )?;
+        }
         for (axis, g) in [("d", &c.d), ("q", &c.q)] {
             writeln!(
                 s,

@@ -303,6 +303,19 @@ fn design_rules_are_located_errors() {
         "current_loop.bandwidth",
         &["right-half-plane zero", "226."],
     );
+    // Delay compensation is for the first-order loops only.
+    let (t, _) = mutate(
+        "method = \"imc\"",
+        "method = \"pole_placement\"\ndamping = 0.7071\ncompensate_delay = true",
+    );
+    let line = line_of(&t, "compensate_delay");
+    fails(
+        "compensate_pp",
+        &t,
+        line,
+        "current_loop.compensate_delay",
+        &["first-order loops only", "imc_active_damping"],
+    );
     // 30 % of 20 kHz = 6 kHz = 37 699 rad/s.
     let (t, line) = mutate("bandwidth = \"100 rad/s\"", "bandwidth = \"40000 rad/s\"");
     fails("bandwidth", &t, line, "current_loop.bandwidth", &["30 %", "37699"]);

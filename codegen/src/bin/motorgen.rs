@@ -1,14 +1,18 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
+#[path = "motorgen/firmware.rs"]
+mod firmware;
+#[path = "motorgen/report.rs"]
+mod report;
+#[path = "motorgen/verify.rs"]
+mod verify;
+
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use codegen::render::{Output, render_with};
 use codegen::{Diagnostic, Diagnostics};
-
-#[path = "motorgen/firmware.rs"]
-mod firmware;
 
 /// Motor description (TOML) → tuned motor-controller constants.
 #[derive(Parser)]
@@ -69,6 +73,21 @@ enum Command {
         /// Directory of motor specs (default: motors/).
         #[arg(long)]
         dir: Option<PathBuf>,
+    },
+    /// Simulate the firmware's current loop and observer with the motor and print a
+    /// pass/fail table of measured vs designed figures (non-zero exit on a failure).
+    Verify {
+        /// The motor spec.
+        spec: PathBuf,
+    },
+    /// Write a self-contained HTML report (verification table, SVG plots, every constant
+    /// with formula and provenance) to DIR/<stem>.html.
+    Report {
+        /// The motor spec.
+        spec: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long)]
+        out: PathBuf,
     },
     /// List the motors in a directory (default: motors/).
     List {
@@ -318,6 +337,8 @@ fn main() -> ExitCode {
             };
             firmware::run(which, &motors_dir(dir))
         }
+        Command::Verify { spec } => verify::run(&spec),
+        Command::Report { spec, out } => report::run(&spec, &out),
         Command::List { dir } => {
             let dir = motors_dir(dir);
             let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {

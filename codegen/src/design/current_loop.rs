@@ -49,6 +49,9 @@ pub struct AxisGains {
     pub prefilter: Option<Prefilter>,
     /// Designed closed-loop poles, real and imaginary parts [rad/s].
     pub designed_poles: Vec<[f64; 2]>,
+    /// The bandwidth α these gains were designed for [rad/s]: the spec's, or the lower
+    /// delay-compensated one (`design::discrete_loop`).
+    pub bandwidth_rad_s: f64,
 }
 
 /// Why a current-loop design is refused.
@@ -159,6 +162,7 @@ pub fn design_axis(
         ki_ts: ki * ts,
         prefilter,
         designed_poles: poles,
+        bandwidth_rad_s: alpha,
     })
 }
 

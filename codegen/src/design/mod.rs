@@ -7,6 +7,7 @@
 pub mod adc;
 pub mod angle_observer;
 pub mod current_loop;
+pub mod discrete_loop;
 
 pub mod fir;
 pub mod flux_linkage;
@@ -134,6 +135,11 @@ pub struct CurrentLoopOut {
     pub bandwidth_limit_rad_s: f64,
     /// Designed 10–90 % rise time [s]: ln 9/α for first-order loops.
     pub rise_time_s: Option<f64>,
+    /// 10–90 % rise time [s] of the sampled d- and q-axis loops with the 1.5·T_s delay
+    /// (`discrete_loop`), first-order methods.
+    pub sampled_rise_time_s: Option<[f64; 2]>,
+    /// Each axis designed for a lower α so that the sampled loop rises in ln 9/α.
+    pub compensate_delay: bool,
     /// Designed step overshoot (with prefilter for pole placement), fraction.
     pub overshoot: f64,
     /// d-axis gains.
@@ -293,25 +299,17 @@ fn loop_error(src: &Source<'_>, spec: &Spec, e: CurrentLoopError) -> Diagnostic 
 fn axes(spec: &Spec, r: f64, ts: f64) -> Result<(AxisGains, AxisGains), CurrentLoopError> {
     let c = &spec.current_loop;
     let zeta = c.damping.as_ref().map_or(0.0, |d| d.value);
-    let d = current_loop::design_axis(
-        c.method,
-        'd',
-        r,
-        spec.motor.d_inductance.value,
-        c.bandwidth.value,
-        zeta,
-        ts,
-    )?;
-    let q = current_loop::design_axis(
-        c.method,
-        'q',
-        r,
-        spec.motor.q_inductance.value,
-        c.bandwidth.value,
-        zeta,
-        ts,
-    )?;
-    Ok((d, q))
+    let axis = |name: char, l: f64| {
+        if c.compensate_delay {
+            discrete_loop::delay_compensated(c.method, name, r, l, c.bandwidth.value, ts).map(|(g, _)| g)
+        } else {
+            current_loop::design_axis(c.method, name, r, l, c.bandwidth.value, zeta, ts)
+        }
+    };
+    Ok((
+        axis('d', spec.motor.d_inductance.value)?,
+        axis('q', spec.motor.q_inductance.value)?,
+    ))
 }
 
 /// Computes the design, or every rule it breaks, each at its key.
@@ -359,6 +357,29 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     let gains = axes(spec, r, ts)
         .map_err(|e| errors.push(loop_error(&src, spec, e)))
         .ok();
+    let sampled_rise = gains.as_ref().and_then(|(gd, gq)| {
+        if c.method == Method::PolePlacement {
+            return None;
+        }
+        let rise = |g: &AxisGains, l: f64| discrete_loop::predicted_rise_time(g, r, l, ts, g.bandwidth_rad_s);
+        Some([rise(gd, m.d_inductance.value)?, rise(gq, m.q_inductance.value)?])
+    });
+    if let Some(t) = sampled_rise {
+        let want = 9f64.ln() / c.bandwidth.value;
+        let worst = t[0].min(t[1]);
+        if (worst / want - 1.0).abs() > 0.10 {
+            warnings.push(format!(
+                "current loop: sampled at f_s = {fs} Hz with the 1.5·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
+                worst * 1e3,
+                want * 1e3,
+                if worst < want {
+                    "set current_loop.compensate_delay = true or raise f_s"
+                } else {
+                    "raise f_s or lower the bandwidth"
+                }
+            ));
+        }
+    }
     let hot = spec.thermal.as_ref().and_then(|t| {
         let r_hot = thermal::resistance_at(r, t.reference_temperature.value, t.max_winding_temperature.value);
         match axes(spec, r_hot, ts) {
@@ -596,6 +617,8 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
                 .map(|z| current_loop::natural_frequency(c.bandwidth.value, z.value)),
             bandwidth_limit_rad_s: limit,
             rise_time_s: (c.method != Method::PolePlacement).then(|| 9f64.ln() / c.bandwidth.value),
+            sampled_rise_time_s: sampled_rise,
+            compensate_delay: c.compensate_delay,
             overshoot: c.damping.as_ref().map_or(0.0, |z| current_loop::overshoot(z.value)),
             d,
             q,

@@ -147,6 +147,9 @@ pub struct CurrentLoopSpec {
     pub bandwidth: Param,
     /// ζ for pole placement.
     pub damping: Option<Param>,
+    /// Design each axis for the rise time ln 9/α of the sampled loop with its 1.5·T_s delay
+    /// (first-order methods; see `design::discrete_loop`).
+    pub compensate_delay: bool,
 }
 
 /// The resolved angle-observer request.
@@ -1062,11 +1065,25 @@ impl<'a> Resolver_<'a> {
             }
             (None, _) => None,
         };
+        let compensate_delay = match (&c.compensate_delay, method) {
+            (Some(v), Method::PolePlacement) if *v.get_ref() => {
+                self.err(
+                    v.span(),
+                    "current_loop.compensate_delay",
+                    "delay compensation is designed for the first-order loops only",
+                    "compensate_delay = false, or method = \"imc\" or \"imc_active_damping\"",
+                );
+                false
+            }
+            (Some(v), _) => *v.get_ref(),
+            (None, _) => false,
+        };
         Some(CurrentLoopSpec {
             method,
             method_span: c.method.span(),
             bandwidth: bandwidth?,
             damping,
+            compensate_delay,
         })
     }
 

@@ -1,0 +1,117 @@
+//! The firmware's control step and the simulated drive, stepped together with the
+//! timing of thesis A §4.6: at t_n the ADCs sample currents, DC link and resolver; the
+//! step computes duties which the timer loads at the next period, so they act during
+//! [t_{n+1}, t_{n+2}) — one period of computation plus the PWM's half-period
+//! averaging, the 1.5·T_s the angle lead (4.23) compensates.
+
+use std::f64::consts::PI;
+
+use motor_control::SoftTrig;
+use motor_control::ato::{AtoState, ResolverSample};
+use motor_control::step::{AdcSample, ControllerConfig, ControllerState, Demand, StepOutput};
+
+use super::plant::{Plant, wrap};
+
+/// 2^31: one Q1.31 unit.
+pub const Q31: f64 = 2_147_483_648.0;
+
+/// Controller + plant.
+#[derive(Clone, Debug)]
+pub struct Bench {
+    /// The firmware configuration (from the design).
+    pub cfg: ControllerConfig,
+    /// The firmware state.
+    pub state: ControllerState,
+    /// The drive.
+    pub plant: Plant,
+    /// The DC-link voltage the ADC reports if frozen (a failed sensor), else the actual one.
+    pub frozen_dc_link: Option<f64>,
+}
+
+/// One recorded period.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample {
+    /// Time of the sample t_n [s].
+    pub t: f64,
+    /// True i_d, i_q at t_n [A].
+    pub i: [f64; 2],
+    /// The controller's output at t_n.
+    pub out: StepOutput,
+    /// True resolver angle θ_r(t_n) [rad].
+    pub theta_r: f64,
+    /// True mechanical speed [rad/s].
+    pub omega_m: f64,
+}
+
+impl Bench {
+    /// A bench whose observer starts locked on the true resolver angle and speed (a board
+    /// takes a first atan2 of the resolver signals); state at n = −1.
+    pub fn new(cfg: ControllerConfig, plant: Plant) -> Self {
+        let mut state = ControllerState::new();
+        let nr = f64::from(plant.resolver_pole_pairs);
+        let w_r = nr * plant.omega_m() * plant.ts; // rad per sample
+        let th = wrap(plant.theta_r() - w_r);
+        state.observer = AtoState::locked(angle_q31(th), (w_r / PI * Q31).round() as i32);
+        Self {
+            cfg,
+            state,
+            plant,
+            frozen_dc_link: None,
+        }
+    }
+
+    /// The ADC sample the controller sees now.
+    pub fn adc(&self) -> AdcSample {
+        let m = self.plant.measure();
+        let cs = &self.cfg.current_sense;
+        let code = |i: f64, k: usize| {
+            (f64::from(cs.offset[k]) + (i / f64::from(cs.amps_per_lsb[k])).round()).clamp(0.0, 65535.0) as u16
+        };
+        let q = |x: f64| (x * Q31).round().clamp(-Q31, Q31 - 1.0) as i32;
+        let u_dc = self.frozen_dc_link.unwrap_or(m.dc_link);
+        let ds = &self.cfg.dc_link_sense;
+        AdcSample {
+            phase_currents: [
+                code(m.phase_currents[0], 0),
+                code(m.phase_currents[1], 1),
+                code(m.phase_currents[2], 2),
+            ],
+            resolver: ResolverSample {
+                sin: q(m.theta_r.sin()),
+                cos: q(m.theta_r.cos()),
+            },
+            dc_link: (f64::from(ds.offset) + u_dc / f64::from(ds.volts_per_lsb))
+                .round()
+                .clamp(0.0, 65535.0) as u16,
+        }
+    }
+
+    /// One period: sample, control, then the plant runs with the previous duties.
+    pub fn step(&mut self, demand: Demand) -> Sample {
+        let sample = self.adc();
+        let before = Sample {
+            t: self.plant.t,
+            i: self.plant.i,
+            out: StepOutput::default(),
+            theta_r: self.plant.theta_r(),
+            omega_m: self.plant.omega_m(),
+        };
+        let out = self.cfg.process(&mut self.state, &mut SoftTrig, &sample, demand);
+        self.plant.advance();
+        self.plant.pending = match demand {
+            Demand::Off => None,
+            _ => Some(out.duties),
+        };
+        Sample { out, ..before }
+    }
+}
+
+/// Angle [rad] → π-scaled Q1.31 stored integer (wrapping).
+pub fn angle_q31(theta: f64) -> i32 {
+    (wrap(theta) / PI * Q31).round() as i64 as i32
+}
+
+/// π-scaled Q1.31 stored integer → angle [rad].
+pub fn q31_angle(bits: i32) -> f64 {
+    f64::from(bits) * PI / Q31
+}
