@@ -52,6 +52,7 @@ pub mod angle;
 pub mod ato;
 pub mod commissioning;
 pub mod feedforward;
+pub mod field_weakening;
 pub mod fir;
 pub mod modulation;
 pub mod pi;
