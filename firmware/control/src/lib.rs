@@ -51,6 +51,7 @@ pub mod adc;
 pub mod angle;
 pub mod ato;
 pub mod commissioning;
+pub mod estimator;
 pub mod feedforward;
 pub mod field_weakening;
 pub mod fir;
