@@ -174,8 +174,7 @@ impl ControllerConfig {
     /// dq output before the inverse Park transform, outside the PI (the injected carrier
     /// of thesis B Appendix D, `ud = ud + udhf`); `StepOutput::u_dq` excludes it, as the
     /// estimator's back-EMF error (4.38), (4.39) wants; it applies to `Demand::Current`
-    /// only. `theta_r`/`omega_r` of the
-    /// output are 0 and the observer state is untouched.
+    /// only. `theta_r`/`omega_r` of the output are 0 and the observer state is untouched.
     #[allow(clippy::too_many_arguments)]
     pub fn process_at_angle<T: Trig>(
         &self,
