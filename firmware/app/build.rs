@@ -3,7 +3,7 @@
 //! `motorgen`. `MOTORS_DIR` overrides the spec directory. A bad spec fails the
 //! build with the CLI's located message, not a panic.
 //!
-//! For the bare-metal target it also puts `memory.x` (STM32G474RE) on the linker
+//! For the bare-metal target with the `board` feature (the image) it also puts `memory.x` (STM32G474RE) on the linker
 //! search path and links the binary with cortex-m-rt's `link.x`.
 
 use std::path::{Path, PathBuf};
@@ -16,10 +16,14 @@ fn fail(message: &str) {
     }
 }
 
-/// Linker setup for the bare-metal target only (host builds need none).
+/// Linker setup for the bare-metal image only: host builds need none, and without the
+/// `board` feature this crate is a library linked into other bare-metal binaries (the
+/// QEMU benchmarks) that bring their own `memory.x`.
 fn link_setup(out: &Path) {
     println!("cargo::rerun-if-changed=memory.x");
-    if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none") {
+    if std::env::var("CARGO_CFG_TARGET_OS").as_deref() != Ok("none")
+        || std::env::var_os("CARGO_FEATURE_BOARD").is_none()
+    {
         return;
     }
     if let Err(e) = std::fs::copy("memory.x", out.join("memory.x")) {

@@ -5,8 +5,10 @@
 //! Pure logic (host-tested): [`config`] (the core's configuration from the generated
 //! constants), [`timing`] (register encodings from times and frequencies),
 //! [`adc_frame`] (ADC codes → the core's sample, resolver demodulation),
-//! [`can_frame`] (the setpoint frame). The board layer (`board`, target only) owns
-//! the peripherals.
+//! [`can_frame`] (the setpoint frame). The board layer (`src/board/`, target only) owns
+//! the peripherals and is part of the binary, not of this library, so that other
+//! bare-metal binaries (the QEMU benchmarks) can link this crate's logic with their own
+//! exception and panic handlers.
 #![cfg_attr(not(test), no_std)]
 
 /// The generated constants of the motor this image is built for.
@@ -26,9 +28,6 @@ pub mod can_frame;
 pub mod config;
 pub mod hw;
 pub mod timing;
-
-#[cfg(target_os = "none")]
-pub mod board;
 
 #[cfg(test)]
 mod tests {

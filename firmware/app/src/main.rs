@@ -3,6 +3,14 @@
 //! STM32G474 board through `probe-rs` (see firmware/README.md).
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
+// The board layer lives in the binary: it defines the exception and panic handlers.
+// `crate::config` etc. inside it name the library's pure modules.
+#[cfg(target_os = "none")]
+#[path = "board/mod.rs"]
+mod board;
+#[cfg(target_os = "none")]
+use motor_firmware::{adc_frame, can_frame, config, hw};
+
 #[cfg(target_os = "none")]
 mod target {
     use cortex_m_rt::entry;
@@ -10,7 +18,7 @@ mod target {
     /// Reset entry: brings up the board and runs the main loop (never returns).
     #[entry]
     fn main() -> ! {
-        motor_firmware::board::run()
+        crate::board::run()
     }
 }
 
