@@ -5,6 +5,7 @@
 //! overrides `[motor.datasheet]` key by key, and ψ_M may be derived from K_t or
 //! K_e (thesis A 2.34). Nothing here does file I/O.
 
+mod field_weakening;
 mod raw;
 
 use std::ops::Range;
@@ -13,6 +14,7 @@ use serde::Serialize;
 
 use crate::diagnostic::{Diagnostic, Diagnostics, Source};
 use crate::units::{self, Kind};
+pub use field_weakening::{DEFAULT_VOLTAGE_FRACTION, FieldWeakeningSpec};
 pub use raw::{Amplitude, Between, Connection, Method, ObserverError, SpeedAxis};
 use raw::{RawParams, RawSpec, Val};
 
@@ -254,6 +256,8 @@ pub struct Spec {
     pub thermal: Option<ThermalSpec>,
     /// Inverter loss data, if given.
     pub inverter: Option<InverterSpec>,
+    /// `[field_weakening]` and `[losses]` (thesis B §2.3, chapter 3).
+    pub field_weakening: FieldWeakeningSpec,
 }
 
 /// Parses and resolves a spec. `source.file` is only used in messages.
@@ -521,6 +525,7 @@ impl<'a> Resolver_<'a> {
         let adc = raw.adc.as_ref().and_then(|a| self.adc(a.get_ref()));
         let thermal = raw.thermal.as_ref().and_then(|t| self.thermal(t.get_ref()));
         let inverter = raw.inverter.as_ref().and_then(|i| self.inverter(i.get_ref()));
+        let field_weakening = self.field_weakening(raw);
         Some(Spec {
             name,
             description: raw.description.clone(),
@@ -534,6 +539,7 @@ impl<'a> Resolver_<'a> {
             adc,
             thermal,
             inverter,
+            field_weakening: field_weakening?,
         })
     }
 

@@ -30,6 +30,10 @@ pub struct RawSpec {
     pub thermal: Option<Spanned<RawThermal>>,
     #[serde(default)]
     pub inverter: Option<Spanned<RawInverter>>,
+    #[serde(default)]
+    pub field_weakening: Option<Spanned<super::field_weakening::RawFieldWeakening>>,
+    #[serde(default)]
+    pub losses: Option<Spanned<super::field_weakening::RawLosses>>,
 }
 
 /// `[motor]`.

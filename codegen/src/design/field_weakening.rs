@@ -1,0 +1,330 @@
+//! Field-weakening design rules, thesis B §2.3.2–2.3.4, and the MTPA / loss-minimising
+//! d-current tables of chapter 3 ([`super::loss_minimisation`]).
+//!
+//! ```text
+//! di_d^ref/dt = γ·(V'_max² − v_d² − v_q²)                         (2.55)
+//! −I_max ≤ i_d^ref ≤ i_d,MTPA(i_q)                                   (2.56)
+//! i_q^ref = √(I_max² − (i_d^ref)²)  (Mode B)                         (2.57)
+//! γ = α_fw/(2·ω_fw·L̂_d·V'_max),  ω_fw = max(ω_base, |ω_r|)           (2.60)
+//! α_fw = 10·α_s (speed loop) or α_fw ≥ 10·b/J (torque control)       (§2.3.3)
+//! ```
+
+use serde::Serialize;
+
+use super::loss_minimisation::{self, InverterLoss, LossModel, LossTable};
+
+/// α_s/α_c when no speed loop is specified: thesis B Fig. 2.15 (α_s = α_c/100).
+pub const DEFAULT_SPEED_LOOP_FRACTION: f64 = 0.01;
+/// α_fw/α_s and α_fw/(b/J): "a decade faster" (thesis B §2.3.3).
+pub const DECADE: f64 = 10.0;
+/// Largest α_fw/α_c accepted as "α_fw ≪ α_c" (2.61): twice the thesis's α_c/10.
+pub const MAX_BANDWIDTH_FRACTION: f64 = 0.2;
+/// Points of the MTPA (and loss-minimising) |i_q| grid, 0 … the i_q of the MTPA point on
+/// the current circle.
+pub const MTPA_POINTS: usize = 17;
+/// Speeds of the loss-minimising table, 0 … ω_e,max.
+pub const LOSS_SPEED_POINTS: usize = 9;
+
+/// γ (2.60) [A/(V²·s)].
+pub fn gain(alpha_fw: f64, w_fw: f64, ld: f64, v_prime: f64) -> f64 {
+    alpha_fw / (2.0 * w_fw * ld * v_prime)
+}
+
+/// ω_fw of (2.60) [rad/s].
+pub fn fw_speed(w: f64, w_base: f64) -> f64 {
+    w.abs().max(w_base)
+}
+
+/// The Mode-B limit (2.57) on |i_q^ref| [A] at `id`.
+pub fn mode_b_iq(i_max: f64, id: f64) -> f64 {
+    (i_max * i_max - id * id).max(0.0).sqrt()
+}
+
+/// Which rule set α_fw.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum BandwidthRule {
+    /// α_fw = 10·b/J (torque-controlled drive, J and b in the spec).
+    Mechanical,
+    /// α_fw = 10·α_s, α_s from `field_weakening.speed_loop_bandwidth`.
+    SpeedLoop,
+    /// α_fw = 10·α_s with the thesis's α_s = α_c/100 (Fig. 2.15): no speed loop or
+    /// mechanics given.
+    DefaultSpeedLoop,
+}
+
+/// The design inputs (SI; speeds electrical).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Inputs {
+    /// Motor (ψ_m > 0) and loss data; its `i_max` is the current-circle radius I_max.
+    pub model: LossModel,
+    /// V_max = U_dc/√3 [V] at the nominal U_dc.
+    pub voltage_max: f64,
+    /// V'_max/V_max.
+    pub voltage_fraction: f64,
+    /// α_c [rad/s].
+    pub current_bandwidth: f64,
+    /// ω_base = 2π·f_n [rad/s] when the per-unit system is known.
+    pub rated_speed: Option<f64>,
+    /// α_s [rad/s] if specified.
+    pub speed_loop_bandwidth: Option<f64>,
+    /// b/J [1/s] if both are specified.
+    pub mechanical_bandwidth: Option<f64>,
+    /// ω_e,max [rad/s].
+    pub max_speed: f64,
+}
+
+/// The MTPA table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MtpaTable {
+    /// |i_q| grid [A], uniform from 0 to the MTPA point on the circle |i| = I_max; the
+    /// firmware holds the last value beyond it, which with (2.57) gives that point.
+    pub iq_a: Vec<f64>,
+    /// i_d,MTPA [A] (3.10) at the grid points.
+    pub id_a: Vec<f64>,
+    /// Largest |linear interpolation − (3.10)| over the interval midpoints [A].
+    pub max_interpolation_error_a: f64,
+}
+
+/// The loss-minimising table and what it includes.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct LossMinimisation {
+    /// R_c [Ω], null = no core losses.
+    pub core_resistance_ohm: Option<f64>,
+    /// Whether the inverter losses (3.11)–(3.14) are included.
+    pub inverter_losses: bool,
+    /// The table.
+    pub table: LossTable,
+}
+
+/// The field-weakening design.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FieldWeakeningOut {
+    /// V'_max/V_max.
+    pub voltage_fraction: f64,
+    /// V'_max at the nominal U_dc [V] (the firmware scales it with the measured U_dc).
+    pub voltage_limit_v: f64,
+    /// α_fw [rad/s].
+    pub bandwidth_rad_s: f64,
+    /// The rule that set α_fw.
+    pub bandwidth_rule: BandwidthRule,
+    /// α_s [rad/s] used by the speed-loop rules.
+    pub speed_loop_bandwidth_rad_s: Option<f64>,
+    /// b/J [1/s], when J and b are given.
+    pub mechanical_bandwidth_rad_s: Option<f64>,
+    /// ω_base [rad/s] of (2.60).
+    pub base_speed_rad_s: f64,
+    /// L̂_d [H] in γ.
+    pub d_inductance_h: f64,
+    /// γ at ω_fw = ω_base and the nominal V'_max [A/(V²·s)] (2.60).
+    pub gain_at_base_speed: f64,
+    /// I_max [A], the current-circle radius (2.50).
+    pub current_max_a: f64,
+    /// −I_max [A], the lower limit of (2.56).
+    pub id_min_a: f64,
+    /// i_d of the MTPA point on the current circle [A]: the upper limit of (2.56) at full
+    /// current.
+    pub id_mtpa_at_current_max_a: f64,
+    /// (2.57) at that i_d [A]: the i_q where Mode B begins, the end of the table grid.
+    pub iq_mode_b_at_mtpa_a: f64,
+    /// MTPA table (3.10).
+    pub mtpa: MtpaTable,
+    /// Loss-minimising table, when R_c or inverter losses are given.
+    pub loss_minimisation: Option<LossMinimisation>,
+}
+
+/// α_fw [rad/s], the rule, and α_s if a speed-loop rule was used.
+pub fn bandwidth(inp: &Inputs) -> (f64, BandwidthRule, Option<f64>) {
+    match (inp.speed_loop_bandwidth, inp.mechanical_bandwidth) {
+        (Some(a_s), _) => (DECADE * a_s, BandwidthRule::SpeedLoop, Some(a_s)),
+        (None, Some(bj)) => (DECADE * bj, BandwidthRule::Mechanical, None),
+        (None, None) => {
+            let a_s = DEFAULT_SPEED_LOOP_FRACTION * inp.current_bandwidth;
+            (DECADE * a_s, BandwidthRule::DefaultSpeedLoop, Some(a_s))
+        }
+    }
+}
+
+/// ω_base of (2.60): the per-unit base 2π·f_n (thesis B App. A) when known, else the
+/// speed at which the full-current MTPA point reaches V'_max (2.53), resistance
+/// neglected — where field weakening starts.
+pub fn base_speed(inp: &Inputs) -> f64 {
+    if let Some(w) = inp.rated_speed {
+        return w;
+    }
+    let m = &inp.model;
+    let (id, iq) = loss_minimisation::mtpa_corner(m.psi, m.lq - m.ld, m.i_max);
+    let flux = (m.ld * id + m.psi).hypot(m.lq * iq);
+    inp.voltage_fraction * inp.voltage_max / flux
+}
+
+/// Computes the design (the caller checks α_fw against α_c).
+pub fn design(inp: &Inputs) -> FieldWeakeningOut {
+    let m = &inp.model;
+    let (alpha_fw, rule, alpha_s) = bandwidth(inp);
+    let w_base = base_speed(inp);
+    let v_prime = inp.voltage_fraction * inp.voltage_max;
+    let dl = m.lq - m.ld;
+    let (id_top, iq_top) = loss_minimisation::mtpa_corner(m.psi, dl, m.i_max);
+    let iq = loss_minimisation::grid(iq_top, MTPA_POINTS);
+    let id: Vec<f64> = iq.iter().map(|&i| loss_minimisation::mtpa_id(m.psi, dl, i)).collect();
+    let mtpa_err = loss_minimisation::midpoint_error(&iq, &id, |i| loss_minimisation::mtpa_id(m.psi, dl, i));
+    let loss_minimisation = (m.rc.is_some() || m.inverter.is_some()).then(|| LossMinimisation {
+        core_resistance_ohm: m.rc,
+        inverter_losses: m.inverter.is_some(),
+        table: loss_minimisation::loss_table(m, &loss_minimisation::grid(inp.max_speed, LOSS_SPEED_POINTS), &iq),
+    });
+    FieldWeakeningOut {
+        voltage_fraction: inp.voltage_fraction,
+        voltage_limit_v: v_prime,
+        bandwidth_rad_s: alpha_fw,
+        bandwidth_rule: rule,
+        speed_loop_bandwidth_rad_s: alpha_s,
+        mechanical_bandwidth_rad_s: inp.mechanical_bandwidth,
+        base_speed_rad_s: w_base,
+        d_inductance_h: m.ld,
+        gain_at_base_speed: gain(alpha_fw, w_base, m.ld, v_prime),
+        current_max_a: m.i_max,
+        id_min_a: -m.i_max,
+        id_mtpa_at_current_max_a: id_top,
+        iq_mode_b_at_mtpa_a: iq_top,
+        mtpa: MtpaTable {
+            iq_a: iq,
+            id_a: id,
+            max_interpolation_error_a: mtpa_err,
+        },
+        loss_minimisation,
+    }
+}
+
+/// Convenience for [`InverterLoss`] from the spec's `[inverter]` (means of transistor
+/// and diode, thesis B §3.3.4).
+pub fn inverter_loss(i: &crate::spec::InverterSpec, fs: f64) -> InverterLoss {
+    InverterLoss {
+        threshold_v: 0.5 * (i.transistor_threshold.value + i.diode_threshold.value),
+        resistance_ohm: 0.5 * (i.transistor_resistance.value + i.diode_resistance.value),
+        switching_energy_j: i.switching_energy.value,
+        recovery_energy_j: i.recovery_energy.value,
+        nominal_current_a: i.nominal_current.value,
+        switching_frequency_hz: fs,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The thesis B motor (Tables B.1–B.2) with the chalmers spec's drive: U_dc = 320 V,
+    /// α_c = 1470 rad/s, I_max = √2·224 A = 316.78 A, f_n = 200 Hz.
+    fn chalmers() -> Inputs {
+        Inputs {
+            model: LossModel {
+                pole_pairs: 2,
+                rs: 7.9e-3,
+                ld: 0.23e-3,
+                lq: 0.56e-3,
+                psi: 0.104,
+                rc: None,
+                inverter: None,
+                i_max: std::f64::consts::SQRT_2 * 224.0,
+            },
+            voltage_max: 320.0 / 3f64.sqrt(),
+            voltage_fraction: 0.9,
+            current_bandwidth: 1470.0,
+            rated_speed: Some(2.0 * std::f64::consts::PI * 200.0),
+            speed_loop_bandwidth: None,
+            mechanical_bandwidth: None,
+            max_speed: 2.0 * 2.0 * std::f64::consts::PI * 200.0,
+        }
+    }
+
+    /// By hand for the chalmers spec: α_s = α_c/100 = 14.7 rad/s, α_fw = 10·α_s = 147 rad/s
+    /// (Fig. 2.15); ω_fw = ω_base = 2π·200 = 1256.64 rad/s below base speed (2.60);
+    /// V'_max = 0.9·320/√3 = 166.277 V; γ = 147/(2·1256.64·0.23e-3·166.277)
+    /// = 147/96.117 = 1.52939 A/(V²·s).
+    #[test]
+    fn gamma_and_omega_fw_by_hand() {
+        let out = design(&chalmers());
+        assert_eq!(out.bandwidth_rule, BandwidthRule::DefaultSpeedLoop);
+        assert!((out.bandwidth_rad_s - 147.0).abs() < 1e-9);
+        assert!((out.base_speed_rad_s - 1256.637).abs() < 1e-3);
+        assert!((out.voltage_limit_v - 166.277).abs() < 1e-3);
+        assert!(
+            (out.gain_at_base_speed - 1.52939).abs() < 1e-4,
+            "{}",
+            out.gain_at_base_speed
+        );
+        // Above base speed ω_fw = |ω_r|: at 2·ω_base γ halves.
+        assert!((fw_speed(-2513.27, 1256.64) - 2513.27).abs() < 1e-9);
+        assert!((fw_speed(300.0, 1256.64) - 1256.64).abs() < 1e-9);
+    }
+
+    /// (2.56) and (2.57) at I_max = √2·224 A = 316.784 A, by hand: with a = ψ/(2ΔL)
+    /// = 157.576 A, (3.10) on the circle i_d² + i_q² = I² gives 2i_d² − 2a·i_d − I² = 0,
+    /// i_d = (a − √(a² + 2I²))/2 = (157.576 − √(24830.1 + 200704.0))/2
+    /// = (157.576 − 474.904)/2 = −158.664 A; Mode B (2.57) starts at
+    /// i_q = √(100352.0 − 25174.3) = 274.185 A. Lower limit −I_max = −316.784 A.
+    #[test]
+    fn current_limits_by_hand() {
+        let out = design(&chalmers());
+        assert!((out.id_min_a + 316.784).abs() < 1e-3);
+        assert!(
+            (out.id_mtpa_at_current_max_a + 158.664).abs() < 0.002,
+            "{}",
+            out.id_mtpa_at_current_max_a
+        );
+        assert!(
+            (out.iq_mode_b_at_mtpa_a - 274.185).abs() < 0.002,
+            "{}",
+            out.iq_mode_b_at_mtpa_a
+        );
+        assert_eq!(mode_b_iq(10.0, 12.0), 0.0);
+    }
+
+    /// α_fw from a speed loop and from the mechanics (§2.3.3).
+    #[test]
+    fn bandwidth_rules() {
+        let mut inp = chalmers();
+        inp.mechanical_bandwidth = Some(2.5);
+        assert_eq!(bandwidth(&inp), (25.0, BandwidthRule::Mechanical, None));
+        inp.speed_loop_bandwidth = Some(20.0);
+        assert_eq!(bandwidth(&inp), (200.0, BandwidthRule::SpeedLoop, Some(20.0)));
+    }
+
+    /// Without f_n, ω_base is where the full-current MTPA point meets V'_max (2.53):
+    /// at (−158.664 A, 274.185 A): |ψ_s| = √((0.23e-3·(−158.664) + 0.104)² + (0.56e-3·274.185)²)
+    /// = √(0.067507² + 0.153544²) = 0.167729 Wb; ω = 166.277/0.167729 = 991.34 rad/s.
+    #[test]
+    fn base_speed_without_rated_frequency() {
+        let mut inp = chalmers();
+        inp.rated_speed = None;
+        assert!((base_speed(&inp) - 991.34).abs() < 0.02, "{}", base_speed(&inp));
+    }
+
+    /// MTPA table properties: monotone non-increasing, i_d ≤ 0, |i| ≤ I_max at every grid
+    /// point, and the f32 table equals (3.10) at the grid points to f32 precision; the
+    /// midpoint error is below the bound h²/8·max|f''| = h²/(8·ψ/(2ΔL)) of linear
+    /// interpolation (f'' = −a²/(a² + x²)^{3/2}, largest at 0: 1/a).
+    #[test]
+    fn mtpa_table_properties() {
+        let out = design(&chalmers());
+        let t = &out.mtpa;
+        assert_eq!(t.iq_a.len(), MTPA_POINTS);
+        for w in t.id_a.windows(2) {
+            assert!(w[1] <= w[0]);
+        }
+        for (&iq, &id) in t.iq_a.iter().zip(&t.id_a) {
+            assert!(id <= 0.0 && iq.hypot(id) <= out.current_max_a * (1.0 + 1e-12));
+            let exact = 157.5757575 - (157.5757575f64.powi(2) + iq * iq).sqrt();
+            assert!(((id as f32) - (exact as f32)).abs() <= 2.0 * f32::EPSILON * (exact.abs() as f32).max(1.0));
+        }
+        assert_eq!(*t.iq_a.last().unwrap(), out.iq_mode_b_at_mtpa_a);
+        let h = out.iq_mode_b_at_mtpa_a / 16.0;
+        let bound = h * h / (8.0 * 157.5757575);
+        assert!(
+            t.max_interpolation_error_a > 0.0 && t.max_interpolation_error_a <= bound,
+            "{} vs {bound}",
+            t.max_interpolation_error_a
+        );
+    }
+}
