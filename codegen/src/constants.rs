@@ -5,6 +5,8 @@
 //! constant cannot differ between them. Every entry carries its physical value
 //! with unit, its formula, the source equation and the provenance of its inputs.
 
+mod field_weakening;
+
 use serde::{Deserialize, Serialize};
 
 use crate::design::{Design, Origin};
@@ -644,6 +646,7 @@ pub fn constants(d: &Design) -> Vec<Group> {
             title: "Sampling, voltage and current limits, modulator and ADC",
             constants: limits,
         },
+        field_weakening::group(d),
     ]
 }
 

@@ -22,8 +22,11 @@ pub const MAX_BANDWIDTH_FRACTION: f64 = 0.2;
 /// Points of the MTPA (and loss-minimising) |i_q| grid, 0 … the i_q of the MTPA point on
 /// the current circle.
 pub const MTPA_POINTS: usize = 17;
-/// Speeds of the loss-minimising table, 0 … ω_e,max.
-pub const LOSS_SPEED_POINTS: usize = 9;
+/// Speeds of the loss-minimising table, 0 … [`LOSS_TABLE_TOP_SPEED`]·ω_base.
+pub const LOSS_SPEED_POINTS: usize = 7;
+/// Top of the loss-minimising table's speed grid in ω_base: thesis B Fig. 3.3 (0 … 1.5 pu;
+/// above it the field-weakening controller sets i_d, and the firmware holds the last row).
+pub const LOSS_TABLE_TOP_SPEED: f64 = 1.5;
 
 /// γ (2.60) [A/(V²·s)].
 pub fn gain(alpha_fw: f64, w_fw: f64, ld: f64, v_prime: f64) -> f64 {
@@ -172,7 +175,11 @@ pub fn design(inp: &Inputs) -> FieldWeakeningOut {
     let loss_minimisation = (m.rc.is_some() || m.inverter.is_some()).then(|| LossMinimisation {
         core_resistance_ohm: m.rc,
         inverter_losses: m.inverter.is_some(),
-        table: loss_minimisation::loss_table(m, &loss_minimisation::grid(inp.max_speed, LOSS_SPEED_POINTS), &iq),
+        table: loss_minimisation::loss_table(
+            m,
+            &loss_minimisation::grid((LOSS_TABLE_TOP_SPEED * w_base).min(inp.max_speed), LOSS_SPEED_POINTS),
+            &iq,
+        ),
     });
     FieldWeakeningOut {
         voltage_fraction: inp.voltage_fraction,

@@ -154,8 +154,15 @@ impl LossModel {
     }
 
     /// The loss-minimising i_d [A] at terminal `iq` [A] ≥ 0 and speed `w` ≥ 0: bisection on
-    /// the torque until the optimum's terminal i_q is `iq`.
+    /// the torque until the optimum's terminal i_q is `iq`, then kept inside the current
+    /// circle (2.50) — losses fall monotonically towards the unconstrained optimum along
+    /// the constant-torque curve, so the constrained optimum lies on the circle.
     pub fn id_at(&self, w: f64, iq: f64) -> f64 {
+        let circle = (self.i_max * self.i_max - iq * iq).max(0.0).sqrt();
+        self.unconstrained_id_at(w, iq).max(-circle)
+    }
+
+    fn unconstrained_id_at(&self, w: f64, iq: f64) -> f64 {
         let t_hi = 2.0
             * 1.5
             * f64::from(self.pole_pairs)
@@ -195,8 +202,8 @@ pub struct LossTable {
     pub speeds_rad_s: Vec<f64>,
     /// |i_q| grid [A] (columns), the MTPA grid.
     pub iq_a: Vec<f64>,
-    /// i_d [A], row-major (speed, i_q).
-    pub id_a: Vec<Vec<f64>>,
+    /// i_d [A], row-major: `id_a[k·iq_a.len() + j]` at `speeds_rad_s[k]`, `iq_a[j]`.
+    pub id_a: Vec<f64>,
     /// Largest bilinear-interpolation error [A] against the numeric optimum at the cell
     /// centres and edge midpoints.
     pub max_interpolation_error_a: f64,
@@ -229,7 +236,7 @@ pub fn loss_table(model: &LossModel, speeds: &[f64], iq: &[f64]) -> LossTable {
     LossTable {
         speeds_rad_s: speeds.to_vec(),
         iq_a: iq.to_vec(),
-        id_a: id,
+        id_a: id.concat(),
         max_interpolation_error_a: err,
     }
 }

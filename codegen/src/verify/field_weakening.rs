@@ -3,13 +3,12 @@
 //! for the firmware's control step, on the simulated motor, while the shaft speed ramps
 //! from half to twice base speed.
 //!
-//! # Where the constants come from (provisional)
+//! # Where the constants come from
 //!
-//! [`field_weakening_config`] computes the controller's constants here, directly from the
-//! thesis formulas and the design's motor data, because the design rules for them are
-//! not part of [`Design`] yet. When the design carries them, replace the body of
-//! [`field_weakening_config`] (and only it) with the design's values; the scenario and
-//! its criteria stay.
+//! [`field_weakening_config`] takes every constant from the design
+//! ([`crate::design::field_weakening`], emitted as the `field_weakening` constants), so
+//! the scenario, the report and the firmware (`firmware/app/src/config.rs`) run one
+//! configuration.
 
 use std::f64::consts::PI;
 
@@ -24,59 +23,45 @@ use super::sim::Bench;
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use crate::design::Design;
 
-/// V'_max/V_max: thesis B Fig. 2.15 ("V'_max is set to 0.9 pu", V_max = 1 pu).
-pub const VOLTAGE_FRACTION: f64 = 0.9;
-/// α_fw/α_c: thesis B Fig. 2.15 (α_s = α_c/100, α_fw = 10·α_s = α_c/10).
-pub const BANDWIDTH_FRACTION: f64 = 0.1;
-
-/// Electrical base speed ω_base [rad/s] of (2.60): the per-unit base 2π·f_n (thesis B
-/// App. A) when the spec gives the rated frequency, else the speed at which the
-/// max-current MTPA point reaches V'_max — where field weakening starts.
+/// Electrical base speed ω_base [rad/s] of (2.60), from the design.
 pub fn base_speed(d: &Design) -> Option<f64> {
-    if let Some(pu) = &d.per_unit {
-        return Some(pu.bases.angular_frequency_rad_s);
-    }
-    let m = &d.motor;
-    let psi = m.flux_linkage_wb?;
-    let i_max = m.peak_current_a;
-    let mtpa = mtpa(psi, m.q_inductance_h - m.d_inductance_h);
-    let id = mtpa.id(i_max as f32) as f64;
-    let iq = (i_max * i_max - id * id).max(0.0).sqrt();
-    let v = VOLTAGE_FRACTION * d.current_loop.voltage_limit_v;
-    // |v| = ω·√((L_d·i_d + ψ)² + (L_q·i_q)²), resistance neglected (2.53).
-    let flux = ((m.d_inductance_h * id + psi).powi(2) + (m.q_inductance_h * iq).powi(2)).sqrt();
-    (flux > 0.0).then_some(v / flux)
+    d.field_weakening.as_ref().map(|fw| fw.base_speed_rad_s)
 }
 
-fn mtpa(psi: f64, delta_l: f64) -> MtpaCurve {
-    MtpaCurve::Analytic {
-        psi_m: psi as f32,
-        delta_l: delta_l as f32,
-    }
+/// V'_max/V_max of the design (thesis B Fig. 2.15: 0.9), 0 without field weakening.
+fn voltage_fraction(d: &Design) -> f64 {
+    d.field_weakening.as_ref().map_or(0.0, |fw| fw.voltage_fraction)
 }
 
-/// The field-weakening constants for `d`, or `None` when ψ_M is unknown:
+/// The field-weakening constants of `d` (thesis B §2.3.3, [`crate::design::field_weakening`]),
+/// or `None` when ψ_M is unknown:
 ///
-/// * `bandwidth` α_fw = α_c/10 (thesis B §2.3.4, Fig. 2.15: α_fw = 10·α_s, α_s = α_c/100);
-/// * `ld` L̂_d, `base_speed` ω_base ([`base_speed`]) — γ = α_fw/(2·ω_fw·L̂_d·V'_max) (2.60)
-///   is evaluated by the firmware at the measured V'_max;
-/// * `voltage_fraction` V'_max/V_max = 0.9 (Fig. 2.15);
-/// * `current_max` I_max = the peak phase current (2.50), (2.56);
-/// * `mtpa` (3.10) with the design's L̂_d, L̂_q, ψ̂_M.
+/// * `bandwidth` α_fw (10·α_s, α_s = α_c/100 of Fig. 2.15 unless the spec gives a speed
+///   loop or J and b), `ld` L̂_d, `base_speed` ω_base — γ = α_fw/(2·ω_fw·L̂_d·V'_max)
+///   (2.60) is evaluated by the firmware at the measured V'_max;
+/// * `voltage_fraction` V'_max/V_max (spec, default 0.9 of Fig. 2.15);
+/// * `current_max` I_max (2.50), (2.56);
+/// * `mtpa` the design's MTPA table (3.10) as a [`MtpaCurve::Table`].
 ///
-/// PROVISIONAL: the lead replaces this body with the design rules' values when they
-/// are merged (V'_max, γ's α_fw and ω_base, i_d limits, MTPA table).
+/// The control core's table borrows `'static` points (the firmware's are generated
+/// constants); here the design's 17 points (136 bytes) are leaked once per call.
 pub fn field_weakening_config(d: &Design) -> Option<FieldWeakeningConfig> {
-    let m = &d.motor;
-    let psi = m.flux_linkage_wb.filter(|p| *p > 0.0)?;
+    let fw = d.field_weakening.as_ref()?;
+    let points: Vec<[f32; 2]> = fw
+        .mtpa
+        .iq_a
+        .iter()
+        .zip(&fw.mtpa.id_a)
+        .map(|(&iq, &id)| [iq as f32, id as f32])
+        .collect();
     Some(FieldWeakeningConfig {
         sample_period: d.drive.sample_period_s as f32,
-        bandwidth: (BANDWIDTH_FRACTION * d.current_loop.bandwidth_rad_s) as f32,
-        ld: m.d_inductance_h as f32,
-        base_speed: base_speed(d)? as f32,
-        voltage_fraction: VOLTAGE_FRACTION as f32,
-        current_max: m.peak_current_a as f32,
-        mtpa: mtpa(psi, m.q_inductance_h - m.d_inductance_h),
+        bandwidth: fw.bandwidth_rad_s as f32,
+        ld: fw.d_inductance_h as f32,
+        base_speed: fw.base_speed_rad_s as f32,
+        voltage_fraction: fw.voltage_fraction as f32,
+        current_max: fw.current_max_a as f32,
+        mtpa: MtpaCurve::Table(Box::leak(points.into_boxed_slice())),
     })
 }
 
@@ -135,7 +120,7 @@ pub fn max_torque(m: &MotorModel, w: f64, i_max: f64, v_max: f64) -> f64 {
 pub fn top_speed(d: &Design, base: f64) -> f64 {
     let m = &d.motor;
     let psi = m.flux_linkage_wb.unwrap_or(0.0);
-    let v = VOLTAGE_FRACTION * d.current_loop.voltage_limit_v;
+    let v = voltage_fraction(d) * d.current_loop.voltage_limit_v;
     let mut w = (2.0 * base).min(m.max_electrical_speed_rad_s);
     let residual = psi - m.d_inductance_h * m.peak_current_a;
     if residual > 0.0 {
@@ -188,9 +173,9 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
     // a = Δ·π/(2T) = RAMP_ACCELERATION·K_i (resolver angle).
     let acc_e = RAMP_ACCELERATION * d.angle_observer.ki / nr * np;
     let alpha_fw = f64::from(fw.bandwidth);
-    // Time scale from the designed α_fw = α_c/10 (not the config under test, which may
-    // be broken, e.g. α_fw = 0).
-    let t_fw = 1.0 / (BANDWIDTH_FRACTION * d.current_loop.bandwidth_rad_s);
+    // Time scale from the designed α_fw (not the config under test, which may be broken,
+    // e.g. α_fw = 0).
+    let t_fw = 1.0 / d.field_weakening.as_ref().map_or(alpha_fw, |x| x.bandwidth_rad_s);
     let t0 = 10.0 * t_fw;
     let ramp = (top - start).max(0.0) * PI / (2.0 * acc_e);
     let hold = 20.0 * t_fw;
@@ -215,7 +200,7 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
     let n = ((t0 + ramp + hold) / ts).ceil() as usize;
     let i_max = f64::from(fw.current_max);
     let v_max_design = d.current_loop.voltage_limit_v;
-    let v_prime = VOLTAGE_FRACTION * v_max_design;
+    let v_prime = voltage_fraction(d) * v_max_design;
     let mut st = FieldWeakeningState::default();
     let mut prev = StepOutput::default();
     let (mut t, mut w, mut id, mut iq, mut idr, mut iqr, mut v) =
