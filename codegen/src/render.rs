@@ -57,6 +57,8 @@ impl Output {
 
 /// rustfmt's default line width, which the Rust output is laid out for.
 pub const RUST_MAX_WIDTH: usize = 100;
+/// rustfmt's default `short_array_element_width_threshold`.
+const SHORT_ARRAY_ELEMENT_WIDTH: usize = 10;
 
 /// `pub const NAME: TYPE = EXPR;` at `indent`, laid out as rustfmt (default config) does:
 /// one line if it fits; a long array broken into rustfmt's mixed layout; otherwise the
@@ -71,12 +73,18 @@ pub fn rust_const(k: &Constant, indent: usize) -> String {
     if let Some(inner) = expr.strip_prefix('[').and_then(|e| e.strip_suffix(']')) {
         let items: Vec<&str> = inner.split(", ").collect();
         let inner_pad = " ".repeat(indent + 4);
+        // rustfmt lays an array out one item per line when any item is wider than
+        // `short_array_element_width_threshold` (10).
+        if items.iter().any(|i| i.chars().count() > SHORT_ARRAY_ELEMENT_WIDTH) {
+            let body: String = items.iter().map(|i| format!("{inner_pad}{i},\n")).collect();
+            return format!("{head}[\n{body}{pad}];");
+        }
         let mut out = format!("{head}[\n");
         let mut line = inner_pad.clone();
         for (i, item) in items.iter().enumerate() {
             let piece = format!("{item},");
             let sep = if line.len() > inner_pad.len() { " " } else { "" };
-            if line.len() + sep.len() + piece.len() > RUST_MAX_WIDTH {
+            if line.len() + sep.len() + piece.len() >= RUST_MAX_WIDTH {
                 out.push_str(&line);
                 out.push('\n');
                 line = format!("{inner_pad}{piece}");

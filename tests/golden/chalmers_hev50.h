@@ -196,4 +196,70 @@ static const float LIMITS_MAX_ELECTRICAL_SPEED = 2513.2742f;
  *  Inputs: N = 12 bits. */
 static const uint32_t LIMITS_ADC_SETTLING_TIME_CONSTANTS = 9;
 
+/* Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3). */
+
+/** 0.9: V'_max/V_max (spec field_weakening.voltage_fraction, default 0.9 of thesis B Fig. 2.15), thesis B (2.55), Fig. 2.15.
+ *  Inputs: V'_max/V_max = 0.9. */
+static const float FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
+
+/** 166.277 V: V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
+ *  Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 184.752 V (U_dc = 320 V, spec). */
+static const float FIELD_WEAKENING_VOLTAGE_LIMIT_V = 166.27687f;
+
+/** 147 rad/s: α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c, thesis B (2.60), §2.3.3.
+ *  Inputs: α_fw = 10·α_s, α_s = α_c/100 = 14.7 rad/s (no speed loop or J, b in the spec: thesis B Fig. 2.15), α_c = 1470 rad/s. */
+static const float FIELD_WEAKENING_BANDWIDTH = 147.0f;
+
+/** 1256.64 rad/s: ω_base (electrical): ω_fw = max(ω_base, |ω_r|), thesis B (2.60).
+ *  Inputs: ω_base = 2π·f_n (per-unit base, thesis B App. A). */
+static const float FIELD_WEAKENING_BASE_SPEED = 1256.6371f;
+
+/** 0.00023 H: L̂_d in γ = α_fw/(2·ω_fw·L̂_d·V'_max), thesis B (2.60).
+ *  Inputs: L_d = 0.00023 H. */
+static const float FIELD_WEAKENING_LD = 0.00023f;
+
+/** 1.52939 A/(V²·s): γ = α_fw/(2·ω_base·L̂_d·V'_max) at ω_fw = ω_base and the nominal V'_max, thesis B (2.60).
+ *  Inputs: α_fw, ω_base, L̂_d, V'_max above. */
+static const float FIELD_WEAKENING_GAIN_AT_BASE_SPEED = 1.5293883f;
+
+/** 316.784 A: I_max: current circle, −I_max ≤ i_d^ref, i_q^ref = √(I_max² − (i_d^ref)²) in Mode B, thesis B (2.50), (2.56), (2.57).
+ *  Inputs: I_max = √2·I_peak,rms = √2·224 A. */
+static const float FIELD_WEAKENING_CURRENT_MAX_A = 316.78384f;
+
+/** -316.784 A: −I_max, lower limit of i_d^ref (demagnetisation), thesis B (2.56).
+ *  Inputs: I_max = √2·I_peak,rms = √2·224 A. */
+static const float FIELD_WEAKENING_ID_MIN_A = -316.78384f;
+
+/** -158.664 A: upper limit of i_d^ref at full current: i_d = −2ΔL·I²/(ψ_M + √(ψ_M² + 8ΔL²·I²)), (3.10) on |i| = I_max, thesis B (2.56), (3.10).
+ *  Inputs: I_max = √2·I_peak,rms = √2·224 A, ΔL = L_q − L_d. */
+static const float FIELD_WEAKENING_ID_MTPA_AT_CURRENT_MAX_A = -158.66429f;
+
+/** 274.185 A: √(I_max² − i_d²) at the MTPA point on the circle: Mode B limits |i_q^ref| below this, thesis B (2.57).
+ *  Inputs: I_max = √2·I_peak,rms = √2·224 A. */
+static const float FIELD_WEAKENING_IQ_MODE_B_START_A = 274.18542f;
+
+/** 17 points, 0 … 274.185 A: uniform |i_q| grid of the MTPA table, thesis B (3.10).
+ *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10). */
+static const float FIELD_WEAKENING_MTPA_IQ_A[17] = {0.0f, 17.13659f, 34.27318f, 51.409767f, 68.54636f, 85.682945f, 102.819534f, 119.95612f, 137.09271f, 154.2293f, 171.36589f, 188.50247f, 205.63907f, 222.77565f, 239.91225f, 257.04883f, 274.18542f};
+
+/** 0 A … -158.664 A: i_d,MTPA = ψ_M/(2ΔL) − √((ψ_M/(2ΔL))² + i_q²), ΔL = L_q − L_d, thesis B (3.10), (2.56).
+ *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10). */
+static const float FIELD_WEAKENING_MTPA_ID_A[17] = {0.0f, -0.9290753f, -3.6841881f, -8.174306f, -14.263476f, -21.788916f, -30.57837f, -40.463608f, -51.289104f, -62.91641f, -75.22542f, -88.113686f, -101.49478f, -115.29621f, -129.45735f, -143.9275f, -158.66429f};
+
+/** 0.231756 A: max |linear interpolation − (3.10)| at the grid midpoints, thesis B (3.10).
+ *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10). */
+static const float FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.23175603f;
+
+/** 7 points, 0 … 1884.96 rad/s: uniform electrical-speed grid (rows of LOSS_MIN_ID_A), thesis B (3.8), (3.9).
+ *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
+static const float FIELD_WEAKENING_LOSS_MIN_SPEED_RAD_S[7] = {0.0f, 314.15927f, 628.31854f, 942.4778f, 1256.6371f, 1570.7964f, 1884.9556f};
+
+/** -254.595 A … 0 A: i_d minimising P_res + P_co (+ P_loss,inv) at constant torque and speed, row-major [speed][MTPA_IQ_A], thesis B (3.3)–(3.9), (3.14), (C.3).
+ *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
+static const float FIELD_WEAKENING_LOSS_MIN_ID_A[119] = {0.0f, -0.929075f, -3.684188f, -8.174305f, -14.263476f, -21.788916f, -30.578367f, -40.463604f, -51.2891f, -62.916405f, -75.22542f, -88.113686f, -101.49478f, -115.2962f, -129.45735f, -143.9275f, -158.66429f, 0.0f, -1.326426f, -4.468582f, -9.360402f, -15.883373f, -23.88512f, -33.19804f, -43.654385f, -55.09647f, -67.382225f, -80.38732f, -94.00501f, -108.14479f, -122.73048f, -137.69812f, -152.9942f, -158.66429f, 0.0f, -2.56724f, -6.903425f, -13.005556f, -20.798843f, -30.157042f, -40.924397f, -52.9348f, -66.025734f, -80.046776f, -94.86387f, -110.36038f, -126.43656f, -143.00792f, -160.00325f, -177.36281f, -158.66429f, 0.0f, -4.717815f, -11.103147f, -19.256144f, -29.169863f, -40.755287f, -53.8703f, -68.346535f, -84.0101f, -100.695335f, -118.2522f, -136.54933f, -155.47415f, -174.93149f, -194.84154f, -185.14291f, -158.66429f, 0.0f, -8.05936f, -17.52445f, -28.672186f, -41.596275f, -56.254505f, -72.51638f, -90.20559f, -109.13215f, -129.113f, -149.983f, -171.59901f, -193.84001f, -216.60527f, -206.86739f, -185.14291f, -158.66429f, 0.0f, -13.56896f, -27.531277f, -42.716885f, -59.454967f, -77.80308f, -97.66872f, -118.887764f, -141.27411f, -164.64755f, -188.84697f, -213.7345f, -239.19516f, -225.2177f, -206.86739f, -185.14291f, -158.66429f, 0.0f, -25.101364f, -44.7499f, -64.274216f, -84.767494f, -106.543755f, -129.62163f, -153.89627f, -179.21945f, -205.4383f, -232.41234f, -254.5954f, -240.96593f, -225.2177f, -206.86739f, -185.14291f, -158.66429f};
+
+/** 10.8997 A: max |bilinear interpolation − numeric optimum| at cell centres and edge midpoints, thesis B (3.8), (3.9).
+ *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
+static const float FIELD_WEAKENING_LOSS_MIN_MAX_INTERPOLATION_ERROR_A = 10.899656f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

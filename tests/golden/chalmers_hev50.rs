@@ -204,3 +204,200 @@ pub mod limits {
     /// Inputs: N = 12 bits.
     pub const ADC_SETTLING_TIME_CONSTANTS: u32 = 9;
 }
+
+/// Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3).
+pub mod field_weakening {
+    /// 0.9: `V'_max/V_max (spec field_weakening.voltage_fraction, default 0.9 of thesis B Fig. 2.15)`, thesis B (2.55), Fig. 2.15.
+    ///
+    /// Inputs: V'_max/V_max = 0.9.
+    pub const VOLTAGE_FRACTION: f32 = 0.9;
+    /// 166.277 V: `V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc)`, thesis B (2.51), (2.55).
+    ///
+    /// Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 184.752 V (U_dc = 320 V, spec).
+    pub const VOLTAGE_LIMIT_V: f32 = 166.27687;
+    /// 147 rad/s: `α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c`, thesis B (2.60), §2.3.3.
+    ///
+    /// Inputs: α_fw = 10·α_s, α_s = α_c/100 = 14.7 rad/s (no speed loop or J, b in the spec: thesis B Fig. 2.15), α_c = 1470 rad/s.
+    pub const BANDWIDTH: f32 = 147.0;
+    /// 1256.64 rad/s: `ω_base (electrical): ω_fw = max(ω_base, |ω_r|)`, thesis B (2.60).
+    ///
+    /// Inputs: ω_base = 2π·f_n (per-unit base, thesis B App. A).
+    pub const BASE_SPEED: f32 = 1256.6371;
+    /// 0.00023 H: `L̂_d in γ = α_fw/(2·ω_fw·L̂_d·V'_max)`, thesis B (2.60).
+    ///
+    /// Inputs: L_d = 0.00023 H.
+    pub const LD: f32 = 0.00023;
+    /// 1.52939 A/(V²·s): `γ = α_fw/(2·ω_base·L̂_d·V'_max) at ω_fw = ω_base and the nominal V'_max`, thesis B (2.60).
+    ///
+    /// Inputs: α_fw, ω_base, L̂_d, V'_max above.
+    pub const GAIN_AT_BASE_SPEED: f32 = 1.5293883;
+    /// 316.784 A: `I_max: current circle, −I_max ≤ i_d^ref, i_q^ref = √(I_max² − (i_d^ref)²) in Mode B`, thesis B (2.50), (2.56), (2.57).
+    ///
+    /// Inputs: I_max = √2·I_peak,rms = √2·224 A.
+    pub const CURRENT_MAX_A: f32 = 316.78384;
+    /// -316.784 A: `−I_max, lower limit of i_d^ref (demagnetisation)`, thesis B (2.56).
+    ///
+    /// Inputs: I_max = √2·I_peak,rms = √2·224 A.
+    pub const ID_MIN_A: f32 = -316.78384;
+    /// -158.664 A: `upper limit of i_d^ref at full current: i_d = −2ΔL·I²/(ψ_M + √(ψ_M² + 8ΔL²·I²)), (3.10) on |i| = I_max`, thesis B (2.56), (3.10).
+    ///
+    /// Inputs: I_max = √2·I_peak,rms = √2·224 A, ΔL = L_q − L_d.
+    pub const ID_MTPA_AT_CURRENT_MAX_A: f32 = -158.66429;
+    /// 274.185 A: `√(I_max² − i_d²) at the MTPA point on the circle: Mode B limits |i_q^ref| below this`, thesis B (2.57).
+    ///
+    /// Inputs: I_max = √2·I_peak,rms = √2·224 A.
+    pub const IQ_MODE_B_START_A: f32 = 274.18542;
+    /// 17 points, 0 … 274.185 A: `uniform |i_q| grid of the MTPA table`, thesis B (3.10).
+    ///
+    /// Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10).
+    pub const MTPA_IQ_A: [f32; 17] = [
+        0.0, 17.13659, 34.27318, 51.409767, 68.54636, 85.682945, 102.819534, 119.95612, 137.09271,
+        154.2293, 171.36589, 188.50247, 205.63907, 222.77565, 239.91225, 257.04883, 274.18542,
+    ];
+    /// 0 A … -158.664 A: `i_d,MTPA = ψ_M/(2ΔL) − √((ψ_M/(2ΔL))² + i_q²), ΔL = L_q − L_d`, thesis B (3.10), (2.56).
+    ///
+    /// Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10).
+    pub const MTPA_ID_A: [f32; 17] = [
+        0.0, -0.9290753, -3.6841881, -8.174306, -14.263476, -21.788916, -30.57837, -40.463608,
+        -51.289104, -62.91641, -75.22542, -88.113686, -101.49478, -115.29621, -129.45735,
+        -143.9275, -158.66429,
+    ];
+    /// 0.231756 A: `max |linear interpolation − (3.10)| at the grid midpoints`, thesis B (3.10).
+    ///
+    /// Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10).
+    pub const MTPA_MAX_INTERPOLATION_ERROR_A: f32 = 0.23175603;
+    /// 7 points, 0 … 1884.96 rad/s: `uniform electrical-speed grid (rows of LOSS_MIN_ID_A)`, thesis B (3.8), (3.9).
+    ///
+    /// Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum.
+    pub const LOSS_MIN_SPEED_RAD_S: [f32; 7] = [
+        0.0, 314.15927, 628.31854, 942.4778, 1256.6371, 1570.7964, 1884.9556,
+    ];
+    /// -254.595 A … 0 A: `i_d minimising P_res + P_co (+ P_loss,inv) at constant torque and speed, row-major [speed][MTPA_IQ_A]`, thesis B (3.3)–(3.9), (3.14), (C.3).
+    ///
+    /// Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum.
+    pub const LOSS_MIN_ID_A: [f32; 119] = [
+        0.0,
+        -0.929075,
+        -3.684188,
+        -8.174305,
+        -14.263476,
+        -21.788916,
+        -30.578367,
+        -40.463604,
+        -51.2891,
+        -62.916405,
+        -75.22542,
+        -88.113686,
+        -101.49478,
+        -115.2962,
+        -129.45735,
+        -143.9275,
+        -158.66429,
+        0.0,
+        -1.326426,
+        -4.468582,
+        -9.360402,
+        -15.883373,
+        -23.88512,
+        -33.19804,
+        -43.654385,
+        -55.09647,
+        -67.382225,
+        -80.38732,
+        -94.00501,
+        -108.14479,
+        -122.73048,
+        -137.69812,
+        -152.9942,
+        -158.66429,
+        0.0,
+        -2.56724,
+        -6.903425,
+        -13.005556,
+        -20.798843,
+        -30.157042,
+        -40.924397,
+        -52.9348,
+        -66.025734,
+        -80.046776,
+        -94.86387,
+        -110.36038,
+        -126.43656,
+        -143.00792,
+        -160.00325,
+        -177.36281,
+        -158.66429,
+        0.0,
+        -4.717815,
+        -11.103147,
+        -19.256144,
+        -29.169863,
+        -40.755287,
+        -53.8703,
+        -68.346535,
+        -84.0101,
+        -100.695335,
+        -118.2522,
+        -136.54933,
+        -155.47415,
+        -174.93149,
+        -194.84154,
+        -185.14291,
+        -158.66429,
+        0.0,
+        -8.05936,
+        -17.52445,
+        -28.672186,
+        -41.596275,
+        -56.254505,
+        -72.51638,
+        -90.20559,
+        -109.13215,
+        -129.113,
+        -149.983,
+        -171.59901,
+        -193.84001,
+        -216.60527,
+        -206.86739,
+        -185.14291,
+        -158.66429,
+        0.0,
+        -13.56896,
+        -27.531277,
+        -42.716885,
+        -59.454967,
+        -77.80308,
+        -97.66872,
+        -118.887764,
+        -141.27411,
+        -164.64755,
+        -188.84697,
+        -213.7345,
+        -239.19516,
+        -225.2177,
+        -206.86739,
+        -185.14291,
+        -158.66429,
+        0.0,
+        -25.101364,
+        -44.7499,
+        -64.274216,
+        -84.767494,
+        -106.543755,
+        -129.62163,
+        -153.89627,
+        -179.21945,
+        -205.4383,
+        -232.41234,
+        -254.5954,
+        -240.96593,
+        -225.2177,
+        -206.86739,
+        -185.14291,
+        -158.66429,
+    ];
+    /// 10.8997 A: `max |bilinear interpolation − numeric optimum| at cell centres and edge midpoints`, thesis B (3.8), (3.9).
+    ///
+    /// Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum.
+    pub const LOSS_MIN_MAX_INTERPOLATION_ERROR_A: f32 = 10.899656;
+}

@@ -196,4 +196,58 @@ static const float LIMITS_MAX_ELECTRICAL_SPEED = 8377.58f;
  *  Inputs: N = 12 bits. */
 static const uint32_t LIMITS_ADC_SETTLING_TIME_CONSTANTS = 9;
 
+/* Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3). */
+
+/** 0.9: V'_max/V_max (spec field_weakening.voltage_fraction, default 0.9 of thesis B Fig. 2.15), thesis B (2.55), Fig. 2.15.
+ *  Inputs: V'_max/V_max = 0.9. */
+static const float FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
+
+/** 311.769 V: V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
+ *  Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 346.41 V (U_dc = 600 V, spec). */
+static const float FIELD_WEAKENING_VOLTAGE_LIMIT_V = 311.76913f;
+
+/** 10 rad/s: α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c, thesis B (2.60), §2.3.3.
+ *  Inputs: α_fw = 10·α_s, α_s = α_c/100 = 1 rad/s (no speed loop or J, b in the spec: thesis B Fig. 2.15), α_c = 100 rad/s. */
+static const float FIELD_WEAKENING_BANDWIDTH = 10.0f;
+
+/** 4499.96 rad/s: ω_base (electrical): ω_fw = max(ω_base, |ω_r|), thesis B (2.60).
+ *  Inputs: no f_n: ω_base = the speed where the full-current MTPA point reaches V'_max (2.53). */
+static const float FIELD_WEAKENING_BASE_SPEED = 4499.9644f;
+
+/** 0.000393 H: L̂_d in γ = α_fw/(2·ω_fw·L̂_d·V'_max), thesis B (2.60).
+ *  Inputs: L_d = 0.000393 H. */
+static const float FIELD_WEAKENING_LD = 0.000393f;
+
+/** 0.0090685 A/(V²·s): γ = α_fw/(2·ω_base·L̂_d·V'_max) at ω_fw = ω_base and the nominal V'_max, thesis B (2.60).
+ *  Inputs: α_fw, ω_base, L̂_d, V'_max above. */
+static const float FIELD_WEAKENING_GAIN_AT_BASE_SPEED = 0.009068496f;
+
+/** 86.267 A: I_max: current circle, −I_max ≤ i_d^ref, i_q^ref = √(I_max² − (i_d^ref)²) in Mode B, thesis B (2.50), (2.56), (2.57).
+ *  Inputs: I_max = √2·I_peak,rms = √2·61 A. */
+static const float FIELD_WEAKENING_CURRENT_MAX_A = 86.26703f;
+
+/** -86.267 A: −I_max, lower limit of i_d^ref (demagnetisation), thesis B (2.56).
+ *  Inputs: I_max = √2·I_peak,rms = √2·61 A. */
+static const float FIELD_WEAKENING_ID_MIN_A = -86.26703f;
+
+/** 0 A: upper limit of i_d^ref at full current: i_d = −2ΔL·I²/(ψ_M + √(ψ_M² + 8ΔL²·I²)), (3.10) on |i| = I_max, thesis B (2.56), (3.10).
+ *  Inputs: I_max = √2·I_peak,rms = √2·61 A, ΔL = L_q − L_d. */
+static const float FIELD_WEAKENING_ID_MTPA_AT_CURRENT_MAX_A = 0.0f;
+
+/** 86.267 A: √(I_max² − i_d²) at the MTPA point on the circle: Mode B limits |i_q^ref| below this, thesis B (2.57).
+ *  Inputs: I_max = √2·I_peak,rms = √2·61 A. */
+static const float FIELD_WEAKENING_IQ_MODE_B_START_A = 86.26703f;
+
+/** 17 points, 0 … 86.267 A: uniform |i_q| grid of the MTPA table, thesis B (3.10).
+ *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
+static const float FIELD_WEAKENING_MTPA_IQ_A[17] = {0.0f, 5.3916893f, 10.783379f, 16.175068f, 21.566757f, 26.958447f, 32.350136f, 37.741825f, 43.133514f, 48.525204f, 53.916893f, 59.308582f, 64.70027f, 70.09196f, 75.48365f, 80.875336f, 86.26703f};
+
+/** 0 A … 0 A: i_d,MTPA = ψ_M/(2ΔL) − √((ψ_M/(2ΔL))² + i_q²), ΔL = L_q − L_d, thesis B (3.10), (2.56).
+ *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
+static const float FIELD_WEAKENING_MTPA_ID_A[17] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+
+/** 0 A: max |linear interpolation − (3.10)| at the grid midpoints, thesis B (3.10).
+ *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
+static const float FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.0f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

@@ -204,4 +204,34 @@ static const float LIMITS_MAX_ELECTRICAL_SPEED = 1570.7964f;
  *  Inputs: N = 12 bits. */
 static const uint32_t LIMITS_ADC_SETTLING_TIME_CONSTANTS = 9;
 
+/* Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3). */
+
+/** 0: V'_max/V_max, thesis B (2.55).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float FIELD_WEAKENING_VOLTAGE_FRACTION = 0.0f;
+
+/** 0 rad/s: α_fw, thesis B (2.60), §2.3.3.
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float FIELD_WEAKENING_BANDWIDTH = 0.0f;
+
+/** 0 rad/s: ω_base, thesis B (2.60).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float FIELD_WEAKENING_BASE_SPEED = 0.0f;
+
+/** 0 H: L̂_d in γ, thesis B (2.60).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float FIELD_WEAKENING_LD = 0.0f;
+
+/** 0 A: I_max, thesis B (2.50), (2.56).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float FIELD_WEAKENING_CURRENT_MAX_A = 0.0f;
+
+/** [0 A]: |i_q| grid, thesis B (3.10).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float FIELD_WEAKENING_MTPA_IQ_A[1] = {0.0f};
+
+/** [0 A]: i_d = 0, thesis B (3.10).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float FIELD_WEAKENING_MTPA_ID_A[1] = {0.0f};
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

@@ -212,3 +212,35 @@ pub mod limits {
     /// Inputs: N = 12 bits.
     pub const ADC_SETTLING_TIME_CONSTANTS: u32 = 9;
 }
+
+/// Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3).
+pub mod field_weakening {
+    /// 0: `V'_max/V_max`, thesis B (2.55).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const VOLTAGE_FRACTION: f32 = 0.0;
+    /// 0 rad/s: `α_fw`, thesis B (2.60), §2.3.3.
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const BANDWIDTH: f32 = 0.0;
+    /// 0 rad/s: `ω_base`, thesis B (2.60).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const BASE_SPEED: f32 = 0.0;
+    /// 0 H: `L̂_d in γ`, thesis B (2.60).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const LD: f32 = 0.0;
+    /// 0 A: `I_max`, thesis B (2.50), (2.56).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const CURRENT_MAX_A: f32 = 0.0;
+    /// [0 A]: `|i_q| grid`, thesis B (3.10).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const MTPA_IQ_A: [f32; 1] = [0.0];
+    /// [0 A]: `i_d = 0`, thesis B (3.10).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const MTPA_ID_A: [f32; 1] = [0.0];
+}

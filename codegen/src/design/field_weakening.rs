@@ -220,6 +220,7 @@ pub fn inverter_loss(i: &crate::spec::InverterSpec, fs: f64) -> InverterLoss {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::loss_minimisation::InverterLoss;
 
     /// The thesis B motor (Tables B.1–B.2) with the chalmers spec's drive: U_dc = 320 V,
     /// α_c = 1470 rad/s, I_max = √2·224 A = 316.78 A, f_n = 200 Hz.
@@ -306,6 +307,59 @@ mod tests {
         let mut inp = chalmers();
         inp.rated_speed = None;
         assert!((base_speed(&inp) - 991.34).abs() < 0.02, "{}", base_speed(&inp));
+    }
+
+    /// The MTPA table's reported interpolation error for the chalmers motor, by hand: the
+    /// curvature of (3.10) is largest at i_q = 0, so the first interval is the worst.
+    /// h = 274.1854 A/16 = 17.13659 A; f(h) = 157.5758 − √(157.5758² + 17.13659²)
+    /// = −0.929075 A; f(h/2) = −0.232782 A; error = |f(h)/2 − f(h/2)| = 0.231756 A.
+    #[test]
+    fn mtpa_interpolation_error_by_hand() {
+        let out = design(&chalmers());
+        assert!(
+            (out.mtpa.max_interpolation_error_a - 0.231756).abs() < 1e-5,
+            "{}",
+            out.mtpa.max_interpolation_error_a
+        );
+    }
+
+    /// Loss-minimising table with R_c = 30 pu = 24.5 Ω (Fig. 3.1) and the Table B.3
+    /// inverter: 7 speeds × 17 currents; the ω = 0 row is the MTPA table (C.4) to 0.1 mA
+    /// (a golden-section search on a quadratic minimum resolves i_d to about
+    /// √ε_f64·I_max ≈ 5 µA); every point has i_d ≤ 0 and |i| ≤ I_max (2.50); at a fixed
+    /// i_q more speed never asks for less negative i_d (Fig. 3.1).
+    #[test]
+    fn loss_table_properties() {
+        let mut inp = chalmers();
+        inp.model.rc = Some(24.5);
+        inp.model.inverter = Some(InverterLoss {
+            threshold_v: 0.87,
+            resistance_ohm: 2.6e-3,
+            switching_energy_j: 0.306,
+            recovery_energy_j: 0.015,
+            nominal_current_a: 600.0,
+            switching_frequency_hz: 10e3,
+        });
+        let out = design(&inp);
+        let lm = out.loss_minimisation.as_ref().unwrap();
+        let t = &lm.table;
+        let n = t.iq_a.len();
+        assert_eq!(
+            (t.speeds_rad_s.len(), n, t.id_a.len()),
+            (LOSS_SPEED_POINTS, MTPA_POINTS, LOSS_SPEED_POINTS * MTPA_POINTS)
+        );
+        assert!((t.speeds_rad_s[LOSS_SPEED_POINTS - 1] - 1.5 * 1256.637).abs() < 1e-2);
+        for j in 0..n {
+            assert!((t.id_a[j] - out.mtpa.id_a[j]).abs() <= 1e-4, "{j}");
+            for k in 0..LOSS_SPEED_POINTS {
+                let id = t.id_a[k * n + j];
+                assert!(id <= 0.0 && id.hypot(t.iq_a[j]) <= out.current_max_a + 1e-6);
+                if k > 0 {
+                    assert!(id <= t.id_a[(k - 1) * n + j] + 1e-6, "ω row {k}, i_q {j}");
+                }
+            }
+        }
+        assert!(t.max_interpolation_error_a > 0.0);
     }
 
     /// MTPA table properties: monotone non-increasing, i_d ≤ 0, |i| ≤ I_max at every grid
