@@ -8,13 +8,14 @@ use motor_control::adc::{CurrentSense, DcLinkSense, MeasuredPhases};
 use motor_control::angle::ResolverToElectrical;
 use motor_control::ato::AtoConfig;
 use motor_control::feedforward::FeedForwardConfig;
+use motor_control::field_weakening::{FieldWeakeningConfig, MtpaCurve};
 use motor_control::fir::FmacFir;
 use motor_control::pi::{CurrentPiConfig, PiConfig, VoltageLimit};
 use motor_control::setpoint::SetpointConfig;
 
 use crate::design;
 use crate::hw;
-use crate::motor::{current_loop as cl, filter, limits, observer, scaling};
+use crate::motor::{current_loop as cl, field_weakening as fw, filter, limits, observer, scaling};
 use crate::timing;
 
 /// TIM1 auto-reload: centre-aligned carrier at f_s from the 170 MHz timer clock
@@ -77,6 +78,36 @@ pub const CONTROLLER: ControllerConfig = ControllerConfig {
     // The whole THPWM linear range U_dc/√3 (3.8), as the generated VOLTAGE_LIMIT_V.
     voltage_margin: 1.0,
     pwm_period: PWM_PERIOD,
+};
+
+/// Points of the generated MTPA table (thesis B (3.10)).
+pub const MTPA_POINTS: usize = fw::MTPA_IQ_A.len();
+
+/// `[|i_q|, i_d]` pairs of the generated MTPA grid and values, for [`MtpaCurve::Table`].
+const fn mtpa_pairs(iq: [f32; MTPA_POINTS], id: [f32; MTPA_POINTS]) -> [[f32; 2]; MTPA_POINTS] {
+    let mut out = [[0.0; 2]; MTPA_POINTS];
+    let mut k = 0;
+    while k < MTPA_POINTS {
+        out[k] = [iq[k], id[k]];
+        k += 1;
+    }
+    out
+}
+
+/// The MTPA table (3.10): the upper limit of i_d^ref (2.56).
+pub const MTPA_TABLE: [[f32; 2]; MTPA_POINTS] = mtpa_pairs(fw::MTPA_IQ_A, fw::MTPA_ID_A);
+
+/// The field-weakening controller of thesis B §2.3 (2.55)–(2.60), every field a generated
+/// constant: α_fw, L̂_d, ω_base, V'_max/V_max, I_max and the MTPA table. With ψ_M unknown
+/// the generated α_fw is 0 (γ = 0) and the table holds i_d^ref = 0.
+pub const FIELD_WEAKENING: FieldWeakeningConfig = FieldWeakeningConfig {
+    sample_period: limits::SAMPLE_PERIOD_S,
+    bandwidth: fw::BANDWIDTH,
+    ld: fw::LD,
+    base_speed: fw::BASE_SPEED,
+    voltage_fraction: fw::VOLTAGE_FRACTION,
+    current_max: fw::CURRENT_MAX_A,
+    mtpa: MtpaCurve::Table(&MTPA_TABLE),
 };
 
 /// Milliseconds per second.
@@ -223,6 +254,23 @@ mod tests {
         }
         assert_eq!(y, 8192);
         assert_eq!(FILTER.gain_shift, 0);
+    }
+
+    /// Every motor: the field-weakening configuration is the generated constants, and
+    /// the table reproduces the generated MTPA points (thesis B (3.10)) exactly.
+    #[test]
+    fn field_weakening_is_the_generated_constants() {
+        let c = FIELD_WEAKENING;
+        assert_eq!(c.bandwidth, motor::field_weakening::BANDWIDTH);
+        assert_eq!(c.current_max, motor::field_weakening::CURRENT_MAX_A);
+        assert_eq!(c.voltage_fraction, motor::field_weakening::VOLTAGE_FRACTION);
+        for (iq, id) in motor::field_weakening::MTPA_IQ_A
+            .iter()
+            .zip(motor::field_weakening::MTPA_ID_A)
+        {
+            assert_eq!(c.mtpa.id(*iq), id);
+            assert_eq!(c.mtpa.id(-*iq), id);
+        }
     }
 
     /// Every motor: the configuration is consistent with its own constants (the

@@ -77,6 +77,10 @@ fn table(points: &[[f32; 2]], x: f32) -> f32 {
         if let [[xa, ya], [xb, yb]] = *w
             && x <= xb
         {
+            if x == xb {
+                // Grid points return the stored value exactly.
+                return yb;
+            }
             let span = xb - xa;
             return if span > 0.0 {
                 ya + (yb - ya) * (x - xa) / span
@@ -248,6 +252,39 @@ mod tests {
         assert!((m.id(-150.0) + 40.0).abs() < 1e-5);
         assert_eq!(m.id(500.0), -60.0);
         assert_eq!(MtpaCurve::Table(&[]).id(5.0), 0.0);
+    }
+
+    /// A 17-point table of (3.10) on |i_q| = 0 … 274.185 A (the thesis B motor's MTPA
+    /// point on the circle |i| = √2·224 A, as the design emits it) returns the analytic
+    /// curve exactly at the grid points, stays within the linear-interpolation bound
+    /// h²/8·max|f''| = h²/(8·ψ/(2ΔL)) = 17.137²/(8·157.58) = 0.233 A in between (f'' of
+    /// (3.10) is largest at i_q = 0), is monotone, and holds its end value beyond.
+    #[test]
+    fn table_tracks_the_analytic_curve() {
+        let exact = MtpaCurve::Analytic {
+            psi_m: PSI,
+            delta_l: LQ - LD,
+        };
+        let h = 274.185f32 / 16.0;
+        let mut pts = [[0.0f32; 2]; 17];
+        for (k, p) in pts.iter_mut().enumerate() {
+            let iq = h * k as f32;
+            *p = [iq, exact.id(iq)];
+        }
+        // Leaked once: the variant borrows 'static points, like the generated constants.
+        let table = MtpaCurve::Table(Box::leak(Box::new(pts)));
+        let mut prev = 0.0f32;
+        for k in 0..=160 {
+            let iq = h * 16.0 * k as f32 / 160.0;
+            let (t, a) = (table.id(iq), exact.id(iq));
+            assert!((t - a).abs() <= 0.234, "{iq}: {t} vs {a}");
+            assert!(t <= prev + 1e-6 && t <= 0.0);
+            prev = t;
+        }
+        for p in pts {
+            assert_eq!(table.id(p[0]), p[1]);
+        }
+        assert_eq!(table.id(400.0), pts[16][1]);
     }
 
     /// γ (2.60), hand-evaluated: α_fw = 147 rad/s, L_d = 0.23 mH, V'_max = 0.9·184.75 V
