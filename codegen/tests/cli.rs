@@ -377,3 +377,117 @@ fn generate_writes_only_changed_files_and_templates_errors_name_the_file() {
     assert!(stderr.contains("motor.rs.j2:2"), "{stderr}");
     assert!(bad.stdout.is_empty());
 }
+
+/// `[field_weakening]`, `[losses]` and the α_fw ≪ α_c rule (thesis B §2.3.3): each bad
+/// value is reported at its key with what is accepted.
+#[test]
+fn field_weakening_and_losses_keys() {
+    let with = |extra: &str| {
+        let text = format!("{}\n{extra}\n", fischer());
+        let line = line_of(&text, extra.lines().last().unwrap());
+        (text, line)
+    };
+    let (t, line) = with("[field_weakening]\nvoltage_fraction = 1.2");
+    fails(
+        "fw_fraction",
+        &t,
+        line,
+        "field_weakening.voltage_fraction",
+        &["out of range", "below 1", "Fig. 2.15"],
+    );
+    let (t, line) = with("[field_weakening]\nvoltage_fraction = \"0.9\"");
+    fails(
+        "fw_fraction_string",
+        &t,
+        line,
+        "field_weakening.voltage_fraction",
+        &["plain number"],
+    );
+    let (t, line) = with("[field_weakening]\nspeed_loop_bandwidth = 5");
+    fails(
+        "fw_speed_bare",
+        &t,
+        line,
+        "field_weakening.speed_loop_bandwidth",
+        &["bare number", "rad/s"],
+    );
+    // Fischer α_c = 100 rad/s: α_fw = 10·5 = 50 rad/s > α_c/5 = 20 rad/s; α_s ≤ 2 rad/s.
+    let (t, line) = with("[field_weakening]\nspeed_loop_bandwidth = \"5 rad/s\"");
+    fails(
+        "fw_speed_fast",
+        &t,
+        line,
+        "field_weakening.speed_loop_bandwidth",
+        &["α_fw = 10·α_s = 50.0 rad/s", "α_c/5", "at most 2.00 rad/s"],
+    );
+    let (t, line) = with("[field_weakening]\nvoltage_fractoin = 0.9");
+    fails(
+        "fw_typo",
+        &t,
+        line,
+        "field_weakening.voltage_fractoin",
+        &["unknown key", "`voltage_fraction`"],
+    );
+    let (t, line) = with("[losses]\ninclude_inverter = true");
+    fails(
+        "losses_no_inverter",
+        &t,
+        line,
+        "losses.include_inverter",
+        &["no [inverter] section", "include_inverter = false"],
+    );
+    let (t, line) = with("[losses]\ncore_resistance = \"-3 Ω\"");
+    fails(
+        "losses_negative",
+        &t,
+        line,
+        "losses.core_resistance",
+        &["greater than zero"],
+    );
+    let (t, line) = with("[losses]\ncore_resistance = \"24.5 mH\"");
+    fails("losses_unit", &t, line, "losses.core_resistance", &["Ω"]);
+    // Torque control with J and b: α_fw = 10·b/J = 10·(0.01/0.001) = 100 rad/s > 20 rad/s.
+    let (t, _) = mutate(
+        "inductance = \"0.393 mH\"",
+        "inductance = \"0.393 mH\"\ninertia = \"0.001 kg·m²\"\nviscous_friction = \"0.01 N·m·s/rad\"",
+    );
+    let line = line_of(&t, "inertia = ");
+    fails(
+        "fw_mechanics_fast",
+        &t,
+        line,
+        "motor.datasheet.inertia",
+        &["α_fw = 10·b/J", "α_c/5"],
+    );
+}
+
+/// The field-weakening design in the JSON: the defaults of thesis B Fig. 2.15, and the
+/// torque-control rule α_fw = 10·b/J when J and b are given (hand values for Fischer:
+/// α_c = 100 rad/s → α_s = 1 rad/s, α_fw = 10 rad/s; b/J = 0.0005/0.001 = 0.5 s⁻¹ →
+/// α_fw = 5 rad/s).
+#[test]
+fn field_weakening_rules_in_the_design() {
+    let design = |text: &str, name: &str| {
+        let path = write(name, text.as_bytes());
+        let out = motorgen(&["design", path.to_str().unwrap(), "--format", "json"]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        serde_json::from_slice::<serde_json::Value>(&out.stdout).unwrap()["field_weakening"].clone()
+    };
+    let fw = design(&fischer(), "fw_default.toml");
+    assert_eq!(fw["bandwidth_rule"], "default_speed_loop");
+    assert_eq!(fw["bandwidth_rad_s"].as_f64(), Some(10.0));
+    assert_eq!(fw["voltage_fraction"].as_f64(), Some(0.9));
+    assert!(fw["loss_minimisation"].is_null());
+    let (t, _) = mutate(
+        "inductance = \"0.393 mH\"",
+        "inductance = \"0.393 mH\"\ninertia = \"0.001 kg·m²\"\nviscous_friction = \"0.0005 N·m·s/rad\"",
+    );
+    let fw = design(&t, "fw_mechanics.toml");
+    assert_eq!(fw["bandwidth_rule"], "mechanical");
+    assert!((fw["bandwidth_rad_s"].as_f64().unwrap() - 5.0).abs() < 1e-9);
+    let fw = design(
+        &format!("{}\n[field_weakening]\nvoltage_fraction = 0.85\n", fischer()),
+        "fw_085.toml",
+    );
+    assert_eq!(fw["voltage_fraction"].as_f64(), Some(0.85));
+}
