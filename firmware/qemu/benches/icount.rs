@@ -1,7 +1,7 @@
 //! Instructions per control step on the emulated Cortex-M4F, per motor in `motors/`.
 //!
 //! For every `motors/<stem>.toml` (or `$MOTORS_DIR`): builds the `icount` binary with
-//! `MOTOR=<stem>` (release, thumbv7em-none-eabihf; only `motor-firmware` and
+//! `MOTOR=<stem>` (release, thumbv7em-none-eabihf; only `motor-config` and
 //! `motor-qemu` rebuild per motor), runs it twice under
 //! `qemu-system-arm -machine netduinoplus2 -icount shift=5` (deterministic: both runs
 //! must print the same bytes), checks the tick/instruction factor against the
@@ -155,6 +155,9 @@ fn row(stem: &str, output: &str) -> Result<String, String> {
     let replayed = get("step-trig-replayed")?;
     let sin_cos = get("sin-cos")?;
     let atan2 = get("atan2")?;
+    let fast = get("step-fast-trig")?;
+    let fast_sin_cos = get("fast-sin-cos")?;
+    let fast_atan2 = get("fast-atan2")?;
     let n_sc = calls_of("sin-cos-calls-per-step")?;
     let n_at = calls_of("atan2-calls-per-step")?;
     let mean = |s: motor_qemu::icount::Stats| deci_instructions(s.sum, u64::from(s.count));
@@ -162,8 +165,15 @@ fn row(stem: &str, output: &str) -> Result<String, String> {
     let replayed_mean = mean(replayed);
     let cordic = replayed_mean + 10 * CORDIC_CYCLES * (n_sc + n_at);
     let trig = n_sc * mean(sin_cos) + n_at * mean(atan2);
+    let fast_mean = mean(fast);
     Ok(format!(
-        "| {stem} | {} / {} / {} | {:.1} % | {} × {} + {} × {} = {} | {} | {} ({:.1} %) |",
+        "| {stem} | {} / {} / {} ({:.1} %) | {}, {} | {} / {} / {} | {:.1} % | {} × {} + {} × {} = {} | {} | {} ({:.1} %) |",
+        deci(deci_instructions(u64::from(fast.min), 1)),
+        deci(deci_instructions(u64::from(fast.max), 1)),
+        deci(fast_mean),
+        fast_mean as f64 / 10.0 / BUDGET_CYCLES as f64 * 100.0,
+        deci(mean(fast_sin_cos)),
+        deci(mean(fast_atan2)),
         deci(deci_instructions(u64::from(step.min), 1)),
         deci(deci_instructions(u64::from(step.max), 1)),
         deci(step_mean),
@@ -210,14 +220,15 @@ fn run() -> Result<(), String> {
         rows.push(row(stem, &first)?);
     }
     println!(
-        "instructions per current-control step on the emulated Cortex-M4F (-icount shift=5, \
-         SoftTrig; min / max / mean over the measured steps)"
+        "instructions per current-control step on the emulated Cortex-M4F (-icount shift=5; \
+         min / max / mean over the measured steps)"
     );
     println!(
-        "| motor | step min / max / mean | of {BUDGET_CYCLES} cycles | software trig (calls × mean) | \
+        "| motor | step, FastTrig min / max / mean (of {BUDGET_CYCLES} cycles) | FastTrig sin/cos, atan2 | \
+         step, SoftTrig min / max / mean | of {BUDGET_CYCLES} cycles | SoftTrig (calls × mean) | \
          step, trig replayed | with CORDIC (+{CORDIC_CYCLES} cycles per call) |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for r in rows {
         println!("{r}");
     }
