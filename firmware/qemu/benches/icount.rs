@@ -18,14 +18,13 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::ExitCode;
 
+use motor_qemu::host::{build, emulate, on_path};
 use motor_qemu::icount::{Measurement, deci_instructions};
 
-/// The emulated target.
-const TARGET: &str = "thumbv7em-none-eabihf";
 /// Seconds one emulator run may take.
-const TIMEOUT_S: &str = "120";
+const TIMEOUT_S: u32 = 120;
 /// STM32G474 CORDIC cycles for one sine/cosine or phase (atan2) in q1.31 at 20-bit
 /// precision: PRECISION = 6, i.e. 24 iterations at 4 iterations per clock cycle
 /// (RM0440, CORDIC precision table). The register accesses around it (one or two
@@ -34,11 +33,6 @@ const TIMEOUT_S: &str = "120";
 const CORDIC_CYCLES: u64 = 6;
 /// Cycle budget of one step: 170 MHz core clock / 20 kHz control rate.
 const BUDGET_CYCLES: u64 = 8_500;
-
-/// Whether `program` is an executable file in one of `PATH`'s directories.
-fn on_path(program: &str) -> bool {
-    std::env::var_os("PATH").is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
-}
 
 /// Motor stems in `dir`, sorted.
 fn motors(dir: &Path) -> Result<Vec<String>, String> {
@@ -50,67 +44,6 @@ fn motors(dir: &Path) -> Result<Vec<String>, String> {
         .collect();
     stems.sort();
     Ok(stems)
-}
-
-/// Builds `icount` for `stem`; returns the ELF path.
-fn build(workspace: &Path, stem: &str) -> Result<PathBuf, String> {
-    let out = Command::new(env!("CARGO"))
-        .args([
-            "build",
-            "--release",
-            "--target",
-            TARGET,
-            "-p",
-            "motor-qemu",
-            "--bin",
-            "icount",
-        ])
-        .args(["--message-format=short"])
-        .current_dir(workspace)
-        .env("MOTOR", stem)
-        .output()
-        .map_err(|e| format!("running cargo: {e}"))?;
-    if !out.status.success() {
-        return Err(format!(
-            "MOTOR={stem} cargo build -p motor-qemu --bin icount failed ({}):\n{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        ));
-    }
-    let target_dir = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| workspace.join("target"), PathBuf::from);
-    let target_dir = if target_dir.is_absolute() {
-        target_dir
-    } else {
-        workspace.join(target_dir)
-    };
-    Ok(target_dir.join(TARGET).join("release").join("icount"))
-}
-
-/// Runs `elf` under QEMU with `-icount shift=5`; returns its semihosting output.
-fn emulate(elf: &Path) -> Result<String, String> {
-    let out = Command::new("timeout")
-        .arg(TIMEOUT_S)
-        .args([
-            "qemu-system-arm",
-            "-machine",
-            "netduinoplus2",
-            "-icount",
-            "shift=5",
-            "-nographic",
-        ])
-        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
-        .arg(elf)
-        .output()
-        .map_err(|e| format!("running qemu-system-arm: {e}"))?;
-    let stdout = String::from_utf8_lossy(&out.stdout).replace('\r', "");
-    if !out.status.success() {
-        return Err(format!(
-            "qemu exited with {} (124 = timed out after {TIMEOUT_S} s)\nstdout:\n{stdout}\nstderr:\n{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        ));
-    }
-    Ok(stdout)
 }
 
 /// `x` (× 10) as `<int>.<digit>`.
@@ -208,9 +141,9 @@ fn run() -> Result<(), String> {
     }
     let mut rows = Vec::new();
     for stem in &stems {
-        let elf = build(&workspace, stem)?;
-        let first = emulate(&elf)?;
-        let second = emulate(&elf)?;
+        let elf = build(&workspace, "icount", Some(stem))?;
+        let first = emulate(&elf, &["-icount", "shift=5"], TIMEOUT_S)?;
+        let second = emulate(&elf, &["-icount", "shift=5"], TIMEOUT_S)?;
         if first != second {
             return Err(format!(
                 "{stem}: two runs differ (not deterministic)\nfirst:\n{first}\nsecond:\n{second}"
