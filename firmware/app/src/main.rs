@@ -3,13 +3,12 @@
 //! STM32G474 board through `probe-rs` (see firmware/README.md).
 #![cfg_attr(target_os = "none", no_std, no_main)]
 
-// The board layer lives in the binary: it defines the exception and panic handlers.
-// `crate::config` etc. inside it name the library's pure modules.
+// The board layer: peripherals, the control interrupt, exception and panic handlers.
+// `crate::config` etc. inside it name motor-config's modules.
 #[cfg(target_os = "none")]
-#[path = "board/mod.rs"]
 mod board;
 #[cfg(target_os = "none")]
-use motor_firmware::{adc_frame, can_frame, config, hw};
+use motor_config::{adc_frame, can_frame, config, hw};
 
 #[cfg(target_os = "none")]
 mod target {
@@ -25,7 +24,7 @@ mod target {
 /// Host build: prints the register values this image would program.
 #[cfg(not(target_os = "none"))]
 fn main() {
-    use motor_firmware::{config, motor};
+    use motor_config::{config, motor};
     println!("motor: {}", motor::limits::SWITCHING_FREQUENCY_HZ);
     println!("TIM1 ARR {} DTG {:#04x}", config::PWM_PERIOD, config::DEAD_TIME_DTG);
     println!("ADC SMP {}", config::ADC_SMP);

@@ -53,6 +53,7 @@ pub mod angle;
 pub mod ato;
 pub mod commissioning;
 pub mod estimator;
+pub mod fast_trig;
 pub mod feedforward;
 pub mod field_weakening;
 pub mod fir;
@@ -63,5 +64,6 @@ pub mod step;
 pub mod transforms;
 pub mod trig;
 
+pub use fast_trig::FastTrig;
 pub use step::{AdcSample, ControllerConfig, ControllerState, Demand, StepOutput};
 pub use trig::{SoftTrig, Trig};

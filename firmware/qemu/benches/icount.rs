@@ -1,7 +1,7 @@
 //! Instructions per control step on the emulated Cortex-M4F, per motor in `motors/`.
 //!
 //! For every `motors/<stem>.toml` (or `$MOTORS_DIR`): builds the `icount` binary with
-//! `MOTOR=<stem>` (release, thumbv7em-none-eabihf; only `motor-firmware` and
+//! `MOTOR=<stem>` (release, thumbv7em-none-eabihf; only `motor-config` and
 //! `motor-qemu` rebuild per motor), runs it twice under
 //! `qemu-system-arm -machine netduinoplus2 -icount shift=5` (deterministic: both runs
 //! must print the same bytes), checks the tick/instruction factor against the
@@ -18,14 +18,13 @@
 
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode};
+use std::process::ExitCode;
 
+use motor_qemu::host::{build, emulate, on_path};
 use motor_qemu::icount::{Measurement, deci_instructions};
 
-/// The emulated target.
-const TARGET: &str = "thumbv7em-none-eabihf";
 /// Seconds one emulator run may take.
-const TIMEOUT_S: &str = "120";
+const TIMEOUT_S: u32 = 120;
 /// STM32G474 CORDIC cycles for one sine/cosine or phase (atan2) in q1.31 at 20-bit
 /// precision: PRECISION = 6, i.e. 24 iterations at 4 iterations per clock cycle
 /// (RM0440, CORDIC precision table). The register accesses around it (one or two
@@ -34,11 +33,6 @@ const TIMEOUT_S: &str = "120";
 const CORDIC_CYCLES: u64 = 6;
 /// Cycle budget of one step: 170 MHz core clock / 20 kHz control rate.
 const BUDGET_CYCLES: u64 = 8_500;
-
-/// Whether `program` is an executable file in one of `PATH`'s directories.
-fn on_path(program: &str) -> bool {
-    std::env::var_os("PATH").is_some_and(|paths| std::env::split_paths(&paths).any(|dir| dir.join(program).is_file()))
-}
 
 /// Motor stems in `dir`, sorted.
 fn motors(dir: &Path) -> Result<Vec<String>, String> {
@@ -50,67 +44,6 @@ fn motors(dir: &Path) -> Result<Vec<String>, String> {
         .collect();
     stems.sort();
     Ok(stems)
-}
-
-/// Builds `icount` for `stem`; returns the ELF path.
-fn build(workspace: &Path, stem: &str) -> Result<PathBuf, String> {
-    let out = Command::new(env!("CARGO"))
-        .args([
-            "build",
-            "--release",
-            "--target",
-            TARGET,
-            "-p",
-            "motor-qemu",
-            "--bin",
-            "icount",
-        ])
-        .args(["--message-format=short"])
-        .current_dir(workspace)
-        .env("MOTOR", stem)
-        .output()
-        .map_err(|e| format!("running cargo: {e}"))?;
-    if !out.status.success() {
-        return Err(format!(
-            "MOTOR={stem} cargo build -p motor-qemu --bin icount failed ({}):\n{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        ));
-    }
-    let target_dir = std::env::var_os("CARGO_TARGET_DIR").map_or_else(|| workspace.join("target"), PathBuf::from);
-    let target_dir = if target_dir.is_absolute() {
-        target_dir
-    } else {
-        workspace.join(target_dir)
-    };
-    Ok(target_dir.join(TARGET).join("release").join("icount"))
-}
-
-/// Runs `elf` under QEMU with `-icount shift=5`; returns its semihosting output.
-fn emulate(elf: &Path) -> Result<String, String> {
-    let out = Command::new("timeout")
-        .arg(TIMEOUT_S)
-        .args([
-            "qemu-system-arm",
-            "-machine",
-            "netduinoplus2",
-            "-icount",
-            "shift=5",
-            "-nographic",
-        ])
-        .args(["-semihosting-config", "enable=on,target=native", "-kernel"])
-        .arg(elf)
-        .output()
-        .map_err(|e| format!("running qemu-system-arm: {e}"))?;
-    let stdout = String::from_utf8_lossy(&out.stdout).replace('\r', "");
-    if !out.status.success() {
-        return Err(format!(
-            "qemu exited with {} (124 = timed out after {TIMEOUT_S} s)\nstdout:\n{stdout}\nstderr:\n{}",
-            out.status,
-            String::from_utf8_lossy(&out.stderr)
-        ));
-    }
-    Ok(stdout)
 }
 
 /// `x` (× 10) as `<int>.<digit>`.
@@ -155,6 +88,9 @@ fn row(stem: &str, output: &str) -> Result<String, String> {
     let replayed = get("step-trig-replayed")?;
     let sin_cos = get("sin-cos")?;
     let atan2 = get("atan2")?;
+    let fast = get("step-fast-trig")?;
+    let fast_sin_cos = get("fast-sin-cos")?;
+    let fast_atan2 = get("fast-atan2")?;
     let n_sc = calls_of("sin-cos-calls-per-step")?;
     let n_at = calls_of("atan2-calls-per-step")?;
     let mean = |s: motor_qemu::icount::Stats| deci_instructions(s.sum, u64::from(s.count));
@@ -162,8 +98,15 @@ fn row(stem: &str, output: &str) -> Result<String, String> {
     let replayed_mean = mean(replayed);
     let cordic = replayed_mean + 10 * CORDIC_CYCLES * (n_sc + n_at);
     let trig = n_sc * mean(sin_cos) + n_at * mean(atan2);
+    let fast_mean = mean(fast);
     Ok(format!(
-        "| {stem} | {} / {} / {} | {:.1} % | {} × {} + {} × {} = {} | {} | {} ({:.1} %) |",
+        "| {stem} | {} / {} / {} ({:.1} %) | {}, {} | {} / {} / {} | {:.1} % | {} × {} + {} × {} = {} | {} | {} ({:.1} %) |",
+        deci(deci_instructions(u64::from(fast.min), 1)),
+        deci(deci_instructions(u64::from(fast.max), 1)),
+        deci(fast_mean),
+        fast_mean as f64 / 10.0 / BUDGET_CYCLES as f64 * 100.0,
+        deci(mean(fast_sin_cos)),
+        deci(mean(fast_atan2)),
         deci(deci_instructions(u64::from(step.min), 1)),
         deci(deci_instructions(u64::from(step.max), 1)),
         deci(step_mean),
@@ -198,9 +141,9 @@ fn run() -> Result<(), String> {
     }
     let mut rows = Vec::new();
     for stem in &stems {
-        let elf = build(&workspace, stem)?;
-        let first = emulate(&elf)?;
-        let second = emulate(&elf)?;
+        let elf = build(&workspace, "icount", Some(stem))?;
+        let first = emulate(&elf, &["-icount", "shift=5"], TIMEOUT_S)?;
+        let second = emulate(&elf, &["-icount", "shift=5"], TIMEOUT_S)?;
         if first != second {
             return Err(format!(
                 "{stem}: two runs differ (not deterministic)\nfirst:\n{first}\nsecond:\n{second}"
@@ -210,14 +153,15 @@ fn run() -> Result<(), String> {
         rows.push(row(stem, &first)?);
     }
     println!(
-        "instructions per current-control step on the emulated Cortex-M4F (-icount shift=5, \
-         SoftTrig; min / max / mean over the measured steps)"
+        "instructions per current-control step on the emulated Cortex-M4F (-icount shift=5; \
+         min / max / mean over the measured steps)"
     );
     println!(
-        "| motor | step min / max / mean | of {BUDGET_CYCLES} cycles | software trig (calls × mean) | \
+        "| motor | step, FastTrig min / max / mean (of {BUDGET_CYCLES} cycles) | FastTrig sin/cos, atan2 | \
+         step, SoftTrig min / max / mean | of {BUDGET_CYCLES} cycles | SoftTrig (calls × mean) | \
          step, trig replayed | with CORDIC (+{CORDIC_CYCLES} cycles per call) |"
     );
-    println!("|---|---|---|---|---|---|");
+    println!("|---|---|---|---|---|---|---|---|");
     for r in rows {
         println!("{r}");
     }

@@ -8,7 +8,8 @@
 //! directory, so only the app crate rebuilds per motor), copies the ELF to
 //! `target/firmware/<stem>.elf` under the repository root, writes `<stem>.bin` (the
 //! ELF's loadable segments placed by load address, gaps filled with the erased-flash
-//! byte 0xFF) and prints flash and static RAM use. An image over 64 KiB of flash is an
+//! byte 0xFF) and prints flash and static RAM use; for one motor it first prints the
+//! constants summary of the design the image is built from. An image over 64 KiB of flash is an
 //! error and is not written.
 //!
 //! The repository root is the nearest ancestor of the motors folder that holds
@@ -340,15 +341,19 @@ pub fn run(which: Which, motors: &Path) -> ExitCode {
     };
     let motors = motors.canonicalize().unwrap_or_else(|_| motors.to_path_buf());
     // Every selected spec must design before cargo runs (located diagnostics).
-    let mut designs_ok = true;
+    let mut designs = Vec::new();
     for stem in &selected {
-        if let Err(d) = super::design(&motors.join(format!("{stem}.toml"))) {
-            designs_ok = false;
-            eprint!("{d}");
+        match super::design(&motors.join(format!("{stem}.toml"))) {
+            Ok(d) => designs.push(d),
+            Err(d) => eprint!("{d}"),
         }
     }
-    if !designs_ok {
+    if designs.len() != selected.len() {
         return ExitCode::FAILURE;
+    }
+    // One motor: the constants the image is built from, as `motorgen design` prints them.
+    if let [d] = designs.as_slice() {
+        print!("{}", codegen::summary::summary(d));
     }
     let mut ok = true;
     for stem in &selected {

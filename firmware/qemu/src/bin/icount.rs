@@ -1,7 +1,8 @@
 //! Counts the instructions of one full current-control step on the emulated
-//! Cortex-M4F: `ControllerConfig::process::<SoftTrig>` (ADC codes in → three compare
-//! values out, angle tracking observer included) for the motor chosen at build time
-//! with `MOTOR=<stem>` (its generated constants, through `motor-firmware`).
+//! Cortex-M4F: `ControllerConfig::process` (ADC codes in → three compare values out,
+//! angle tracking observer included) with `SoftTrig`, with `FastTrig` and with the trig
+//! results replayed, for the motor chosen at build time with `MOTOR=<stem>` (its
+//! generated constants, through `motor-config`).
 //!
 //! SysTick runs from the core clock with reload 0xFF_FFFF and is read before and after
 //! every measured call; the ticks of an empty measurement are subtracted. Under
@@ -28,6 +29,7 @@ mod target {
     use cortex_m::peripheral::syst::SystClkSource;
     use cortex_m_rt::{ExceptionFrame, entry, exception};
     use cortex_m_semihosting::{debug, hprintln};
+    use motor_control::FastTrig;
     use motor_control::ato::ObserverError;
     use motor_control::step::{ControllerState, Demand};
     use motor_control::trig::{SoftTrig, Trig};
@@ -145,6 +147,20 @@ mod target {
         }
         print("step", step);
         print("step-trig-replayed", replayed);
+
+        // The same step with the single-precision software trigonometry (FastTrig,
+        // 2^-23), from the same state and samples.
+        let mut fast_state = state;
+        let mut fast = Stats::new();
+        for _ in 0..STEPS {
+            let sample = workload.sample(config);
+            let (t, _) = ticks(|| {
+                let (s, st, d) = black_box((&sample, &mut fast_state, demand));
+                config.process(st, &mut FastTrig, s, d)
+            });
+            fast.add(net(t));
+        }
+        print("step-fast-trig", fast);
         hprintln!("sin-cos-calls-per-step {}", sin_cos_calls);
         hprintln!(
             "atan2-calls-per-step {}",
@@ -169,6 +185,22 @@ mod target {
         }
         print("sin-cos", sin_cos);
         print("atan2", atan2);
+
+        let mut fast_sin_cos = Stats::new();
+        let mut fast_atan2 = Stats::new();
+        let mut trig = FastTrig;
+        for _ in 0..STEPS {
+            fast_sin_cos.add(net(ticks(|| trig.sin_cos(black_box(theta))).0));
+            let sc = motor_control::trig::sin_cos_q31(theta);
+            fast_atan2.add(net(ticks(|| {
+                let (y, x) = black_box((sc.sin, sc.cos));
+                trig.atan2(y, x)
+            })
+            .0));
+            theta = theta.wrapping_add(4_294_967);
+        }
+        print("fast-sin-cos", fast_sin_cos);
+        print("fast-atan2", fast_atan2);
         exit(debug::EXIT_SUCCESS)
     }
 

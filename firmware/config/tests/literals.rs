@@ -207,7 +207,10 @@ fn sources() -> Vec<(PathBuf, String)> {
         }
     }
     let mut files = Vec::new();
-    walk(&Path::new(env!("CARGO_MANIFEST_DIR")).join("src"), &mut files);
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // This crate's logic and the board layer of the image (`../app`).
+    walk(&manifest.join("src"), &mut files);
+    walk(&manifest.join("../app/src"), &mut files);
     files.sort();
     files
         .into_iter()
