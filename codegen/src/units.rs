@@ -49,6 +49,10 @@ pub enum Kind {
     Inertia,
     /// N·m·s/rad (viscous friction b).
     ViscousFriction,
+    /// °, deg or rad, returned in rad.
+    Angle,
+    /// rad/s² or rpm/s, returned in rad/s².
+    AngularAcceleration,
 }
 
 impl Kind {
@@ -74,6 +78,8 @@ impl Kind {
             Kind::BackEmfConstant => "a back-EMF constant",
             Kind::Inertia => "a moment of inertia",
             Kind::ViscousFriction => "a viscous friction coefficient",
+            Kind::Angle => "an angle",
+            Kind::AngularAcceleration => "an angular acceleration",
         }
     }
 
@@ -103,6 +109,10 @@ impl Kind {
             }
             Kind::Inertia => "a moment of inertia such as \"0.01 kg·m²\" (units: kg·m², kg m^2)",
             Kind::ViscousFriction => "a viscous friction coefficient such as \"0.001 N·m·s/rad\"",
+            Kind::Angle => "an angle such as \"10 °\" (units: °, deg, rad, mrad)",
+            Kind::AngularAcceleration => {
+                "an angular acceleration such as \"5000 rpm/s\" (units: rad/s², rad/s^2, rpm/s, krpm/s)"
+            }
         }
     }
 }
@@ -237,6 +247,18 @@ pub fn parse(kind: Kind, text: &str) -> Result<f64, UnitError> {
         Kind::ViscousFriction => {
             matches!(unit.as_str(), "N · m·s/rad" | "N · m s/rad" | "N · ms/rad" | "N · m·s").then_some(value)
         }
+        Kind::Angle => match unit.as_str() {
+            "°" | "deg" | "degree" | "degrees" => Some(value.to_radians()),
+            "rad" => Some(value),
+            "mrad" => Some(value * 1e-3),
+            _ => None,
+        },
+        Kind::AngularAcceleration => match unit.as_str() {
+            "rad/s²" | "rad/s^2" | "rad/s2" => Some(value),
+            "rpm/s" => Some(value * std::f64::consts::PI / 30.0),
+            "krpm/s" => Some(value * 1e3 * std::f64::consts::PI / 30.0),
+            _ => None,
+        },
         Kind::TorqueConstant => match unit.as_str() {
             "N · m/A" | "N · m / A" => Some(value),
             _ => None,
@@ -267,6 +289,23 @@ mod tests {
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() <= 1e-12 * b.abs().max(1e-300)
+    }
+
+    #[test]
+    fn angles_and_accelerations() {
+        // 10° = π/18 rad; 1 rpm/s = π/30 rad/s² (hand conversions).
+        assert!(close(parse(Kind::Angle, "10 °").unwrap(), std::f64::consts::PI / 18.0));
+        assert!(close(
+            parse(Kind::Angle, "10 deg").unwrap(),
+            std::f64::consts::PI / 18.0
+        ));
+        assert!(close(parse(Kind::Angle, "0.1 rad").unwrap(), 0.1));
+        assert!(close(
+            parse(Kind::AngularAcceleration, "300 rpm/s").unwrap(),
+            10.0 * std::f64::consts::PI
+        ));
+        assert!(close(parse(Kind::AngularAcceleration, "50 rad/s²").unwrap(), 50.0));
+        assert!(parse(Kind::Angle, "10 rad/s").is_err());
     }
 
     #[test]

@@ -17,6 +17,7 @@ pub mod modulation;
 pub mod per_unit;
 pub mod sampling;
 pub mod scaling;
+pub mod sensorless;
 pub mod thermal;
 
 use std::collections::BTreeMap;
@@ -278,6 +279,8 @@ pub struct Design {
     pub adc: AdcOut,
     /// Field weakening and MTPA / loss-minimising tables (thesis B §2.3, ch. 3), if ψ_M is known.
     pub field_weakening: Option<field_weakening::FieldWeakeningOut>,
+    /// Sensorless estimator (thesis B chapter 4), when ψ_M is known.
+    pub sensorless: Option<sensorless::SensorlessOut>,
     /// Non-fatal observations.
     pub warnings: Vec<String>,
 }
@@ -318,6 +321,74 @@ fn axes(spec: &Spec, r: f64, ts: f64) -> Result<(AxisGains, AxisGains), CurrentL
 
 /// The field-weakening rules (thesis B §2.3) when ψ_M is known; α_fw ≪ α_c is enforced
 /// at the key that set α_fw.
+/// The sensorless estimator rules (thesis B chapter 4) for a motor with known ψ_M; a ρ
+/// above α_c/10 (Table 4.1) is an error at the `[sensorless]` key that set it.
+fn sensorless_design(
+    spec: &Spec,
+    src: &Source<'_>,
+    per_unit: Option<&PerUnitOut>,
+    speed_max: f64,
+) -> Result<Option<(sensorless::SensorlessOut, Vec<String>)>, Box<Diagnostic>> {
+    let m = &spec.motor;
+    let Some(psi) = m.flux_linkage.as_ref().map(|p| p.value) else {
+        return Ok(None);
+    };
+    let s = &spec.sensorless;
+    let i_max = std::f64::consts::SQRT_2 * m.peak_current.value;
+    let value = |p: &Option<crate::spec::Param>| p.as_ref().map(|p| p.value);
+    let inp = sensorless::Inputs {
+        resistance: m.phase_resistance.value,
+        ld: m.d_inductance.value,
+        lq: m.q_inductance.value,
+        psi,
+        current_max: i_max,
+        current_base: per_unit.map_or(i_max, |p| p.bases.current_a),
+        speed_max,
+        current_bandwidth: spec.current_loop.bandwidth.value,
+        switching: 2.0 * PI * spec.drive.switching_frequency.value,
+        speed_base: per_unit.map(|p| p.bases.angular_frequency_rad_s),
+        pole_pairs: f64::from(m.pole_pairs),
+        choices: sensorless::Choices {
+            bandwidth: value(&s.bandwidth),
+            max_acceleration: value(&s.max_acceleration),
+            angle_error: crate::spec::angle_error_rad(s).0,
+            injection_frequency: value(&s.injection_frequency),
+            injection_voltage: value(&s.injection_voltage),
+            highpass: value(&s.highpass),
+            lowpass: value(&s.lowpass),
+            resistance_error: value(&s.resistance_error).unwrap_or(crate::spec::DEFAULT_RESISTANCE_ERROR),
+            speed_noise: value(&s.speed_noise),
+        },
+    };
+    let (out, notes) = sensorless::design(&inp);
+    if out.rho_rad_s > out.rho_max_rad_s * (1.0 + 1e-9)
+        && let Some(p) = s.bandwidth.as_ref().or(s.max_acceleration.as_ref())
+    {
+        let accepted = if s.bandwidth.is_some() {
+            format!(
+                "a bandwidth up to α_c/10 = {:.1} rad/s, or a faster current loop",
+                out.rho_max_rad_s
+            )
+        } else {
+            format!(
+                "a shaft acceleration up to (α_c/10)²·sin θ̃max/n_p = {:.1} rad/s² ({:.0} rpm/s), a larger sensorless.max_angle_error, or a faster current loop",
+                out.rho_max_rad_s.powi(2) * out.angle_error_rad.sin() / inp.pole_pairs,
+                out.rho_max_rad_s.powi(2) * out.angle_error_rad.sin() / inp.pole_pairs * 30.0 / PI
+            )
+        };
+        return Err(Box::new(src.error(
+            p.span.clone(),
+            &p.key,
+            format!(
+                "the estimator bandwidth ρ = {:.1} rad/s exceeds α_c/10 = {:.1} rad/s (thesis B Table 4.1): the current loop would not follow the estimated frame",
+                out.rho_rad_s, out.rho_max_rad_s
+            ),
+            accepted,
+        )));
+    }
+    Ok(Some((out, notes)))
+}
+
 fn field_weakening_design(
     spec: &Spec,
     src: &Source<'_>,
@@ -659,6 +730,15 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         _ => None,
     };
 
+    let sensorless = match sensorless_design(spec, &src, per_unit.as_ref(), 2.0 * PI * fe_max) {
+        Ok(Some((out, notes))) => {
+            warnings.extend(notes);
+            Some(out)
+        }
+        Ok(None) => None,
+        Err(e) => return Err(Diagnostics(vec![*e])),
+    };
+
     let offset = spec.resolver.offset.as_ref().map(|p| p.value);
     let lead = o.lead_samples.value;
     let design = Design {
@@ -784,6 +864,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
             sample_time,
         },
         field_weakening: fw,
+        sensorless,
         warnings,
     };
     Ok(design)

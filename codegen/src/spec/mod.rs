@@ -7,6 +7,7 @@
 
 mod field_weakening;
 mod raw;
+mod sensorless;
 
 use std::ops::Range;
 
@@ -17,6 +18,7 @@ use crate::units::{self, Kind};
 pub use field_weakening::{DEFAULT_VOLTAGE_FRACTION, FieldWeakeningSpec};
 pub use raw::{Amplitude, Between, Connection, Method, ObserverError, SpeedAxis};
 use raw::{RawParams, RawSpec, Val};
+pub use sensorless::{DEFAULT_ANGLE_ERROR_DEG, DEFAULT_RESISTANCE_ERROR, SensorlessSpec, angle_error_rad};
 
 /// Where a resolved value came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -258,6 +260,8 @@ pub struct Spec {
     pub inverter: Option<InverterSpec>,
     /// `[field_weakening]` and `[losses]` (thesis B §2.3, chapter 3).
     pub field_weakening: FieldWeakeningSpec,
+    /// `[sensorless]` (thesis B chapter 4).
+    pub sensorless: SensorlessSpec,
 }
 
 /// Parses and resolves a spec. `source.file` is only used in messages.
@@ -526,6 +530,7 @@ impl<'a> Resolver_<'a> {
         let thermal = raw.thermal.as_ref().and_then(|t| self.thermal(t.get_ref()));
         let inverter = raw.inverter.as_ref().and_then(|i| self.inverter(i.get_ref()));
         let field_weakening = self.field_weakening(raw);
+        let sensorless = self.sensorless(raw);
         Some(Spec {
             name,
             description: raw.description.clone(),
@@ -540,6 +545,7 @@ impl<'a> Resolver_<'a> {
             thermal,
             inverter,
             field_weakening: field_weakening?,
+            sensorless: sensorless?,
         })
     }
 

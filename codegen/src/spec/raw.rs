@@ -34,6 +34,8 @@ pub struct RawSpec {
     pub field_weakening: Option<Spanned<super::field_weakening::RawFieldWeakening>>,
     #[serde(default)]
     pub losses: Option<Spanned<super::field_weakening::RawLosses>>,
+    #[serde(default)]
+    pub sensorless: Option<Spanned<super::sensorless::RawSensorless>>,
 }
 
 /// `[motor]`.
