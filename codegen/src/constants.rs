@@ -6,6 +6,7 @@
 //! with unit, its formula, the source equation and the provenance of its inputs.
 
 mod field_weakening;
+mod sensorless;
 
 use serde::{Deserialize, Serialize};
 
@@ -647,6 +648,7 @@ pub fn constants(d: &Design) -> Vec<Group> {
             constants: limits,
         },
         field_weakening::group(d),
+        sensorless::group(d),
     ]
 }
 

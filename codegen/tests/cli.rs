@@ -322,6 +322,36 @@ fn design_rules_are_located_errors() {
     // f_s ≥ 12·1333 Hz = 16 kHz.
     let (t, line) = mutate("switching_frequency = \"20 kHz\"", "switching_frequency = \"15 kHz\"");
     fails("fs", &t, line, "drive.switching_frequency", &["12·f_e,max", "16000"]);
+    // Sensorless: ρ ≤ α_c/10 = 10 rad/s for Fischer (thesis B Table 4.1).
+    let section = |body: &str| mutate("[fir]", &format!("[sensorless]\n{body}\n\n[fir]"));
+    let (t, _) = section("bandwidth = \"50 rad/s\"");
+    let line = line_of(&t, "bandwidth = \"50");
+    fails("rho", &t, line, "sensorless.bandwidth", &["α_c/10", "10.0 rad/s"]);
+    // (4.74): ρ = √(n_p·a/sin 10°) ≤ 10 rad/s ⇔ a ≤ 10²·0.17365/4 = 4.34 rad/s² = 41 rpm/s.
+    let (t, _) = section("max_acceleration = \"5000 rpm/s\"");
+    let line = line_of(&t, "max_acceleration");
+    fails(
+        "accel",
+        &t,
+        line,
+        "sensorless.max_acceleration",
+        &["(4.74)", "4.3 rad/s²", "41 rpm/s"],
+    );
+    let (t, _) = section("bandwidth = \"5 rad/s\"\nmax_acceleration = \"10 rpm/s\"");
+    let line = line_of(&t, "bandwidth = \"5");
+    fails("both", &t, line, "sensorless.bandwidth", &["both", "max_acceleration"]);
+    let (t, _) = section("max_angle_error = \"95 °\"");
+    let line = line_of(&t, "max_angle_error");
+    fails("angle", &t, line, "sensorless.max_angle_error", &["90°", "\"10 °\""]);
+    let (t, _) = section("max_angle_error = \"10 m\"");
+    let line = line_of(&t, "max_angle_error");
+    fails(
+        "angle_unit",
+        &t,
+        line,
+        "sensorless.max_angle_error",
+        &["not an angle", "°, deg, rad"],
+    );
 }
 
 #[test]

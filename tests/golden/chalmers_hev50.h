@@ -262,4 +262,62 @@ static const float FIELD_WEAKENING_LOSS_MIN_ID_A[119] = {0.0f, -0.929075f, -3.68
  *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
 static const float FIELD_WEAKENING_LOSS_MIN_MAX_INTERPOLATION_ERROR_A = 10.899656f;
 
+/* Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4). */
+
+/** 147 rad/s: ρ: estimator bandwidth, ρ ≤ α_c/10, thesis B (4.74), Table 4.1.
+ *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_RHO = 147.0f;
+
+/** 21609 1/s²: γ1 = ρ², thesis B (4.7).
+ *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_GAMMA1 = 21609.0f;
+
+/** 294 1/s: γ2 = 2ρ, thesis B (4.7).
+ *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_GAMMA2 = 294.0f;
+
+/** 3141.59 rad/s: ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10), thesis B (4.34).
+ *  Inputs: 5α_c = 7350 rad/s, ω_sw/10 = 6283.19 rad/s. */
+static const float SENSORLESS_INJECTION_FREQUENCY = 3141.5928f;
+
+/** 27.7451 V: V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum), thesis B (4.35).
+ *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, minimum 27.7451 V. */
+static const float SENSORLESS_INJECTION_VOLTAGE = 27.74513f;
+
+/** 5.65685 A: K_e = V_e·ΔL/(4·ω_e·L_d·L_q), thesis B (4.19).
+ *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb. */
+static const float SENSORLESS_INJECTION_GAIN = 5.656854f;
+
+/** 18.8496 rad/s: ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base), thesis B §4.3, Table 4.1.
+ *  Inputs: spec sensorless.highpass or the default. */
+static const float SENSORLESS_HIGHPASS = 18.849556f;
+
+/** 735 rad/s: ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ), thesis B Table 4.1.
+ *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_LOWPASS = 735.0f;
+
+/** 246.269 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max, thesis B (4.59), (4.69), Table 4.1.
+ *  Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 137.517 rad/s (θ̃ = 10.0°), I_max = 316.784 A. */
+static const float SENSORLESS_LOW_SPEED = 246.26897f;
+
+/** 492.538 rad/s: ω_hs = 2·ω_ls, thesis B Table 4.1.
+ *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_HIGH_SPEED = 492.53793f;
+
+/** 147 rad/s: Δω1 = ρ: γ0 = 0 below, thesis B (4.83), §4.6.
+ *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_RESET_LOWER = 147.0f;
+
+/** 294 rad/s: Δω2 = 2ρ: γ0 = ρ above, thesis B (4.83), §4.6.
+ *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_RESET_UPPER = 294.0f;
+
+/** 18.433 A: |i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed), thesis B (4.92).
+ *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, ω_max = 2513.27 rad/s. */
+static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 18.433037f;
+
+/** 315.152 A: |i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency), thesis B (4.66).
+ *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb. */
+static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 315.15152f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

@@ -401,3 +401,63 @@ pub mod field_weakening {
     /// Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum.
     pub const LOSS_MIN_MAX_INTERPOLATION_ERROR_A: f32 = 10.899656;
 }
+
+/// Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4).
+pub mod sensorless {
+    /// 147 rad/s: `ρ: estimator bandwidth, ρ ≤ α_c/10`, thesis B (4.74), Table 4.1.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const RHO: f32 = 147.0;
+    /// 21609 1/s²: `γ1 = ρ²`, thesis B (4.7).
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const GAMMA1: f32 = 21609.0;
+    /// 294 1/s: `γ2 = 2ρ`, thesis B (4.7).
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const GAMMA2: f32 = 294.0;
+    /// 3141.59 rad/s: `ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10)`, thesis B (4.34).
+    ///
+    /// Inputs: 5α_c = 7350 rad/s, ω_sw/10 = 6283.19 rad/s.
+    pub const INJECTION_FREQUENCY: f32 = 3141.5928;
+    /// 27.7451 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
+    ///
+    /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, minimum 27.7451 V.
+    pub const INJECTION_VOLTAGE: f32 = 27.74513;
+    /// 5.65685 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q)`, thesis B (4.19).
+    ///
+    /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb.
+    pub const INJECTION_GAIN: f32 = 5.656854;
+    /// 18.8496 rad/s: `ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base)`, thesis B §4.3, Table 4.1.
+    ///
+    /// Inputs: spec sensorless.highpass or the default.
+    pub const HIGHPASS: f32 = 18.849556;
+    /// 735 rad/s: `ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ)`, thesis B Table 4.1.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const LOWPASS: f32 = 735.0;
+    /// 246.269 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
+    ///
+    /// Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 137.517 rad/s (θ̃ = 10.0°), I_max = 316.784 A.
+    pub const LOW_SPEED: f32 = 246.26897;
+    /// 492.538 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const HIGH_SPEED: f32 = 492.53793;
+    /// 147 rad/s: `Δω1 = ρ: γ0 = 0 below`, thesis B (4.83), §4.6.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const RESET_LOWER: f32 = 147.0;
+    /// 294 rad/s: `Δω2 = 2ρ: γ0 = ρ above`, thesis B (4.83), §4.6.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const RESET_UPPER: f32 = 294.0;
+    /// 18.433 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
+    ///
+    /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, ω_max = 2513.27 rad/s.
+    pub const IQ_LIMIT_RESETTING_A: f32 = 18.433037;
+    /// 315.152 A: `|i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
+    ///
+    /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb.
+    pub const IQ_LIMIT_BIFURCATION_A: f32 = 315.15152;
+}

@@ -250,4 +250,62 @@ static const float FIELD_WEAKENING_MTPA_ID_A[17] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f
  *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
 static const float FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.0f;
 
+/* Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4). */
+
+/** 10 rad/s: ρ: estimator bandwidth, ρ ≤ α_c/10, thesis B (4.74), Table 4.1.
+ *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_RHO = 10.0f;
+
+/** 100 1/s²: γ1 = ρ², thesis B (4.7).
+ *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_GAMMA1 = 100.0f;
+
+/** 20 1/s: γ2 = 2ρ, thesis B (4.7).
+ *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_GAMMA2 = 20.0f;
+
+/** 0 rad/s: ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10), thesis B (4.34).
+ *  Inputs: L_q ≤ L_d: no saliency, no signal injection → 0. */
+static const float SENSORLESS_INJECTION_FREQUENCY = 0.0f;
+
+/** 0 V: V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum), thesis B (4.35).
+ *  Inputs: L_q ≤ L_d: no saliency, no signal injection → 0. */
+static const float SENSORLESS_INJECTION_VOLTAGE = 0.0f;
+
+/** 0 A: K_e = V_e·ΔL/(4·ω_e·L_d·L_q), thesis B (4.19).
+ *  Inputs: L_q ≤ L_d: no saliency, no signal injection → 0. */
+static const float SENSORLESS_INJECTION_GAIN = 0.0f;
+
+/** 0 rad/s: ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base), thesis B §4.3, Table 4.1.
+ *  Inputs: L_q ≤ L_d: no saliency, no signal injection → 0. */
+static const float SENSORLESS_HIGHPASS = 0.0f;
+
+/** 0 rad/s: ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ), thesis B Table 4.1.
+ *  Inputs: L_q ≤ L_d: no saliency, no signal injection → 0. */
+static const float SENSORLESS_LOWPASS = 0.0f;
+
+/** 2061.49 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max, thesis B (4.59), (4.69), Table 4.1.
+ *  Inputs: ω_min1 = 0 rad/s, ω_min2 = 2061.49 rad/s (θ̃ = 10.0°), I_max = 86.267 A. */
+static const float SENSORLESS_LOW_SPEED = 2061.4932f;
+
+/** 4122.99 rad/s: ω_hs = 2·ω_ls, thesis B Table 4.1.
+ *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_HIGH_SPEED = 4122.9863f;
+
+/** 10 rad/s: Δω1 = ρ: γ0 = 0 below, thesis B (4.83), §4.6.
+ *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_RESET_LOWER = 10.0f;
+
+/** 20 rad/s: Δω2 = 2ρ: γ0 = ρ above, thesis B (4.83), §4.6.
+ *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
+static const float SENSORLESS_RESET_UPPER = 20.0f;
+
+/** 0 A: |i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed), thesis B (4.92).
+ *  Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb, ω_max = 8377.58 rad/s. */
+static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 0.0f;
+
+/** 0 A: |i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency), thesis B (4.66).
+ *  Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb. */
+static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 0.0f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

@@ -266,3 +266,63 @@ pub mod field_weakening {
     /// Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10).
     pub const MTPA_MAX_INTERPOLATION_ERROR_A: f32 = 0.0;
 }
+
+/// Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4).
+pub mod sensorless {
+    /// 10 rad/s: `ρ: estimator bandwidth, ρ ≤ α_c/10`, thesis B (4.74), Table 4.1.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const RHO: f32 = 10.0;
+    /// 100 1/s²: `γ1 = ρ²`, thesis B (4.7).
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const GAMMA1: f32 = 100.0;
+    /// 20 1/s: `γ2 = 2ρ`, thesis B (4.7).
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const GAMMA2: f32 = 20.0;
+    /// 0 rad/s: `ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10)`, thesis B (4.34).
+    ///
+    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    pub const INJECTION_FREQUENCY: f32 = 0.0;
+    /// 0 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
+    ///
+    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    pub const INJECTION_VOLTAGE: f32 = 0.0;
+    /// 0 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q)`, thesis B (4.19).
+    ///
+    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    pub const INJECTION_GAIN: f32 = 0.0;
+    /// 0 rad/s: `ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base)`, thesis B §4.3, Table 4.1.
+    ///
+    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    pub const HIGHPASS: f32 = 0.0;
+    /// 0 rad/s: `ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ)`, thesis B Table 4.1.
+    ///
+    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    pub const LOWPASS: f32 = 0.0;
+    /// 2061.49 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
+    ///
+    /// Inputs: ω_min1 = 0 rad/s, ω_min2 = 2061.49 rad/s (θ̃ = 10.0°), I_max = 86.267 A.
+    pub const LOW_SPEED: f32 = 2061.4932;
+    /// 4122.99 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const HIGH_SPEED: f32 = 4122.9863;
+    /// 10 rad/s: `Δω1 = ρ: γ0 = 0 below`, thesis B (4.83), §4.6.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const RESET_LOWER: f32 = 10.0;
+    /// 20 rad/s: `Δω2 = 2ρ: γ0 = ρ above`, thesis B (4.83), §4.6.
+    ///
+    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    pub const RESET_UPPER: f32 = 20.0;
+    /// 0 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
+    ///
+    /// Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb, ω_max = 8377.58 rad/s.
+    pub const IQ_LIMIT_RESETTING_A: f32 = 0.0;
+    /// 0 A: `|i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
+    ///
+    /// Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb.
+    pub const IQ_LIMIT_BIFURCATION_A: f32 = 0.0;
+}

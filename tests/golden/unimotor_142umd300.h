@@ -234,4 +234,62 @@ static const float FIELD_WEAKENING_MTPA_IQ_A[1] = {0.0f};
  *  Inputs: ψ_M unknown → 0 (field weakening off). */
 static const float FIELD_WEAKENING_MTPA_ID_A[1] = {0.0f};
 
+/* Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4). */
+
+/** 0 rad/s: ρ: estimator bandwidth, ρ ≤ α_c/10, thesis B (4.74), Table 4.1.
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_RHO = 0.0f;
+
+/** 0 1/s²: γ1 = ρ², thesis B (4.7).
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_GAMMA1 = 0.0f;
+
+/** 0 1/s: γ2 = 2ρ, thesis B (4.7).
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_GAMMA2 = 0.0f;
+
+/** 0 rad/s: ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10), thesis B (4.34).
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_INJECTION_FREQUENCY = 0.0f;
+
+/** 0 V: V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum), thesis B (4.35).
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_INJECTION_VOLTAGE = 0.0f;
+
+/** 0 A: K_e = V_e·ΔL/(4·ω_e·L_d·L_q), thesis B (4.19).
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_INJECTION_GAIN = 0.0f;
+
+/** 0 rad/s: ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base), thesis B §4.3, Table 4.1.
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_HIGHPASS = 0.0f;
+
+/** 0 rad/s: ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ), thesis B Table 4.1.
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_LOWPASS = 0.0f;
+
+/** 0 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max, thesis B (4.59), (4.69), Table 4.1.
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_LOW_SPEED = 0.0f;
+
+/** 0 rad/s: ω_hs = 2·ω_ls, thesis B Table 4.1.
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_HIGH_SPEED = 0.0f;
+
+/** 0 rad/s: Δω1 = ρ: γ0 = 0 below, thesis B (4.83), §4.6.
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_RESET_LOWER = 0.0f;
+
+/** 0 rad/s: Δω2 = 2ρ: γ0 = ρ above, thesis B (4.83), §4.6.
+ *  Inputs: ψ_M unknown → 0 (sensorless off). */
+static const float SENSORLESS_RESET_UPPER = 0.0f;
+
+/** 0 A: |i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed), thesis B (4.92).
+ *  Inputs: L_d = 0.0054 H, L_q = 0.0076 H, ψ_M = 0 Wb, ω_max = 1570.8 rad/s. */
+static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 0.0f;
+
+/** 0 A: |i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency), thesis B (4.66).
+ *  Inputs: L_d = 0.0054 H, L_q = 0.0076 H, ψ_M = 0 Wb. */
+static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 0.0f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

@@ -380,8 +380,10 @@ fn sensorless_design(
             p.span.clone(),
             &p.key,
             format!(
-                "the estimator bandwidth ρ = {:.1} rad/s exceeds α_c/10 = {:.1} rad/s (thesis B Table 4.1): the current loop would not follow the estimated frame",
-                out.rho_rad_s, out.rho_max_rad_s
+                "the estimator bandwidth ρ = {:.1} rad/s{} exceeds α_c/10 = {:.1} rad/s (thesis B Table 4.1): the current loop would not follow the estimated frame",
+                out.rho_rad_s,
+                if s.bandwidth.is_some() { "" } else { " = √(n_p·|ω̇_m|max/sin θ̃max) (thesis B (4.74))" },
+                out.rho_max_rad_s
             ),
             accepted,
         )));

@@ -4,12 +4,11 @@
 //! simulated motor; the estimate starts 5ρ too fast (Fig. 4.17: the rotor drops from 1 to
 //! 0.5 pu with ρ = 0.1 pu). Cycle slips are counted with and without the resetting term.
 //!
-//! # Where the constants come from (provisional)
+//! # Where the constants come from
 //!
-//! [`estimator_config`] computes the estimator's constants here from the thesis
-//! formulas and the design's motor data, because the design rules for them are not part
-//! of [`Design`] yet. When the design carries them, replace the body of
-//! [`estimator_config`] (and only it) with the design's values.
+//! [`estimator_config`] takes them from the design (`Design::sensorless`, the thesis B
+//! chapter 4 rules of [`crate::design::sensorless`]), as the firmware's generated
+//! constants do.
 //!
 //! [`ControllerConfig::process_at_angle`]: motor_control::step::ControllerConfig::process_at_angle
 
@@ -27,71 +26,40 @@ use super::sim::{Bench, angle_q31};
 use super::{Check, ScenarioResult, Series, Setup, format_value};
 use crate::design::Design;
 
-/// ρ/α_c: Table 4.1 (ρ ≤ α_c/10) at its bound, as in Figs. 4.17, 4.18 (ρ = α_c/10).
-pub const RHO_FRACTION: f64 = 0.1;
 /// Initial speed error in units of ρ: Fig. 4.17's 0.5 pu drop at ρ = 0.1 pu.
 pub const INITIAL_ERROR_RHO: f64 = 5.0;
-/// Allowed transient angle error θ̃ for ω_min2 (4.69): 10° (thesis B §4.4.2).
-pub const ANGLE_ERROR_RAD: f64 = 10.0 * PI / 180.0;
 /// Samples between the carrier phase of a step and the current the estimator
 /// demodulates with it: the voltage acts 1.5 periods later (thesis A §4.6) and the
 /// estimator reads the previous period's current, 1 more.
 pub const CARRIER_DELAY_SAMPLES: f64 = 2.5;
 
-/// The estimator constants for `d`, or `None` when ψ_M is unknown:
-///
-/// * ρ = α_c/10 (Table 4.1, the choice of Figs. 4.17, 4.18); γ1 = ρ², γ2 = 2ρ (4.7)
-///   are formed by the firmware;
-/// * R̂, L̂_d, L̂_q, ψ̂_M: the design's motor values;
-/// * resetting term Δω1 = ρ, Δω2 = 2ρ (§4.6), ω_max = ω_e,max for (4.92);
-/// * injection only for a salient motor (ΔL = L_q − L_d > 0):
-///   ω_e = 5α_c (4.34), lowered to ω_sw/10 when 5α_c exceeds it (the thesis's own
-///   remedy, footnote 5); V_e = I_base·ω_e·L_d·L_q/(10·ΔL) (4.35) with I_base = √2·I_n
-///   (App. A) or the peak current; K_e = V_e·ΔL/(4ω_e·L_d·L_q) (4.19);
-///   ω_hp = 2π·3 Hz ("a few Hertz", §4.5.1: 0.015 pu), ω_lp = 5ρ (Table 4.1);
-///   ω_ls = max(ω_min1, ω_min2) with ω_min1 = 5ρ·ΔL·I_max/(3ψ_M) (4.59) and
-///   ω_min2 = |R̃·i_d/(θ̃·(ψ_M − ΔL·i_d))| (4.69) at R̃ = 2R, i_d = −I_max, θ̃ = 10°;
-///   ω_hs = 2ω_ls (Table 4.1).
-///
-/// PROVISIONAL: the lead replaces this body with the design rules' values when they
-/// are merged (ρ (4.74), ω_e, V_e, K_e, filters, ω_ls/ω_hs, Δω1, Δω2).
+/// The estimator constants of the design (`d.sensorless`, thesis B chapter 4 rules in
+/// [`crate::design::sensorless`]), or `None` when ψ_M is unknown. R̂, L̂_d, L̂_q, ψ̂_M
+/// are the design's motor values; ω_max of (4.92) is ω_e,max; the injection's `delay`
+/// is the firmware's timing ([`CARRIER_DELAY_SAMPLES`]).
 pub fn estimator_config(d: &Design) -> Option<EstimatorConfig> {
     let m = &d.motor;
-    let psi = m.flux_linkage_wb.filter(|p| *p > 0.0)?;
-    let (r, ld, lq) = (m.phase_resistance_ohm, m.d_inductance_h, m.q_inductance_h);
-    let alpha = d.current_loop.bandwidth_rad_s;
-    let rho = RHO_FRACTION * alpha;
-    let dl = lq - ld;
-    let i_max = m.peak_current_a;
-    let injection = (dl > 0.0).then(|| {
-        let w_sw = 2.0 * PI * d.drive.switching_frequency_hz;
-        let we = (5.0 * alpha).min(w_sw / 10.0);
-        let i_base = d.per_unit.as_ref().map_or(i_max, |p| p.bases.current_a);
-        let ve = i_base * we * ld * lq / (10.0 * dl);
-        let w_min1 = 5.0 * rho * dl * i_max / (3.0 * psi);
-        let w_min2 = (2.0 * r * i_max / (ANGLE_ERROR_RAD * (psi + dl * i_max))).abs();
-        let ls = w_min1.max(w_min2);
-        InjectionConfig {
-            amplitude: ve as f32,
-            frequency: we as f32,
-            gain: (ve * dl / (4.0 * we * ld * lq)) as f32,
-            highpass: (2.0 * PI * 3.0) as f32,
-            lowpass: (5.0 * rho) as f32,
-            delay: CARRIER_DELAY_SAMPLES as f32,
-            low_speed: ls as f32,
-            high_speed: (2.0 * ls) as f32,
-        }
+    let s = d.sensorless.as_ref()?;
+    let injection = s.injection.as_ref().map(|inj| InjectionConfig {
+        amplitude: inj.voltage_v as f32,
+        frequency: inj.frequency_rad_s as f32,
+        gain: inj.gain_ke_a as f32,
+        highpass: inj.highpass_rad_s as f32,
+        lowpass: inj.lowpass_rad_s as f32,
+        delay: CARRIER_DELAY_SAMPLES as f32,
+        low_speed: s.omega_ls_rad_s as f32,
+        high_speed: s.omega_hs_rad_s as f32,
     });
     Some(EstimatorConfig {
         sample_period: d.drive.sample_period_s as f32,
-        rho: rho as f32,
-        rs: r as f32,
-        ld: ld as f32,
-        lq: lq as f32,
-        psi_m: psi as f32,
+        rho: s.rho_rad_s as f32,
+        rs: m.phase_resistance_ohm as f32,
+        ld: m.d_inductance_h as f32,
+        lq: m.q_inductance_h as f32,
+        psi_m: m.flux_linkage_wb? as f32,
         resetting: Some(ResettingConfig {
-            lower: rho as f32,
-            upper: (2.0 * rho) as f32,
+            lower: s.resetting_lower_rad_s as f32,
+            upper: s.resetting_upper_rad_s as f32,
             speed_max: m.max_electrical_speed_rad_s as f32,
         }),
         injection,
@@ -226,8 +194,10 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
     let d = s.design;
     let rho = f64::from(c.rho);
     let w = test_speed(d, c);
-    // Time scale from the designed ρ = α_c/10 (not the config under test).
-    let seconds = 60.0 / (RHO_FRACTION * d.current_loop.bandwidth_rad_s);
+    // Time scale from the designed ρ (not the config under test).
+    let designed_rho = d.sensorless.as_ref().map_or(rho, |s| s.rho_rad_s);
+    let seconds = 60.0 / designed_rho;
+    let angle_limit = d.sensorless.as_ref().map_or(10f64.to_radians(), |s| s.angle_error_rad);
     let with = simulate(s, c, w, seconds);
     let plain_cfg = EstimatorConfig { resetting: None, ..*c };
     let without = simulate(s, &plain_cfg, w, seconds);
@@ -260,8 +230,11 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
             measured: final_err.to_degrees(),
             designed: Some(0.0),
             unit: "°",
-            criterion: "≤ 10° (thesis B §4.5.1)".into(),
-            pass: final_err <= ANGLE_ERROR_RAD,
+            criterion: format!(
+                "≤ θ̃max = {:.0}° (sensorless.max_angle_error, thesis B §4.4.2)",
+                angle_limit.to_degrees()
+            ),
+            pass: final_err <= angle_limit,
         },
     ];
     let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<_>>();
