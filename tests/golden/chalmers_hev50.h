@@ -320,4 +320,8 @@ static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 18.433037f;
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb. */
 static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 315.15152f;
 
+/** 0.0079 Ω: R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI), thesis B (4.51).
+ *  Inputs: phase resistance (spec). */
+static const float SENSORLESS_RS = 0.0079f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

@@ -308,4 +308,8 @@ static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 0.0f;
  *  Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb. */
 static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 0.0f;
 
+/** 0.126 Ω: R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI), thesis B (4.51).
+ *  Inputs: phase resistance (spec). */
+static const float SENSORLESS_RS = 0.126f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

@@ -325,4 +325,8 @@ pub mod sensorless {
     ///
     /// Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb.
     pub const IQ_LIMIT_BIFURCATION_A: f32 = 0.0;
+    /// 0.126 Ω: `R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI)`, thesis B (4.51).
+    ///
+    /// Inputs: phase resistance (spec).
+    pub const RS: f32 = 0.126;
 }

@@ -292,4 +292,8 @@ static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 0.0f;
  *  Inputs: L_d = 0.0054 H, L_q = 0.0076 H, ψ_M = 0 Wb. */
 static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 0.0f;
 
+/** 0.65 Ω: R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI), thesis B (4.51).
+ *  Inputs: phase resistance (spec). */
+static const float SENSORLESS_RS = 0.65f;
+
 #endif /* MOTORGEN_MOTOR_CONSTANTS_H */

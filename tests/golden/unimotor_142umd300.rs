@@ -303,4 +303,8 @@ pub mod sensorless {
     ///
     /// Inputs: L_d = 0.0054 H, L_q = 0.0076 H, ψ_M = 0 Wb.
     pub const IQ_LIMIT_BIFURCATION_A: f32 = 0.0;
+    /// 0.65 Ω: `R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI)`, thesis B (4.51).
+    ///
+    /// Inputs: phase resistance (spec).
+    pub const RS: f32 = 0.65;
 }

@@ -189,7 +189,7 @@ pub fn group(d: &Design) -> Group {
             "iq_limit_bifurcation_a",
         ),
     ];
-    let constants: Vec<Constant> = rows
+    let mut constants: Vec<Constant> = rows
         .into_iter()
         .map(|(name, v, unit, formula, eq, inputs, field)| {
             // JSON null (sensorless off, no injection) reads as 0: point at the null.
@@ -201,6 +201,17 @@ pub fn group(d: &Design) -> Group {
             c(name, f32v(v), phys(v, unit), formula, eq, inputs).at(path)
         })
         .collect();
+    constants.push(
+        c(
+            "RS",
+            f32v(m.phase_resistance_ohm),
+            phys(m.phase_resistance_ohm, "Ω"),
+            "R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI)",
+            "thesis B (4.51)",
+            "phase resistance (spec)".into(),
+        )
+        .at("/motor/phase_resistance_ohm"),
+    );
     Group {
         name: "sensorless",
         title,

@@ -7,6 +7,7 @@ use motor_control::ControllerConfig;
 use motor_control::adc::{CurrentSense, DcLinkSense, MeasuredPhases};
 use motor_control::angle::ResolverToElectrical;
 use motor_control::ato::AtoConfig;
+use motor_control::estimator::{EstimatorConfig, InjectionConfig, ResettingConfig};
 use motor_control::feedforward::FeedForwardConfig;
 use motor_control::field_weakening::{FieldWeakeningConfig, MtpaCurve};
 use motor_control::fir::FmacFir;
@@ -15,7 +16,7 @@ use motor_control::setpoint::SetpointConfig;
 
 use crate::design;
 use crate::hw;
-use crate::motor::{current_loop as cl, field_weakening as fw, filter, limits, observer, scaling};
+use crate::motor::{current_loop as cl, field_weakening as fw, filter, limits, observer, scaling, sensorless as sl};
 use crate::timing;
 
 /// TIM1 auto-reload: centre-aligned carrier at f_s from the 170 MHz timer clock
@@ -108,6 +109,38 @@ pub const FIELD_WEAKENING: FieldWeakeningConfig = FieldWeakeningConfig {
     voltage_fraction: fw::VOLTAGE_FRACTION,
     current_max: fw::CURRENT_MAX_A,
     mtpa: MtpaCurve::Table(&MTPA_TABLE),
+};
+
+/// The sensorless estimator of thesis B chapter 4, every field a generated constant
+/// (`motor::sensorless`: ρ, Δω1, Δω2, ω_e, V_e, K_e, ω_hp, ω_lp, ω_ls, ω_hs; R̂_s, L̂_d,
+/// L̂_q, ψ̂_m) and the firmware's carrier delay. Signal injection only for a salient
+/// motor (generated K_e > 0); with ψ_M unknown the generated ρ is 0 (estimator off).
+pub const ESTIMATOR: EstimatorConfig = EstimatorConfig {
+    sample_period: limits::SAMPLE_PERIOD_S,
+    rho: sl::RHO,
+    rs: sl::RS,
+    ld: cl::FF_LD,
+    lq: cl::FF_LQ,
+    psi_m: cl::FF_PSI,
+    resetting: Some(ResettingConfig {
+        lower: sl::RESET_LOWER,
+        upper: sl::RESET_UPPER,
+        speed_max: limits::MAX_ELECTRICAL_SPEED,
+    }),
+    injection: if sl::INJECTION_GAIN > 0.0 {
+        Some(InjectionConfig {
+            amplitude: sl::INJECTION_VOLTAGE,
+            frequency: sl::INJECTION_FREQUENCY,
+            gain: sl::INJECTION_GAIN,
+            highpass: sl::HIGHPASS,
+            lowpass: sl::LOWPASS,
+            delay: hw::CARRIER_DELAY_PERIODS,
+            low_speed: sl::LOW_SPEED,
+            high_speed: sl::HIGH_SPEED,
+        })
+    } else {
+        None
+    },
 };
 
 /// Milliseconds per second.
@@ -270,6 +303,26 @@ mod tests {
         {
             assert_eq!(c.mtpa.id(*iq), id);
             assert_eq!(c.mtpa.id(-*iq), id);
+        }
+    }
+
+    /// The estimator is the generated constants (thesis B (4.7), (4.83), (4.19)); the
+    /// injection exists exactly when the motor is salient (L_q > L_d).
+    #[test]
+    fn estimator_is_the_generated_constants() {
+        let e = ESTIMATOR;
+        assert_eq!(e.rho, motor::sensorless::RHO);
+        assert_eq!(
+            e.resetting.map(|r| (r.lower, r.upper)),
+            Some((motor::sensorless::RESET_LOWER, motor::sensorless::RESET_UPPER))
+        );
+        assert_eq!(
+            e.injection.is_some(),
+            motor::current_loop::FF_LQ > motor::current_loop::FF_LD && motor::sensorless::RHO > 0.0
+        );
+        if let Some(i) = e.injection {
+            assert_eq!(i.gain, motor::sensorless::INJECTION_GAIN);
+            assert_eq!(i.high_speed, 2.0 * i.low_speed);
         }
     }
 

@@ -85,3 +85,9 @@ pub const ADC_SLAVE_POLLS: u32 = 16;
 /// CORDIC start-up check tolerance against the software reference \[LSB of Q1.31\]:
 /// 2^13 ≈ 3.8·10⁻⁶, above the 24-iteration residual error (order 2^-19 = 2^12 LSB).
 pub const CORDIC_TOLERANCE_LSB: u32 = 1 << 13;
+
+/// Control periods from the carrier phase of a step to the current the sensorless
+/// estimator demodulates with it: the voltage acts 1.5 periods after the sample it was
+/// computed from (thesis A §4.6) and the estimator reads the previous period's current,
+/// one more. A property of this firmware's timing, not of the motor.
+pub const CARRIER_DELAY_PERIODS: f32 = 2.5;
