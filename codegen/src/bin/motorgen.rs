@@ -1,5 +1,7 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
+#[path = "motorgen/identify.rs"]
+mod identify;
 #[path = "motorgen/report.rs"]
 mod report;
 #[path = "motorgen/verify.rs"]
@@ -73,6 +75,12 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Identify R, L, ψ_M or the resolver offset from recorded commissioning runs
+    /// (thesis A chapter 6) and write them into the spec's [motor.identified].
+    Identify {
+        #[command(subcommand)]
+        what: identify::What,
     },
     /// List the motors in a directory (default: motors/).
     List {
@@ -317,6 +325,7 @@ fn main() -> ExitCode {
         }
         Command::Verify { spec } => verify::run(&spec),
         Command::Report { spec, out } => report::run(&spec, &out),
+        Command::Identify { what } => identify::run(what),
         Command::List { dir } => {
             let dir = motors_dir(dir);
             let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {
