@@ -446,3 +446,132 @@ fn bad_recordings_are_located_errors() {
         &["NaN", "current_a"],
     );
 }
+
+/// `identify flux` on the Fischer spec: runs at ω_e = 800 and 1200 rad/s whose u_q holds
+/// ω_e·ψ_M for ψ_M = 60.0 mWb plus the R·i_q and ω_e·L_d·i_d terms of small residual
+/// currents (steady-state (6.1)); the command writes flux_linkage = "60.00 mWb", which
+/// the design then takes over the datasheet's K_e-derived value.
+#[test]
+fn flux_round_trip() {
+    let dir = tmp("flux");
+    let spec = dir.join("fischer.toml");
+    std::fs::copy(repo().join("motors/fischer-ti085.toml"), &spec).unwrap();
+    let mut files = vec![];
+    for (k, w) in [800.0f64, 1200.0].into_iter().enumerate() {
+        let mut s = String::from("# motorgen recording: flux\nsample,omega_e_rad_s,u_q_v,i_d_a,i_q_a\n");
+        for n in 0..200 {
+            let (id, iq) = (0.05 * (n as f64 * 0.1).sin(), 0.08 * (n as f64 * 0.07).cos());
+            let uq = w * 0.060 + 0.126 * iq + w * 0.393e-3 * id;
+            s.push_str(&format!("{n},{w},{uq},{id},{iq}\n"));
+        }
+        let f = dir.join(format!("flux{k}.csv"));
+        std::fs::write(&f, s).unwrap();
+        files.push(f.display().to_string());
+    }
+    let spec_s = spec.display().to_string();
+    let out = motorgen(&[
+        "identify",
+        "flux",
+        &spec_s,
+        "--date",
+        "2025-03-14",
+        "--csv",
+        &files[0],
+        &files[1],
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let updated = std::fs::read_to_string(&spec).unwrap();
+    assert!(updated.contains("flux_linkage = \"60.00 mWb\""), "{updated}");
+    let out = motorgen(&["design", &spec_s, "--format", "json"]);
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["motor"]["provenance"]["flux_linkage"]["source"], "identified");
+    assert!((json["motor"]["flux_linkage_wb"].as_f64().unwrap() - 0.060).abs() < 1e-12);
+}
+
+/// `identify resolver` on the Fischer spec (n_p = 4, n_r = 1): a rotation run with the
+/// resolver turning a quarter as far as the field checks the ratio; an alignment run
+/// at θ_r = 2.0 rad gives θ_off = 2.0 − π/2 = 0.42920 rad (6.9, modulo 2π·n_r/n_p). A
+/// run with the resolver turning backwards, or half as far (ratio 2), is refused at
+/// `motor.pole_pairs` and nothing is written.
+#[test]
+fn resolver_round_trip_and_ratio_check() {
+    use std::f64::consts::{PI, TAU};
+    let wrap = |x: f64| x - TAU * ((x + PI) / TAU).floor();
+    let dir = tmp("resolver");
+    let spec = dir.join("fischer.toml");
+    std::fs::copy(repo().join("motors/fischer-ti085.toml"), &spec).unwrap();
+    let original = std::fs::read_to_string(&spec).unwrap();
+    let rotation = |name: &str, per_turn: f64| {
+        let mut s = String::from("# motorgen recording: pole_pair_ratio\nsample,theta_e_rad,theta_r_rad\n");
+        for n in 0..=1000 {
+            let e = TAU * 8.0 * n as f64 / 1000.0;
+            s.push_str(&format!("{n},{},{}\n", wrap(e), wrap(0.7 + e * per_turn)));
+        }
+        let f = dir.join(name);
+        std::fs::write(&f, s).unwrap();
+        f.display().to_string()
+    };
+    let mut s = String::from("# motorgen recording: resolver_offset\nsample,u_alpha_v,theta_r_rad\n");
+    for n in 0..400 {
+        let u = (n as f64 / 100.0).min(1.0);
+        let th = if n < 200 { 1.0 } else { 2.0 + 1e-4 * (n as f64).sin() };
+        s.push_str(&format!("{n},{u},{th}\n"));
+    }
+    let offset = dir.join("align.csv");
+    std::fs::write(&offset, s).unwrap();
+    let (spec_s, offset_s) = (spec.display().to_string(), offset.display().to_string());
+
+    for (name, per_turn, words) in [
+        ("backwards.csv", -0.25, "turns against the stator field"),
+        ("half.csv", 0.5, "disagrees with the spec's 4/1"),
+    ] {
+        let f = rotation(name, per_turn);
+        let out = motorgen(&["identify", "resolver", &spec_s, "--ratio", &f, "--offset", &offset_s]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success());
+        assert!(err.contains(words) && err.contains("`motor.pole_pairs`"), "{err}");
+        // The line of `[motor]`'s `pole_pairs = 4`, column of its value.
+        let line = original[..original.find("pole_pairs = 4").unwrap()]
+            .matches('\n')
+            .count()
+            + 1;
+        assert!(err.contains(&format!("{spec_s}:{line}:14")), "{err}");
+        assert_eq!(std::fs::read_to_string(&spec).unwrap(), original);
+    }
+    let good = rotation("good.csv", 0.25);
+    let out = motorgen(&[
+        "identify",
+        "resolver",
+        &spec_s,
+        "--date",
+        "2025-03-14",
+        "--ratio",
+        &good,
+        "--offset",
+        &offset_s,
+    ]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
+    assert!(stdout.contains("n_p/n_r = 4.0000"), "{stdout}");
+    let updated = std::fs::read_to_string(&spec).unwrap();
+    assert!(updated.contains("resolver_offset = \"0.42920 rad\""), "{updated}");
+    let out = motorgen(&["design", &spec_s, "--format", "json"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+}
+
+/// The merge rule: one identified axis next to the datasheet's other axis is accepted;
+/// alone (no datasheet inductance for the other axis) it is still an error.
+#[test]
+fn one_identified_axis_needs_the_other_from_the_datasheet() {
+    let text = std::fs::read_to_string(repo().join("motors/fischer-ti085.toml")).unwrap();
+    let with = text.replace(
+        "[motor.datasheet]",
+        "[motor.identified]\nq_inductance = \"0.41 mH\"\n\n[motor.datasheet]",
+    );
+    let d = codegen::design_source("f.toml", &with).unwrap();
+    assert_eq!(d.motor.q_inductance_h, 0.41e-3);
+    assert_eq!(d.motor.d_inductance_h, 0.393e-3);
+    let without = with.replace("inductance = \"0.393 mH\"", "");
+    let err = codegen::design_source("f.toml", &without).unwrap_err().to_string();
+    assert!(err.contains("`q_inductance` is given without `d_inductance`"), "{err}");
+}
