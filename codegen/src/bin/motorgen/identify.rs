@@ -187,6 +187,13 @@ fn names(files: &[PathBuf]) -> Vec<String> {
         .collect()
 }
 
+/// The file name without its directory, for the result tables.
+fn short(file: &str) -> String {
+    Path::new(file)
+        .file_name()
+        .map_or_else(|| file.to_string(), |n| n.to_string_lossy().into_owned())
+}
+
 fn spread_note(label: &str, s: &Spread) -> String {
     if s.count > 1 {
         format!(
@@ -298,13 +305,13 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         recs[0].sample_period_s * 1e6
     );
     println!(
-        "  {:<28} {:>8} {:>10} {:>10} {:>10} {:>12} {:>12}",
+        "  {:<20} {:>8} {:>10} {:>10} {:>10} {:>12} {:>12}",
         "recording", "U [V]", "R [Ω]", "τ [ms]", "L [mH]", "t_5% [T_s]", "T_d [T_s]"
     );
     for (r, e) in recs.iter().zip(&estimates) {
         println!(
-            "  {:<28} {:>8.3} {:>10.5} {:>10.4} {:>10.5} {:>12.2} {:>12.2}",
-            r.file,
+            "  {:<20} {:>8.3} {:>10.5} {:>10.4} {:>10.5} {:>12.2} {:>12.2}",
+            short(&r.file),
             e.voltage_v,
             e.resistance_ohm,
             e.time_constant_s * 1e3,
@@ -378,8 +385,11 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnos
         match flux::identify_flux(r, &setup) {
             Ok(e) => {
                 println!(
-                    "  {:<28} ω_e = {:>9.1} rad/s  ψ_M = {:.5} Wb (current correction {:+.2e} Wb)",
-                    r.file, e.mean_speed_rad_s, e.flux_linkage_wb, -e.correction_wb
+                    "  {:<20} ω_e = {:>9.1} rad/s  ψ_M = {:.5} Wb (current correction {:+.2e} Wb)",
+                    short(&r.file),
+                    e.mean_speed_rad_s,
+                    e.flux_linkage_wb,
+                    -e.correction_wb
                 );
                 values.push(e.flux_linkage_wb);
             }
@@ -435,8 +445,8 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         match resolver::identify_ratio(r) {
             Ok(e) => {
                 println!(
-                    "  {:<28} n_p/n_r = {:.4}, directions {}",
-                    r.file,
+                    "  {:<20} n_p/n_r = {:.4}, directions {}",
+                    short(&r.file),
                     e.ratio,
                     if e.directions_agree { "agree" } else { "DISAGREE" }
                 );
@@ -496,8 +506,11 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         match resolver::identify_offset(r, np, nr) {
             Ok(e) => {
                 println!(
-                    "  {:<28} θ_off = {:.5} rad (θ_r within ±{:.5} rad over {} rows)",
-                    r.file, e.offset_rad, e.deviation_rad, e.rows
+                    "  {:<20} θ_off = {:.5} rad (θ_r within ±{:.5} rad over {} rows)",
+                    short(&r.file),
+                    e.offset_rad,
+                    e.deviation_rad,
+                    e.rows
                 );
                 offsets.push(e.offset_rad);
             }
