@@ -359,6 +359,64 @@ mod tests {
         assert!((e.crossing_5_samples - 13.5).abs() < 0.3, "{e:?}");
     }
 
+    /// A capture decimated by 2 (`VoltageStep::decimation = 2`: rows 0, 2, 4, …) is
+    /// filtered at the capture rate; T_r and the delay are still counted in periods:
+    /// R and L within 0.5 %, the 1.5-period delay within one period.
+    #[test]
+    fn decimated_capture() {
+        let full = ideal(4.0, 0.65, 7.6e-3, 1.5, 40, 40 + 12 * 234);
+        let mut lines = full.lines();
+        let mut text = format!("{}\n{}\n", lines.next().unwrap(), lines.next().unwrap());
+        for (k, l) in lines.enumerate() {
+            if k % 2 == 0 {
+                text.push_str(l);
+                text.push('\n');
+            }
+        }
+        let rec = recording::parse("q.csv", &text, RecordingKind::Step, 50e-6).unwrap();
+        assert_eq!(rec.spacing, 2.0);
+        let e = identify_step(&rec, &setup()).unwrap();
+        assert!((e.resistance_ohm / 0.65 - 1.0).abs() < 5e-3, "{e:?}");
+        assert!((e.inductance_h / 7.6e-3 - 1.0).abs() < 5e-3, "{e:?}");
+        assert!((e.delay_samples - 1.5).abs() < 1.0, "{e:?}");
+    }
+
+    /// `# axis = d` in the file but `--axis q`: refused at the header value.
+    #[test]
+    fn axis_mismatch_is_rejected() {
+        let text = format!("# axis = d\n{}", ideal(4.0, 0.65, 7.6e-3, 1.5, 40, 40 + 12 * 234));
+        let rec = recording::parse("q.csv", &text, RecordingKind::Step, 50e-6).unwrap();
+        let e = identify_step(&rec, &setup()).unwrap_err().0[0].clone();
+        assert_eq!((e.line, e.column, e.key.as_str()), (1, 10, "axis"));
+    }
+
+    /// Zero-padding to the FMAC's 127 taps is exact: the output equals the firmware's
+    /// `FmacFir<21>` with the same taps and preload, and the design's slice model
+    /// (`design::fir::fmac_fir_output`), sample for sample.
+    #[test]
+    fn padded_filter_is_bit_exact() {
+        let xs: Vec<f64> = (0..300)
+            .map(|n| 5.0 * ((n as f64) * 0.37).sin() + 0.01 * n as f64)
+            .collect();
+        let fs = 16.0;
+        let y = fmac_filter(&xs, &TAPS, fs);
+        let q = |i: f64| (i / fs * 32768.0).round().clamp(-32768.0, 32767.0) as i16;
+        let fir = FmacFir::new(TAPS);
+        let mut st = FirState::<21>::new();
+        let mut window: Vec<i16> = vec![q(xs[0]); 21];
+        for _ in 0..21 {
+            fir.process(&mut st, q(xs[0]));
+        }
+        for (k, &x) in xs.iter().enumerate() {
+            let direct = fir.process(&mut st, q(x));
+            window.remove(0);
+            window.push(q(x));
+            let model = crate::design::fir::fmac_fir_output(&TAPS, &window);
+            assert_eq!(y[k], f64::from(direct) / 32768.0 * fs, "sample {k}");
+            assert_eq!(direct, model, "sample {k}");
+        }
+    }
+
     /// A constant input equal to the preload passes the unity-DC-gain filter
     /// unchanged up to the FMAC's truncation (< 1.2 LSB low, see design::fir).
     #[test]
