@@ -71,6 +71,21 @@ pub fn radians(theta: f64) -> String {
     format!("{theta:.5} rad")
 }
 
+/// The date `YYYY-MM-DD` of day `days` since 1970-01-01 in the proleptic Gregorian
+/// calendar (civil-from-days: 400-year eras of 146 097 days, years starting in March).
+pub fn date_from_unix_days(days: i64) -> String {
+    let z = days + 719_468;
+    let era = z.div_euclid(146_097);
+    let doe = z - era * 146_097;
+    let yoe = (doe - doe / 1460 + doe / 36_524 - doe / 146_096) / 365;
+    let doy = doe - (365 * yoe + yoe / 4 - yoe / 100);
+    let mp = (5 * doy + 2) / 153;
+    let day = doy - (153 * mp + 2) / 5 + 1;
+    let month = if mp < 10 { mp + 3 } else { mp - 9 };
+    let year = yoe + era * 400 + i64::from(month <= 2);
+    format!("{year:04}-{month:02}-{day:02}")
+}
+
 /// The spec text with `entries` written into `[motor.identified]` and the origin noted.
 /// Errors (as text) if the file is not TOML or `[motor]` is not a table.
 pub fn apply(text: &str, entries: &[Entry], origin: &Origin<'_>) -> Result<String, String> {
@@ -260,6 +275,15 @@ mod tests {
         assert!(!out.contains("\ninductance ="), "{out}");
         assert!(out.contains("source = \"flux: f.csv; step q: new.csv\""), "{out}");
         assert!(out.ends_with("\n[resolver]\npole_pairs = 1\n"), "{out}");
+    }
+
+    /// Day counts from Python's `date.fromisoformat(s) - date(1970, 1, 1)`.
+    #[test]
+    fn dates_from_day_counts() {
+        assert_eq!(date_from_unix_days(0), "1970-01-01");
+        assert_eq!(date_from_unix_days(10_956), "1999-12-31");
+        assert_eq!(date_from_unix_days(11_017), "2000-03-01");
+        assert_eq!(date_from_unix_days(19_782), "2024-02-29");
     }
 
     #[test]
