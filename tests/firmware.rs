@@ -26,7 +26,7 @@ fn cargo_in_firmware(args: &[&str], target_dir: &str) {
 
 #[test]
 fn firmware_control_core_host_tests_pass() {
-    cargo_in_firmware(&["test", "--locked"], "firmware-host");
+    cargo_in_firmware(&["test", "--locked", "--workspace"], "firmware-host");
 }
 
 #[test]

@@ -6,7 +6,7 @@ use std::path::{Path, PathBuf};
 
 use codegen::constants::{Constant, constants};
 use codegen::design::Design;
-use codegen::verify::{SCENARIOS, Setup, Verification, controller::controller_config, verify};
+use codegen::verify::{Scenario, Setup, Verification, controller::controller_config, verify};
 use codegen::{Source, design, spec};
 
 fn motors() -> Vec<PathBuf> {
@@ -52,7 +52,7 @@ fn every_seed_motor_passes_its_scenarios() {
         let (s, d) = load(&path);
         let v = run(&s, &d);
         let ids: Vec<&str> = v.scenarios.iter().map(|x| x.id).collect();
-        let want: Vec<&str> = SCENARIOS.iter().map(|x| x.id).collect();
+        let want: Vec<&str> = Scenario::applicable(&Setup::new(&s, &d)).iter().map(|x| x.id).collect();
         assert_eq!(ids, want, "{name}");
         println!("{}", v.table());
         for sc in &v.scenarios {
@@ -163,6 +163,69 @@ fn mis_scaled_observer_gain_fails_the_ramp() {
     let c = check(&v, "ato_ramp", "angle lag during the ramp");
     assert!(!c.pass, "{c:?}");
     assert!((c.measured - 23.58).abs() < 1.0, "{c:?}");
+}
+
+/// Field weakening with γ = 0 (α_fw = 0 in (2.60)): i_d^ref stays on the MTPA curve, the
+/// back EMF above base speed drives the current loop into the voltage circle V_max, and
+/// the peak |v| check (never past (V'_max + V_max)/2) fails, as does |v| = V'_max at the
+/// top speed. The working controller passes both (every seed motor it applies to).
+#[test]
+fn field_weakening_without_gain_exceeds_the_voltage_margin() {
+    use codegen::verify::field_weakening::{field_weakening_config, run as fw_run};
+    for stem in ["chalmers-hev50", "fischer-ti085"] {
+        let (s, d) = load(&motor(stem));
+        let setup = Setup::new(&s, &d);
+        let good = field_weakening_config(&d).unwrap();
+        let broken = codegen::verify::field_weakening::FieldWeakeningConfig { bandwidth: 0.0, ..good };
+        let r = fw_run(&setup, Some(broken));
+        let peak = r.checks.iter().find(|c| c.quantity.starts_with("peak |v|")).unwrap();
+        assert!(!peak.pass, "{stem}: {peak:?}");
+        // The current loop saturates: |v| reaches V_max = U_dc/√3 (to f32 rounding).
+        assert!(
+            (peak.measured / d.current_loop.voltage_limit_v - 1.0).abs() < 1e-3,
+            "{stem}: {peak:?}"
+        );
+        assert!(fw_run(&setup, Some(good)).passed(), "{stem}");
+    }
+}
+
+/// A motor without ψ_M (unimotor) gets neither field weakening nor the estimator: the
+/// scenarios are not listed for it.
+#[test]
+fn scenarios_needing_the_flux_are_skipped_without_it() {
+    let (s, d) = load(&motor("unimotor-142umd300"));
+    let ids: Vec<&str> = run(&s, &d).scenarios.iter().map(|x| x.id).collect();
+    assert!(
+        !ids.contains(&"field_weakening") && !ids.contains(&"estimator_recovery"),
+        "{ids:?}"
+    );
+    let (s, d) = load(&motor("chalmers-hev50"));
+    let ids: Vec<&str> = run(&s, &d).scenarios.iter().map(|x| x.id).collect();
+    assert!(
+        ids.contains(&"field_weakening") && ids.contains(&"estimator_recovery"),
+        "{ids:?}"
+    );
+}
+
+/// The estimator with its resetting term switched off (γ0 ≡ 0) in the run that should
+/// have it: from ω̃ = −5ρ the PLL slips cycles (thesis B Fig. 4.17: 14), so the
+/// "no cycle slip" check fails; with the term (Fig. 4.18) none.
+#[test]
+fn estimator_without_resetting_term_slips_cycles() {
+    use codegen::verify::estimator::{estimator_config, run as est_run};
+    for stem in ["chalmers-hev50", "fischer-ti085"] {
+        let (s, d) = load(&motor(stem));
+        let setup = Setup::new(&s, &d);
+        let good = estimator_config(&d).unwrap();
+        let broken = codegen::verify::estimator::EstimatorConfig {
+            resetting: None,
+            ..good
+        };
+        let r = est_run(&setup, &broken);
+        let slips = r.checks.iter().find(|c| c.quantity.starts_with("cycle slips")).unwrap();
+        assert!(!slips.pass && slips.measured.abs() >= 1.0, "{stem}: {slips:?}");
+        assert!(est_run(&setup, &good).passed(), "{stem}");
+    }
 }
 
 fn number(groups: &[codegen::constants::Group], group: &str, name: &str) -> f64 {

@@ -1,5 +1,7 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
+#[path = "motorgen/firmware.rs"]
+mod firmware;
 #[path = "motorgen/identify.rs"]
 mod identify;
 #[path = "motorgen/report.rs"]
@@ -58,6 +60,19 @@ enum Command {
         /// File stem: lowercase letters, digits and '-'.
         stem: String,
         /// Directory of motor specs.
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
+    /// Build the STM32G474 image of one motor (or --all) into target/firmware/<stem>.elf
+    /// and .bin and print its flash and RAM use (fails above 64 KiB of flash).
+    Firmware {
+        /// Motor file stem in the motors folder, e.g. fischer-ti085.
+        #[arg(required_unless_present = "all", conflicts_with = "all")]
+        stem: Option<String>,
+        /// Every motor in the motors folder.
+        #[arg(long)]
+        all: bool,
+        /// Directory of motor specs (default: motors/).
         #[arg(long)]
         dir: Option<PathBuf>,
     },
@@ -322,6 +337,13 @@ fn main() -> ExitCode {
                     ExitCode::FAILURE
                 }
             }
+        }
+        Command::Firmware { stem, all, dir } => {
+            let which = match stem {
+                Some(stem) if !all => firmware::Which::One(stem),
+                _ => firmware::Which::All,
+            };
+            firmware::run(which, &motors_dir(dir))
         }
         Command::Verify { spec } => verify::run(&spec),
         Command::Report { spec, out } => report::run(&spec, &out),

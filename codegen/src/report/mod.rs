@@ -6,7 +6,9 @@
 //! current-loop step responses (simulated vs designed) and Bode plots (discrete
 //! open/closed loop vs the continuous design), decoupling and DC-link responses, ATO lock
 //! and ramp responses and Bode plot, FIR magnitude and phase, and the dq plane with the
-//! current circle and voltage ellipses (thesis B (2.50)–(2.53)).
+//! current circle and voltage ellipses (thesis B (2.50)–(2.53)), the MTPA curve (3.10)
+//! and the field-weakening run's (i_d, i_q) trajectory; the field-weakening run's
+//! currents, voltage and speed; the sensorless estimator's recovery.
 
 pub mod plots;
 
@@ -54,6 +56,8 @@ pub const SECTIONS: &[(&str, &str)] = &[
     ("observer", "Angle tracking observer"),
     ("fir", "Identification FIR"),
     ("dq-plane", "Operating limits in the dq plane"),
+    ("field-weakening", "Field weakening"),
+    ("sensorless", "Sensorless estimator"),
 ];
 
 /// Current circle and voltage ellipses (thesis B (2.50)–(2.53)): |i| = i_max and
@@ -106,6 +110,38 @@ pub fn dq_plane_lines(d: &Design) -> (Vec<Line>, f64) {
     let rho = v_max / w_max;
     let half = (1.6 * i_max).max(1.1 * (rho - psi).abs() / ld).max(1.1 * rho / lq);
     (lines, half)
+}
+
+/// The MTPA curve i_d(i_q) (thesis B (3.10), the field-weakening controller's own,
+/// for |i_q| ≤ i_max) and the (i_d, i_q) samples of the field-weakening run, if the
+/// motor has one.
+pub fn field_weakening_lines(d: &Design, v: &Verification) -> Vec<Line> {
+    let mut lines = Vec::new();
+    let Some(fw) = crate::verify::field_weakening::field_weakening_config(d) else {
+        return lines;
+    };
+    let i_max = d.motor.peak_current_a;
+    let n = 201;
+    let mtpa = (0..n)
+        .map(|k| {
+            let iq = i_max * (2.0 * k as f64 / (n - 1) as f64 - 1.0);
+            (f64::from(fw.mtpa.id(iq as f32)), iq)
+        })
+        .collect();
+    lines.push(("MTPA i_d(i_q) (3.10)".to_string(), mtpa));
+    let run = v
+        .scenarios
+        .iter()
+        .filter(|s| s.id == "field_weakening")
+        .flat_map(|s| s.traces.first());
+    for t in run {
+        let col = |label: &str| t.series.iter().find(|s| s.label == label).map(|s| &s.values);
+        if let (Some(id), Some(iq)) = (col("i_d simulated"), col("i_q simulated")) {
+            let pts = id.iter().zip(iq).map(|(a, b)| (*a, *b)).collect();
+            lines.push(("field-weakening run (simulated i_d, i_q)".to_string(), pts));
+        }
+    }
+    lines
 }
 
 /// Electrical speed [rad/s] at which the voltage ellipse passes through (0, i_max):
@@ -219,13 +255,34 @@ pub fn plots_of(d: &Design, v: &Verification) -> Result<Vec<Plot>, String> {
             false,
         )?,
     });
-    let (lines, half) = dq_plane_lines(d);
+    let (mut lines, half) = dq_plane_lines(d);
+    let mut caption = String::from(
+        "Current circle and voltage ellipses (thesis B (2.50)–(2.53), V_max = U_dc/√3): at a speed, the reachable currents lie inside both",
+    );
+    let fw = field_weakening_lines(d, v);
+    if !fw.is_empty() {
+        caption.push_str("; MTPA curve (3.10) and the simulated field-weakening run (Fig. 2.15): along MTPA below base speed, then toward the ellipse centre −ψ_M/L_d on the current circle (Mode B, (2.57))");
+    }
+    lines.extend(fw);
     out.push(Plot {
         id: "dq-plane".into(),
         section: "dq-plane",
-        caption: "Current circle and voltage ellipses (thesis B (2.50)–(2.53), V_max = U_dc/√3): at a speed, the reachable currents lie inside both".into(),
+        caption,
         svg: plots::plane_chart("dq plane", "i_d [A]", "i_q [A]", &lines, half)?,
     });
+    for (section, id) in [
+        ("field-weakening", "field_weakening"),
+        ("sensorless", "estimator_recovery"),
+    ] {
+        for (k, t) in traces(id).enumerate() {
+            out.push(Plot {
+                id: format!("{section}-{k}"),
+                section,
+                caption: t.title.clone(),
+                svg: plots::trace_chart(t)?,
+            });
+        }
+    }
     Ok(out)
 }
 

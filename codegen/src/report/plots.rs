@@ -12,13 +12,15 @@ pub const SIZE: (u32, u32) = (760, 380);
 /// Height of a two-panel (magnitude/phase) chart [px].
 pub const BODE_HEIGHT: u32 = 560;
 
-const COLORS: [RGBColor; 6] = [
+const COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(214, 39, 40),
     RGBColor(44, 160, 44),
     RGBColor(148, 103, 189),
     RGBColor(255, 127, 14),
     RGBColor(23, 190, 207),
+    RGBColor(140, 86, 75),
+    RGBColor(0, 0, 0),
 ];
 
 fn color(k: usize) -> RGBColor {

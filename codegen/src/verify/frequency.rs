@@ -88,16 +88,16 @@ pub fn current_loop(g: &AxisGains, r: f64, l: f64, ts: f64, omega: &[f64]) -> (R
         open.push(lo);
         closed.push(f * lo / (one + lo));
     }
-    (
-        Response {
-            omega: omega.to_vec(),
-            values: open,
-        },
-        Response {
-            omega: omega.to_vec(),
-            values: closed,
-        },
-    )
+    open_and_closed(omega, open, closed)
+}
+
+/// The open- and closed-loop responses over the same frequencies.
+fn open_and_closed(omega: &[f64], open: Vec<Complex<f64>>, closed: Vec<Complex<f64>>) -> (Response, Response) {
+    let response = |values| Response {
+        omega: omega.to_vec(),
+        values,
+    };
+    (response(open), response(closed))
 }
 
 /// The designed continuous closed loop of the current controller: α/(s + α) (IMC,
@@ -140,16 +140,7 @@ pub fn observer(d: &Design, omega: &[f64]) -> (Response, Response) {
         open.push(lo);
         closed.push(lo / (one + lo));
     }
-    (
-        Response {
-            omega: omega.to_vec(),
-            values: open,
-        },
-        Response {
-            omega: omega.to_vec(),
-            values: closed,
-        },
-    )
+    open_and_closed(omega, open, closed)
 }
 
 /// The continuous ATO design (K_p·s + K_i)/(s² + K_p·s + K_i) (thesis A (4.14)).

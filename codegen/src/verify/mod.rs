@@ -16,8 +16,12 @@
 //! | [`figures`] | rise time, overshoot, settling; designed responses |
 //! | [`scenarios`] | the scenarios and their criteria |
 //! | [`frequency`] | frequency responses of the discrete designs (for the report) |
+//! | [`field_weakening`] | field weakening to 2× base speed (thesis B Fig. 2.15) |
+//! | [`estimator`] | sensorless estimator recovery, cycle slips (thesis B Figs. 4.17, 4.18) |
 
 pub mod controller;
+pub mod estimator;
+pub mod field_weakening;
 pub mod figures;
 pub mod frequency;
 pub mod plant;
@@ -262,6 +266,21 @@ pub struct Scenario {
     pub id: &'static str,
     /// Runs it.
     pub run: fn(&Setup<'_>) -> ScenarioResult,
+    /// Whether it applies to the setup's motor (e.g. ψ_M known); if not, it is not run
+    /// and not listed.
+    pub applies: fn(&Setup<'_>) -> bool,
+}
+
+/// [`Scenario::applies`] of the scenarios every motor runs.
+pub fn always(_: &Setup<'_>) -> bool {
+    true
+}
+
+impl Scenario {
+    /// The scenarios of [`SCENARIOS`] that apply to `setup`.
+    pub fn applicable(setup: &Setup<'_>) -> Vec<&'static Scenario> {
+        SCENARIOS.iter().filter(|s| (s.applies)(setup)).collect()
+    }
 }
 
 /// The standard scenario set, in report order.
@@ -269,32 +288,47 @@ pub const SCENARIOS: &[Scenario] = &[
     Scenario {
         id: "current_step",
         run: scenarios::current_step,
+        applies: always,
     },
     Scenario {
         id: "decoupling",
         run: scenarios::decoupling,
+        applies: always,
     },
     Scenario {
         id: "dc_link_step",
         run: scenarios::dc_link_step,
+        applies: always,
     },
     Scenario {
         id: "ato_lock",
         run: scenarios::ato_lock,
+        applies: always,
     },
     Scenario {
         id: "ato_ramp",
         run: scenarios::ato_ramp,
+        applies: always,
+    },
+    Scenario {
+        id: "field_weakening",
+        run: field_weakening::field_weakening,
+        applies: field_weakening::applies,
+    },
+    Scenario {
+        id: "estimator_recovery",
+        run: estimator::estimator_recovery,
+        applies: estimator::applies,
     },
 ];
 
-/// Runs every scenario of [`SCENARIOS`] on `setup`.
+/// Runs every scenario of [`SCENARIOS`] that applies to `setup`.
 pub fn verify(setup: &Setup<'_>) -> Verification {
     Verification {
         motor: setup.design.name.clone(),
         spec_file: setup.design.spec_file.clone(),
         plant_model: setup.plant_model(),
-        scenarios: SCENARIOS.iter().map(|s| (s.run)(setup)).collect(),
+        scenarios: Scenario::applicable(setup).iter().map(|s| (s.run)(setup)).collect(),
     }
 }
 

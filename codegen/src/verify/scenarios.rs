@@ -63,7 +63,7 @@ fn decimate(t: &[f64], series: Vec<Series>) -> (Vec<f64>, Vec<Series>) {
     )
 }
 
-fn trace(title: impl Into<String>, y_label: &str, t_s: &[f64], series: Vec<Series>) -> Trace {
+pub(super) fn trace(title: impl Into<String>, y_label: &str, t_s: &[f64], series: Vec<Series>) -> Trace {
     let t_ms: Vec<f64> = t_s.iter().map(|t| t * 1e3).collect();
     let (t_ms, series) = decimate(&t_ms, series);
     Trace {

@@ -22,6 +22,7 @@
 //! | [`modulation`] | THPWM (3.7), (3.8), duties and compare values |
 //! | [`fir`] | FMAC-bit-exact FIR for the identification filter (§6.2) |
 //! | [`commissioning`] | chapter-6 routines as state machines |
+//! | [`setpoint`] | received setpoint with timeout and ramp to zero |
 //! | [`step`] | the complete control step and its [`step::ControllerConfig`] |
 //!
 //! Numbers: angles are π-scaled Q1.31 stored integers and wrap; every other integer
@@ -51,13 +52,18 @@ pub mod adc;
 pub mod angle;
 pub mod ato;
 pub mod commissioning;
+pub mod estimator;
+pub mod fast_trig;
 pub mod feedforward;
+pub mod field_weakening;
 pub mod fir;
 pub mod modulation;
 pub mod pi;
+pub mod setpoint;
 pub mod step;
 pub mod transforms;
 pub mod trig;
 
+pub use fast_trig::FastTrig;
 pub use step::{AdcSample, ControllerConfig, ControllerState, Demand, StepOutput};
 pub use trig::{SoftTrig, Trig};

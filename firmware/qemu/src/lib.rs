@@ -8,4 +8,8 @@
 #![no_std]
 #![forbid(unsafe_code)]
 
+#[cfg(not(target_os = "none"))]
+pub mod host;
+pub mod icount;
+pub mod motor_config;
 pub mod vectors;

@@ -22,7 +22,9 @@ use fixed::types::I1F31;
 use motor_control::adc::{CurrentSense, DcLinkSense, MeasuredPhases};
 use motor_control::angle::ResolverToElectrical;
 use motor_control::ato::{AtoConfig, AtoState, ObserverError, ResolverSample};
+use motor_control::estimator::{EstimatorConfig, EstimatorInput, EstimatorState, InjectionConfig, ResettingConfig};
 use motor_control::feedforward::{FeedForwardConfig, dc_link_gain, effective_dc_link};
+use motor_control::field_weakening::{FieldWeakeningConfig, FieldWeakeningInput, FieldWeakeningState, MtpaCurve};
 use motor_control::fir::{FirState, FmacFir};
 use motor_control::modulation::{compare_values, thpwm};
 use motor_control::pi::{CurrentPiConfig, CurrentPiState, PiConfig, VoltageLimit};
@@ -37,7 +39,7 @@ pub const SEED: u32 = 0x2545_f491;
 pub const SAMPLES: u32 = 4096;
 
 /// Number of [`Summary`] lines [`run_all`] produces.
-pub const FUNCTIONS: usize = 14;
+pub const FUNCTIONS: usize = 16;
 
 /// Marsaglia's xorshift32 (shifts 13, 17, 5): a deterministic, platform-independent
 /// stream of `u32`.
@@ -544,6 +546,92 @@ pub fn run_all() -> [Summary; FUNCTIONS] {
                 n = n.wrapping_add(1);
                 let out = config.process(&mut state, &mut trig, &sample, demand);
                 hash_step(h, &out);
+            })
+        },
+        {
+            // Thesis B motor, α_fw = 147 rad/s, V'_max = 0.9·V_max, I_max = 1.4 pu.
+            let config = FieldWeakeningConfig {
+                sample_period: 1e-4,
+                bandwidth: 147.0,
+                ld: 0.23e-3,
+                base_speed: 1256.6,
+                voltage_fraction: 0.9,
+                current_max: 316.8,
+                mtpa: MtpaCurve::Analytic {
+                    psi_m: 0.104,
+                    delta_l: 0.33e-3,
+                },
+            };
+            let mut state = FieldWeakeningState::default();
+            run("field_weakening", move |rng, h| {
+                let input = FieldWeakeningInput {
+                    iq_demand: amps(rng),
+                    omega: rng.range_f32(-4000.0, 4000.0),
+                    voltage: Dq {
+                        d: rng.range_f32(-200.0, 200.0),
+                        q: rng.range_f32(-200.0, 200.0),
+                    },
+                    voltage_max: rng.range_f32(150.0, 200.0),
+                    iq_limit: rng.range_f32(0.0, 400.0),
+                };
+                let (id, iq) = config.process(&mut state, input);
+                h.f32(id);
+                // i_q^ref is clamped with f32::min/max (±0 left to the platform).
+                h.f32_unsigned_zero(iq);
+                h.f32(state.id_ref);
+            })
+        },
+        {
+            let config = EstimatorConfig {
+                sample_period: 1e-4,
+                rho: 125.7,
+                rs: 7.9e-3,
+                ld: 0.23e-3,
+                lq: 0.56e-3,
+                psi_m: 0.104,
+                resetting: Some(ResettingConfig {
+                    lower: 125.7,
+                    upper: 251.4,
+                    speed_max: 2513.0,
+                }),
+                injection: Some(InjectionConfig {
+                    amplitude: 28.0,
+                    frequency: 3141.6,
+                    gain: 1.5,
+                    highpass: 18.85,
+                    lowpass: 628.5,
+                    delay: 2.5,
+                    low_speed: 246.0,
+                    high_speed: 492.0,
+                }),
+            };
+            let mut state = EstimatorState::default();
+            let mut trig = SoftTrig;
+            run("estimator", move |rng, h| {
+                let input = EstimatorInput {
+                    current: Dq {
+                        d: amps(rng),
+                        q: amps(rng),
+                    },
+                    voltage: Dq {
+                        d: rng.range_f32(-200.0, 200.0),
+                        q: rng.range_f32(-200.0, 200.0),
+                    },
+                    reference: Dq {
+                        d: amps(rng),
+                        q: amps(rng),
+                    },
+                };
+                let out = config.process(&mut state, &mut trig, input);
+                h.i32(out.theta);
+                h.f32(out.omega);
+                h.i32(out.omega_increment);
+                h.dq(out.injection);
+                h.f32(out.iq_limit);
+                h.f32(out.gamma0);
+                h.f32(out.speed_error);
+                h.f32(out.blend);
+                h.f32(out.error);
             })
         },
     ]

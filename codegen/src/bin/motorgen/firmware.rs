@@ -1,0 +1,372 @@
+//! `motorgen firmware <stem>` / `motorgen firmware --all`: the STM32G474 image of one
+//! motor or of every motor in `motors/`.
+//!
+//! Per motor: designs the spec first (a bad spec stops here with its located
+//! diagnostic), runs
+//! `cargo build --release --target thumbv7em-none-eabihf -p motor-firmware` in
+//! `firmware/` with `MOTOR=<stem>` and `MOTORS_DIR=<motors folder>` (one shared target
+//! directory, so only the app crate rebuilds per motor), copies the ELF to
+//! `target/firmware/<stem>.elf` under the repository root, writes `<stem>.bin` (the
+//! ELF's loadable segments placed by load address, gaps filled with the erased-flash
+//! byte 0xFF) and prints flash and static RAM use; for one motor it first prints the
+//! constants summary of the design the image is built from. An image over 64 KiB of flash is an
+//! error and is not written.
+//!
+//! The repository root is the nearest ancestor of the motors folder that holds
+//! `firmware/Cargo.toml`, else the nearest such ancestor of the current directory,
+//! else the repository `motorgen` was built from.
+
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::process::{Command, ExitCode, Stdio};
+
+use object::elf;
+use object::read::elf::{ElfFile32, FileHeader, ProgramHeader, SectionHeader};
+use object::{Endianness, Object, ObjectSection, ObjectSymbol};
+
+/// The firmware's target triple.
+const TARGET: &str = "thumbv7em-none-eabihf";
+/// The firmware package (a binary of the same name).
+const PACKAGE: &str = "motor-firmware";
+/// Flash the image must fit in \[bytes\].
+pub const FLASH_LIMIT: u64 = 64 * 1024;
+/// Erased-flash byte, for gaps between segments in the `.bin`.
+const ERASED: u8 = 0xFF;
+/// Largest span of load addresses accepted for a `.bin` \[bytes\]: more means a
+/// segment is loaded outside flash (the file would be mostly padding).
+const MAX_SPAN: u64 = 16 * 1024 * 1024;
+
+/// What to build.
+pub enum Which {
+    /// One stem.
+    One(String),
+    /// Every `*.toml` in the motors folder.
+    All,
+}
+
+/// Flash and RAM use of one image.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Usage {
+    /// Bytes in flash: the `.bin` length (vector table, text, rodata, .data load image).
+    pub flash: u64,
+    /// Flash bytes per allocated section with contents, in address order.
+    pub flash_sections: Vec<(String, u64)>,
+    /// Static RAM: .data + .bss + .uninit (every allocated writable section) \[bytes\].
+    pub ram: u64,
+    /// RAM bytes per allocated writable section.
+    pub ram_sections: Vec<(String, u64)>,
+    /// Stack space: `_stack_start − _stack_end` if the ELF defines both (cortex-m-rt
+    /// gives the stack the RAM above the static data).
+    pub stack: Option<u64>,
+}
+
+/// The `.bin` image and the usage figures of an ELF.
+#[derive(Debug)]
+pub struct Image {
+    /// Flat binary from the lowest load address.
+    pub bin: Vec<u8>,
+    /// Load address of `bin[0]`.
+    pub base: u64,
+    /// Flash and RAM use.
+    pub usage: Usage,
+}
+
+/// Reads a 32-bit ARM ELF: loadable segments by physical (load) address into a flat
+/// binary, section sizes into the usage figures.
+pub fn image(elf_bytes: &[u8]) -> Result<Image, String> {
+    let file = ElfFile32::<Endianness>::parse(elf_bytes).map_err(|e| format!("not a 32-bit ELF: {e}"))?;
+    let e = file.endian();
+    let machine = file.elf_header().e_machine(e);
+    if machine != elf::EM_ARM {
+        return Err(format!("not an ARM ELF (e_machine {machine})"));
+    }
+    let mut loads = Vec::new();
+    for ph in file.elf_program_headers() {
+        if ph.p_type(e) != elf::PT_LOAD || ph.p_filesz(e) == 0 {
+            continue;
+        }
+        let data = ph
+            .data(e, elf_bytes)
+            .map_err(|()| "a loadable segment lies outside the file".to_string())?;
+        loads.push((u64::from(ph.p_paddr(e)), data));
+    }
+    loads.sort_by_key(|&(addr, _)| addr);
+    let (Some(&(base, _)), Some(end)) = (loads.first(), loads.iter().map(|&(a, d)| a + d.len() as u64).max()) else {
+        return Err("the ELF has no loadable contents".into());
+    };
+    let span = end - base;
+    if span > MAX_SPAN {
+        return Err(format!(
+            "loadable segments span {span} bytes from {base:#010x}: a segment is loaded outside flash"
+        ));
+    }
+    let mut bin = vec![ERASED; span as usize];
+    let mut covered_to = base;
+    for (addr, data) in &loads {
+        if *addr < covered_to {
+            return Err(format!("loadable segments overlap at {addr:#010x}"));
+        }
+        let at = (addr - base) as usize;
+        bin[at..at + data.len()].copy_from_slice(data);
+        covered_to = addr + data.len() as u64;
+    }
+
+    let mut flash_sections = Vec::new();
+    let mut ram_sections = Vec::new();
+    for s in file.sections() {
+        let header = s.elf_section_header();
+        let flags = header.sh_flags(e);
+        if !flags.contains(elf::SHF_ALLOC) || s.size() == 0 {
+            continue;
+        }
+        let name = s.name().unwrap_or("?").to_string();
+        if header.sh_type(e) != elf::SHT_NOBITS {
+            flash_sections.push((name.clone(), s.size()));
+        }
+        if flags.contains(elf::SHF_WRITE) {
+            ram_sections.push((name, s.size()));
+        }
+    }
+    let symbol = |name: &str| file.symbols().find(|s| s.name() == Ok(name)).map(|s| s.address());
+    let stack = match (symbol("_stack_start"), symbol("_stack_end")) {
+        (Some(start), Some(end)) if start >= end => Some(start - end),
+        _ => None,
+    };
+    // Alignment gaps between the segments (filled with 0xFF in the `.bin`).
+    let contents: u64 = loads.iter().map(|(_, d)| d.len() as u64).sum();
+    if span > contents {
+        flash_sections.push(("padding".to_string(), span - contents));
+    }
+    let usage = Usage {
+        flash: span,
+        flash_sections,
+        ram: ram_sections.iter().map(|(_, n)| n).sum(),
+        ram_sections,
+        stack,
+    };
+    Ok(Image { bin, base, usage })
+}
+
+/// `n` bytes as KiB with one decimal.
+fn kib(n: u64) -> String {
+    format!("{:.1} KiB", n as f64 / 1024.0)
+}
+
+/// The report lines of one image.
+pub fn report(stem: &str, usage: &Usage) -> String {
+    let mut out = String::new();
+    let parts = |v: &[(String, u64)]| {
+        v.iter()
+            .map(|(n, b)| format!("{n} {b}"))
+            .collect::<Vec<_>>()
+            .join(" + ")
+    };
+    let _ = writeln!(
+        out,
+        "{stem}: flash {} bytes ({}, {:.1} % of 64 KiB) = {}",
+        usage.flash,
+        kib(usage.flash),
+        usage.flash as f64 / FLASH_LIMIT as f64 * 100.0,
+        parts(&usage.flash_sections)
+    );
+    let _ = write!(
+        out,
+        "{stem}: static RAM {} bytes ({}) = {}",
+        usage.ram,
+        kib(usage.ram),
+        if usage.ram_sections.is_empty() {
+            "no .data/.bss".to_string()
+        } else {
+            parts(&usage.ram_sections)
+        }
+    );
+    match usage.stack {
+        Some(s) => {
+            let _ = writeln!(out, "; stack: the remaining {s} bytes ({}) of RAM", kib(s));
+        }
+        None => out.push('\n'),
+    }
+    out
+}
+
+/// Nearest ancestor of `start` (itself included) holding `firmware/Cargo.toml`.
+fn root_above(start: &Path) -> Option<PathBuf> {
+    let start = start.canonicalize().ok()?;
+    start
+        .ancestors()
+        .find(|d| d.join("firmware").join("Cargo.toml").is_file())
+        .map(Path::to_path_buf)
+}
+
+/// The repository root (see the module documentation).
+fn repo_root(motors: &Path) -> Result<PathBuf, String> {
+    root_above(motors)
+        .or_else(|| std::env::current_dir().ok().and_then(|d| root_above(&d)))
+        .or_else(|| root_above(&Path::new(env!("CARGO_MANIFEST_DIR")).join("..")))
+        .ok_or_else(|| {
+            format!(
+                "cannot find the repository (a folder holding firmware/Cargo.toml) above {} or the \
+                 current directory\n  accepted: run motorgen inside the motor-toolchain repository",
+                motors.display()
+            )
+        })
+}
+
+/// Motor stems in `dir`, sorted.
+fn stems(dir: &Path) -> Result<Vec<String>, String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map_err(|e| format!("cannot read the motors folder {}: {e}", dir.display()))?
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+        .collect();
+    v.sort();
+    Ok(v)
+}
+
+/// Runs cargo for `stem`; returns the built ELF's path (from cargo's JSON messages).
+fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String> {
+    let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let child = Command::new(&cargo)
+        .args(["build", "--release", "--target", TARGET, "-p", PACKAGE])
+        .args(["--message-format=json-render-diagnostics"])
+        .current_dir(root.join("firmware"))
+        .env("MOTOR", stem)
+        .env("MOTORS_DIR", motors)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn();
+    let output = match child.and_then(|c| c.wait_with_output()) {
+        Ok(o) => o,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            return Err(format!(
+                "`{}` was not found: install Rust with rustup (https://rustup.rs), then \
+                 `rustup target add {TARGET}`",
+                cargo.to_string_lossy()
+            ));
+        }
+        Err(e) => return Err(format!("cannot run {}: {e}", cargo.to_string_lossy())),
+    };
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    if !output.status.success() {
+        let hint = if stderr.contains("target may not be installed") || stderr.contains("can't find crate for `core`") {
+            format!("\n  the {TARGET} target is missing: install it with `rustup target add {TARGET}`")
+        } else {
+            String::new()
+        };
+        return Err(format!(
+            "MOTOR={stem} cargo build --release --target {TARGET} -p {PACKAGE} failed ({}):\n{stderr}{hint}",
+            output.status
+        ));
+    }
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    stdout
+        .lines()
+        .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
+        .filter(|m| {
+            m["reason"] == "compiler-artifact" && m["target"]["name"] == PACKAGE && m["target"]["kind"][0] == "bin"
+        })
+        .find_map(|m| m["executable"].as_str().map(PathBuf::from))
+        .ok_or_else(|| format!("cargo built no `{PACKAGE}` executable (is firmware/app a binary crate?)"))
+}
+
+/// Builds, checks and writes one motor's image (its spec designs); returns its report.
+fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
+    let elf_path = cargo_build(root, motors, stem)?;
+    let bytes = std::fs::read(&elf_path).map_err(|e| format!("cannot read {}: {e}", elf_path.display()))?;
+    let image = image(&bytes).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+    let mut report = report(stem, &image.usage);
+    if image.usage.flash > FLASH_LIMIT {
+        return Err(format!(
+            "{report}{stem}: the image needs {} bytes of flash, more than the 64 KiB ({FLASH_LIMIT} bytes) \
+             allowed; nothing written (the ELF is {})",
+            image.usage.flash,
+            elf_path.display()
+        ));
+    }
+    let out = root.join("target").join("firmware");
+    std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    let elf_out = out.join(format!("{stem}.elf"));
+    let bin_out = out.join(format!("{stem}.bin"));
+    std::fs::write(&elf_out, &bytes).map_err(|e| format!("cannot write {}: {e}", elf_out.display()))?;
+    std::fs::write(&bin_out, &image.bin).map_err(|e| format!("cannot write {}: {e}", bin_out.display()))?;
+    let _ = writeln!(
+        report,
+        "{stem}: wrote {} and {} (load address {:#010x})",
+        elf_out.display(),
+        bin_out.display(),
+        image.base
+    );
+    Ok(report)
+}
+
+/// The `firmware` subcommand.
+pub fn run(which: Which, motors: &Path) -> ExitCode {
+    let known = match stems(motors) {
+        Ok(k) => k,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let selected = match which {
+        Which::All if known.is_empty() => {
+            eprintln!(
+                "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
+                motors.display()
+            );
+            return ExitCode::FAILURE;
+        }
+        Which::All => known,
+        Which::One(stem) if known.contains(&stem) => vec![stem],
+        Which::One(stem) => {
+            eprintln!(
+                "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
+                motors.display(),
+                if known.is_empty() {
+                    "none: the folder holds no *.toml".to_string()
+                } else {
+                    known.join(", ")
+                }
+            );
+            return ExitCode::FAILURE;
+        }
+    };
+    let root = match repo_root(motors) {
+        Ok(r) => r,
+        Err(e) => {
+            eprintln!("error: {e}");
+            return ExitCode::FAILURE;
+        }
+    };
+    let motors = motors.canonicalize().unwrap_or_else(|_| motors.to_path_buf());
+    // Every selected spec must design before cargo runs (located diagnostics).
+    let mut designs = Vec::new();
+    for stem in &selected {
+        match super::design(&motors.join(format!("{stem}.toml"))) {
+            Ok(d) => designs.push(d),
+            Err(d) => eprint!("{d}"),
+        }
+    }
+    if designs.len() != selected.len() {
+        return ExitCode::FAILURE;
+    }
+    // One motor: the constants the image is built from, as `motorgen design` prints them.
+    if let [d] = designs.as_slice() {
+        print!("{}", codegen::summary::summary(d));
+    }
+    let mut ok = true;
+    for stem in &selected {
+        match build_one(&root, &motors, stem) {
+            Ok(report) => print!("{report}"),
+            Err(e) => {
+                ok = false;
+                eprint!("error: {e}");
+                if !e.ends_with('\n') {
+                    eprintln!();
+                }
+            }
+        }
+    }
+    if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+}

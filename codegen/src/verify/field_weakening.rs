@@ -1,0 +1,358 @@
+//! Field weakening to twice base speed (thesis B §2.3, Fig. 2.15): the firmware's
+//! [`FieldWeakeningConfig::process`] turns a full torque demand into current references
+//! for the firmware's control step, on the simulated motor, while the shaft speed ramps
+//! from half to twice base speed.
+//!
+//! # Where the constants come from (provisional)
+//!
+//! [`field_weakening_config`] computes the controller's constants here, directly from the
+//! thesis formulas and the design's motor data, because the design rules for them are
+//! not part of [`Design`] yet. When the design carries them, replace the body of
+//! [`field_weakening_config`] (and only it) with the design's values; the scenario and
+//! its criteria stay.
+
+use std::f64::consts::PI;
+
+use motor_control::feedforward::effective_dc_link;
+pub use motor_control::field_weakening::FieldWeakeningConfig;
+use motor_control::field_weakening::{FieldWeakeningInput, FieldWeakeningState, MtpaCurve};
+use motor_control::step::{Demand, StepOutput};
+use motor_control::transforms::{Dq, INV_SQRT_3};
+
+use super::plant::{MotorModel, SpeedProfile};
+use super::sim::Bench;
+use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
+use crate::design::Design;
+
+/// V'_max/V_max: thesis B Fig. 2.15 ("V'_max is set to 0.9 pu", V_max = 1 pu).
+pub const VOLTAGE_FRACTION: f64 = 0.9;
+/// α_fw/α_c: thesis B Fig. 2.15 (α_s = α_c/100, α_fw = 10·α_s = α_c/10).
+pub const BANDWIDTH_FRACTION: f64 = 0.1;
+
+/// Electrical base speed ω_base [rad/s] of (2.60): the per-unit base 2π·f_n (thesis B
+/// App. A) when the spec gives the rated frequency, else the speed at which the
+/// max-current MTPA point reaches V'_max — where field weakening starts.
+pub fn base_speed(d: &Design) -> Option<f64> {
+    if let Some(pu) = &d.per_unit {
+        return Some(pu.bases.angular_frequency_rad_s);
+    }
+    let m = &d.motor;
+    let psi = m.flux_linkage_wb?;
+    let i_max = m.peak_current_a;
+    let mtpa = mtpa(psi, m.q_inductance_h - m.d_inductance_h);
+    let id = mtpa.id(i_max as f32) as f64;
+    let iq = (i_max * i_max - id * id).max(0.0).sqrt();
+    let v = VOLTAGE_FRACTION * d.current_loop.voltage_limit_v;
+    // |v| = ω·√((L_d·i_d + ψ)² + (L_q·i_q)²), resistance neglected (2.53).
+    let flux = ((m.d_inductance_h * id + psi).powi(2) + (m.q_inductance_h * iq).powi(2)).sqrt();
+    (flux > 0.0).then_some(v / flux)
+}
+
+fn mtpa(psi: f64, delta_l: f64) -> MtpaCurve {
+    MtpaCurve::Analytic {
+        psi_m: psi as f32,
+        delta_l: delta_l as f32,
+    }
+}
+
+/// The field-weakening constants for `d`, or `None` when ψ_M is unknown:
+///
+/// * `bandwidth` α_fw = α_c/10 (thesis B §2.3.4, Fig. 2.15: α_fw = 10·α_s, α_s = α_c/100);
+/// * `ld` L̂_d, `base_speed` ω_base ([`base_speed`]) — γ = α_fw/(2·ω_fw·L̂_d·V'_max) (2.60)
+///   is evaluated by the firmware at the measured V'_max;
+/// * `voltage_fraction` V'_max/V_max = 0.9 (Fig. 2.15);
+/// * `current_max` I_max = the peak phase current (2.50), (2.56);
+/// * `mtpa` (3.10) with the design's L̂_d, L̂_q, ψ̂_M.
+///
+/// PROVISIONAL: the lead replaces this body with the design rules' values when they
+/// are merged (V'_max, γ's α_fw and ω_base, i_d limits, MTPA table).
+pub fn field_weakening_config(d: &Design) -> Option<FieldWeakeningConfig> {
+    let m = &d.motor;
+    let psi = m.flux_linkage_wb.filter(|p| *p > 0.0)?;
+    Some(FieldWeakeningConfig {
+        sample_period: d.drive.sample_period_s as f32,
+        bandwidth: (BANDWIDTH_FRACTION * d.current_loop.bandwidth_rad_s) as f32,
+        ld: m.d_inductance_h as f32,
+        base_speed: base_speed(d)? as f32,
+        voltage_fraction: VOLTAGE_FRACTION as f32,
+        current_max: m.peak_current_a as f32,
+        mtpa: mtpa(psi, m.q_inductance_h - m.d_inductance_h),
+    })
+}
+
+/// Whether [`field_weakening`] applies to the setup's design.
+pub fn applies(s: &Setup<'_>) -> bool {
+    field_weakening_config(s.design).is_some()
+}
+
+/// Electromagnetic torque T = 3/2·n_p·i_q·(ψ_M + (L_d − L_q(i_q))·i_d) [N·m] (thesis A
+/// (2.33)) of the simulated machine.
+pub fn torque(m: &MotorModel, id: f64, iq: f64) -> f64 {
+    1.5 * f64::from(m.pole_pairs) * iq * (m.psi + (m.ld - m.lq_at(iq)) * id)
+}
+
+/// Steady-state |v| [V] of the simulated machine at speed `w` (2.52), harmonics left out.
+pub fn steady_voltage(m: &MotorModel, w: f64, id: f64, iq: f64) -> f64 {
+    let vd = m.resistance * id - w * m.lq_at(iq) * iq;
+    let vq = m.resistance * iq + w * (m.ld * id + m.psi);
+    vd.hypot(vq)
+}
+
+/// The largest torque [N·m] at speed `w` with |i| ≤ `i_max` (2.50) and the steady-state
+/// |v| ≤ `v_max` (2.52), by search over i_d (2001 points on [−i_max, 0]) and bisection
+/// on i_q (|v| grows with i_q on the torque-producing side), on the simulated
+/// machine's own L_q(i_q).
+pub fn max_torque(m: &MotorModel, w: f64, i_max: f64, v_max: f64) -> f64 {
+    let mut best = 0.0f64;
+    for k in 0..=2000 {
+        let id = -i_max * f64::from(k) / 2000.0;
+        let circle = (i_max * i_max - id * id).max(0.0).sqrt();
+        if steady_voltage(m, w, id, 0.0) > v_max {
+            continue;
+        }
+        let iq = if steady_voltage(m, w, id, circle) <= v_max {
+            circle
+        } else {
+            let (mut lo, mut hi) = (0.0, circle);
+            for _ in 0..60 {
+                let mid = 0.5 * (lo + hi);
+                if steady_voltage(m, w, id, mid) <= v_max {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            lo
+        };
+        best = best.max(torque(m, id, iq));
+    }
+    best
+}
+
+/// The top speed of the run [rad/s, electrical]: 2·ω_base (Fig. 2.15), at most ω_e,max and
+/// at most 90 % of the speed where even i_d = −I_max cannot hold V'_max with i_q = 0
+/// (ω·(ψ_M − L_d·I_max) = V'_max, when ψ_M > L_d·I_max): beyond it no torque is possible.
+pub fn top_speed(d: &Design, base: f64) -> f64 {
+    let m = &d.motor;
+    let psi = m.flux_linkage_wb.unwrap_or(0.0);
+    let v = VOLTAGE_FRACTION * d.current_loop.voltage_limit_v;
+    let mut w = (2.0 * base).min(m.max_electrical_speed_rad_s);
+    let residual = psi - m.d_inductance_h * m.peak_current_a;
+    if residual > 0.0 {
+        w = w.min(0.9 * v / residual);
+    }
+    w
+}
+
+/// Peak acceleration of the resolver angle as a fraction of the observer's K_i: the
+/// observer then lags by at most asin 0.05 ≈ 2.9° (resolver) on the ramp (thesis A §4.4).
+pub const RAMP_ACCELERATION: f64 = 0.05;
+
+/// Speed ramp (cosine-shaped, peak acceleration [`RAMP_ACCELERATION`]·K_i) from ω_base/2
+/// to [`top_speed`] under full torque demand (i_q^0 = I_max), then held.
+///
+/// Criteria (thesis B §2.3, Fig. 2.15):
+/// * the voltage never uses up the margin: peak |v| ≤ (V'_max + V_max)/2 — without field
+///   weakening the current loop saturates at V_max;
+/// * at the top speed |v| settles on V'_max (2.55) within 2 %;
+/// * the current stays in the circle (2.50): peak |i| ≤ 1.05·I_max (tracking and
+///   harmonics);
+/// * the torque at the top speed is at least 95 % of the most the current circle and the
+///   V'_max ellipse allow there ([`max_torque`]).
+pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
+    let cfg = field_weakening_config(s.design);
+    run(s, cfg)
+}
+
+/// [`field_weakening`] with the given controller constants (tests pass broken ones).
+pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
+    let d = s.design;
+    let m = &d.motor;
+    let Some(fw) = fw else {
+        return ScenarioResult {
+            id: "field_weakening",
+            title: "Field weakening: not applicable (ψ_M unknown)".into(),
+            reference: "thesis B §2.3",
+            checks: vec![],
+            traces: vec![],
+        };
+    };
+    let np = f64::from(m.pole_pairs);
+    let nr = f64::from(d.angle_observer.resolver_pole_pairs);
+    let ts = d.drive.sample_period_s;
+    let base = f64::from(fw.base_speed);
+    let top = top_speed(d, base);
+    let start = 0.5 * base;
+    // Cosine speed profile ω(t) = ω_0 + Δ·(1 − cos πτ)/2, τ = (t − t_0)/T: the
+    // acceleration rises and falls smoothly (no step for the observer), peaking at
+    // a = Δ·π/(2T) = RAMP_ACCELERATION·K_i (resolver angle).
+    let acc_e = RAMP_ACCELERATION * d.angle_observer.ki / nr * np;
+    let alpha_fw = f64::from(fw.bandwidth);
+    // Time scale from the designed α_fw = α_c/10 (not the config under test, which may
+    // be broken, e.g. α_fw = 0).
+    let t_fw = 1.0 / (BANDWIDTH_FRACTION * d.current_loop.bandwidth_rad_s);
+    let t0 = 10.0 * t_fw;
+    let ramp = (top - start).max(0.0) * PI / (2.0 * acc_e);
+    let hold = 20.0 * t_fw;
+    let speed_at = |t: f64| {
+        let tau = if ramp > 0.0 {
+            ((t - t0) / ramp).clamp(0.0, 1.0)
+        } else {
+            f64::from(u8::from(t >= t0))
+        };
+        start + (top - start) * 0.5 * (1.0 - (PI * tau).cos())
+    };
+    let segment = |t: f64| {
+        let (a, b) = (speed_at(t), speed_at(t + ts));
+        SpeedProfile {
+            from: a / np,
+            to: b / np,
+            start: t,
+            acceleration: (b - a).abs() / ts / np,
+        }
+    };
+    let mut b = Bench::new(s.cfg, s.plant(SpeedProfile::constant(start / np)));
+    let n = ((t0 + ramp + hold) / ts).ceil() as usize;
+    let i_max = f64::from(fw.current_max);
+    let v_max_design = d.current_loop.voltage_limit_v;
+    let v_prime = VOLTAGE_FRACTION * v_max_design;
+    let mut st = FieldWeakeningState::default();
+    let mut prev = StepOutput::default();
+    let (mut t, mut w, mut id, mut iq, mut idr, mut iqr, mut v) =
+        (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+    let (mut peak_v, mut peak_i) = (0.0f64, 0.0f64);
+    for _ in 0..n {
+        b.plant.speed = segment(b.plant.t);
+        let v_max = s.cfg.voltage_margin * effective_dc_link(prev.u_dc, s.cfg.dc_link_min) * INV_SQRT_3;
+        let (id_ref, iq_ref) = fw.process(
+            &mut st,
+            FieldWeakeningInput {
+                iq_demand: fw.current_max,
+                omega: prev.omega_e,
+                voltage: prev.u_dq,
+                voltage_max: v_max,
+                iq_limit: f32::INFINITY,
+            },
+        );
+        let smp = b.step(Demand::Current {
+            id: id_ref,
+            iq: iq_ref,
+            feed_forward: true,
+        });
+        prev = smp.out;
+        let Dq { d: ud, q: uq } = smp.out.u_dq;
+        let vm = f64::from(ud).hypot(f64::from(uq));
+        t.push(smp.t);
+        w.push(np * smp.omega_m);
+        id.push(smp.i[0]);
+        iq.push(smp.i[1]);
+        idr.push(f64::from(id_ref));
+        iqr.push(f64::from(iq_ref));
+        v.push(vm);
+        if smp.t >= t0 {
+            peak_v = peak_v.max(vm);
+            peak_i = peak_i.max(smp.i[0].hypot(smp.i[1]));
+        }
+    }
+    let tail = ((0.25 * hold / ts) as usize).clamp(1, n);
+    let mean = |x: &[f64]| x[n - tail..].iter().sum::<f64>() / tail as f64;
+    let v_end = mean(&v);
+    let torque_end = {
+        let tq: Vec<f64> = id.iter().zip(&iq).map(|(a, b)| torque(&s.motor, *a, *b)).collect();
+        mean(&tq)
+    };
+    let t_max = max_torque(&s.motor, top, i_max, v_prime);
+    let rpm = |w: f64| w / np * 30.0 / PI;
+    let checks = vec![
+        Check {
+            quantity: "peak |v| on the ramp".into(),
+            measured: peak_v,
+            designed: Some(v_prime),
+            unit: "V",
+            criterion: format!(
+                "≤ (V'_max + V_max)/2 = {} (V_max = {}: the margin is never used up, Fig. 2.15)",
+                format_value(0.5 * (v_prime + v_max_design), "V"),
+                format_value(v_max_design, "V")
+            ),
+            pass: peak_v <= 0.5 * (v_prime + v_max_design),
+        },
+        Check {
+            quantity: format!("|v| at {}", format_value(rpm(top), "rpm")),
+            measured: v_end,
+            designed: Some(v_prime),
+            unit: "V",
+            criterion: "within 2 % of V'_max (2.55)".into(),
+            pass: (v_end / v_prime - 1.0).abs() <= 0.02,
+        },
+        Check {
+            quantity: "peak |i|".into(),
+            measured: peak_i,
+            designed: Some(i_max),
+            unit: "A",
+            criterion: "≤ 1.05·I_max (current circle 2.50, 2.57)".into(),
+            pass: peak_i <= 1.05 * i_max,
+        },
+        Check {
+            quantity: format!("torque at {}", format_value(rpm(top), "rpm")),
+            measured: torque_end,
+            designed: Some(t_max),
+            unit: "N·m",
+            criterion: "≥ 95 % of the most |i| ≤ I_max and |v| ≤ V'_max allow there".into(),
+            pass: torque_end >= 0.95 * t_max,
+        },
+    ];
+    let traces = vec![
+        trace(
+            "Field weakening: currents on the speed ramp",
+            "current [A]",
+            &t,
+            vec![
+                series("i_d simulated", id),
+                series("i_q simulated", iq),
+                series("i_d^ref", idr),
+                series("i_q^ref", iqr),
+            ],
+        ),
+        trace(
+            "Field weakening: voltage magnitude",
+            "|v| [V]",
+            &t,
+            vec![
+                series("|v| (current-loop output)", v),
+                series("V'_max", vec![v_prime; n]),
+                series("V_max", vec![v_max_design; n]),
+            ],
+        ),
+        trace(
+            "Field weakening: electrical speed",
+            "ω_e [rad/s]",
+            &t,
+            vec![series("ω_e", w)],
+        ),
+    ];
+    ScenarioResult {
+        id: "field_weakening",
+        title: format!(
+            "Field weakening, ramp {} → {} under full torque demand (i_q^0 = {}), α_fw = {}, V'_max = {}",
+            format_value(rpm(start), "rpm"),
+            format_value(rpm(top), "rpm"),
+            format_value(i_max, "A"),
+            format_value(alpha_fw, "rad/s"),
+            format_value(v_prime, "V"),
+        ),
+        reference: "thesis B (2.50)–(2.57), (2.60), Fig. 2.15, App. D",
+        checks,
+        traces,
+    }
+}
+
+fn series(label: &str, values: Vec<f64>) -> Series {
+    Series {
+        label: label.into(),
+        values,
+    }
+}
+
+fn trace(title: &str, y_label: &str, t: &[f64], series: Vec<Series>) -> Trace {
+    super::scenarios::trace(title, y_label, t, series)
+}

@@ -1,0 +1,74 @@
+//! FDCAN1 receiving the torque setpoint (classic CAN, [`crate::hw::CAN_BITRATE`]).
+//!
+//! Every standard frame goes to RX FIFO 0 (no filter elements; extended and remote
+//! frames are rejected) and the main loop picks out the setpoint identifier
+//! ([`crate::can_frame`]). The message RAM layout is fixed on the STM32G4
+//! (RM0440 §44.3.3).
+
+use stm32g4::stm32g474 as pac;
+
+use super::clocks::{POLL_LIMIT, wait_for};
+use crate::can_frame::{RxFrame, nominal_bit_timing};
+use crate::hw;
+
+/// FDCAN_NBTP of the bus (a build error if the clock does not divide).
+const NBTP: u32 = match nominal_bit_timing(hw::FDCAN_CLOCK_HZ, hw::CAN_BITRATE, hw::CAN_TQ_PER_BIT, hw::CAN_TSEG2) {
+    Some(v) => v,
+    None => panic!("the FDCAN clock does not divide into the bit rate"),
+};
+
+/// Number of RX FIFO 0 elements.
+const RX_FIFO_ELEMENTS: u8 = 3;
+
+/// FDCAN1, owned.
+pub struct Can {
+    regs: pac::FDCAN1,
+}
+
+impl Can {
+    /// Configures the bit timing and acceptance and joins the bus; `None` if the
+    /// controller does not enter or leave initialisation.
+    pub fn new(regs: pac::FDCAN1) -> Option<Self> {
+        regs.cccr().modify(|_, w| w.init().set_bit());
+        if !wait_for(POLL_LIMIT, || regs.cccr().read().init().bit_is_set()) {
+            return None;
+        }
+        regs.cccr().modify(|_, w| w.cce().set_bit());
+        // SAFETY: NBTP holds the computed bit timing; RXGFC: ANFS = 0 (accept
+        // non-matching standard frames into FIFO 0), ANFE = 2 (reject extended),
+        // RRFS = RRFE = 1 (reject remote frames), no filter elements.
+        unsafe {
+            regs.nbtp().write(|w| w.bits(NBTP));
+            regs.rxgfc()
+                .write(|w| w.anfs().bits(0).anfe().bits(0b10).rrfs().set_bit().rrfe().set_bit());
+        }
+        regs.cccr().modify(|_, w| w.init().clear_bit());
+        if !wait_for(POLL_LIMIT, || regs.cccr().read().init().bit_is_clear()) {
+            return None;
+        }
+        Some(Self { regs })
+    }
+
+    /// The oldest received frame, if any (acknowledged, so the FIFO never fills).
+    pub fn poll(&mut self) -> Option<RxFrame> {
+        let status = self.regs.rxf0s().read();
+        if status.f0fl().bits() == 0 {
+            return None;
+        }
+        let index = status.f0gi().bits();
+        if index >= RX_FIFO_ELEMENTS {
+            return None;
+        }
+        let base = hw::FDCAN1_RAM + hw::FDCAN_RXF0_OFFSET + usize::from(index) * hw::FDCAN_RX_ELEMENT_BYTES;
+        let word = |k: usize| {
+            // SAFETY: `base` is the start of RX FIFO 0 element `index` (< 3) in the
+            // FDCAN1 message RAM; its first four words are word-aligned and owned by
+            // this driver while the element is not acknowledged.
+            unsafe { core::ptr::read_volatile((base + 4 * k) as *const u32) }
+        };
+        let frame = RxFrame::from_words([word(0), word(1), word(2), word(3)]);
+        // SAFETY: F0AI takes the get index just read.
+        self.regs.rxf0a().write(|w| unsafe { w.f0ai().bits(index) });
+        Some(frame)
+    }
+}

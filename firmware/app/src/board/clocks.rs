@@ -1,0 +1,87 @@
+//! System clock: HSI16 → PLL → 170 MHz in range-1 boost mode (RM0440 §6.1.5, §7.2).
+
+use stm32g4::stm32g474 as pac;
+
+use crate::hw;
+
+/// Bounded busy-wait: `ready` polled at most `limit` times.
+pub fn wait_for(limit: u32, mut ready: impl FnMut() -> bool) -> bool {
+    (0..limit).any(|_| ready())
+}
+
+/// Polls for clock and peripheral ready flags: generous for the µs-scale waits.
+pub const POLL_LIMIT: u32 = hw::SYSCLK_HZ / 1_000;
+
+/// Busy-waits `us` microseconds at SYSCLK.
+pub fn delay_us(us: u32) {
+    cortex_m::asm::delay(hw::SYSCLK_HZ / hw::US_PER_S * us);
+}
+
+/// Switches SYSCLK to the PLL at [`hw::SYSCLK_HZ`]; APB1/APB2 undivided. Returns
+/// `false` if the PLL does not lock.
+pub fn init(rcc: &pac::RCC, pwr: &pac::PWR, flash: &pac::FLASH) -> bool {
+    rcc.apb1enr1().modify(|_, w| w.pwren().set_bit());
+    // Boost mode for > 150 MHz (R1MODE = 0), then the wait states, then the PLL.
+    pwr.cr5().modify(|_, w| w.r1mode().clear_bit());
+    // SAFETY: LATENCY takes 0..=15 wait states; 4 is RM0440's value for 170 MHz.
+    flash.acr().modify(|_, w| unsafe {
+        w.latency()
+            .bits(hw::FLASH_WAIT_STATES)
+            .prften()
+            .set_bit()
+            .icen()
+            .set_bit()
+            .dcen()
+            .set_bit()
+    });
+    if !wait_for(POLL_LIMIT, || {
+        flash.acr().read().latency().bits() == hw::FLASH_WAIT_STATES
+    }) {
+        return false;
+    }
+    // SAFETY: PLLSRC 0b10 selects HSI16; PLLN 85 is within 8..=127.
+    rcc.pllcfgr().write(|w| unsafe {
+        w.pllsrc()
+            .bits(0b10)
+            .pllm()
+            .bits((hw::PLL_M - 1) as u8)
+            .plln()
+            .bits(hw::PLL_N as u8)
+            .pllr()
+            .bits((hw::PLL_R / 2 - 1) as u8)
+            .pllren()
+            .set_bit()
+    });
+    rcc.cr().modify(|_, w| w.pllon().set_bit());
+    if !wait_for(POLL_LIMIT, || rcc.cr().read().pllrdy().bit_is_set()) {
+        return false;
+    }
+    // RM0440 §7.2.7: switch to > 80 MHz through AHB/2 for at least 1 µs.
+    rcc.cfgr().modify(|_, w| w.hpre().set(0b1000));
+    rcc.cfgr().modify(|_, w| w.sw().set(0b11));
+    if !wait_for(POLL_LIMIT, || rcc.cfgr().read().sws().bits() == 0b11) {
+        return false;
+    }
+    delay_us(1);
+    rcc.cfgr().modify(|_, w| w.hpre().set(0).ppre1().set(0).ppre2().set(0));
+    true
+}
+
+/// Enables the clocks of every peripheral the board uses.
+pub fn enable_peripherals(rcc: &pac::RCC) {
+    rcc.ahb1enr().modify(|_, w| w.cordicen().set_bit().fmacen().set_bit());
+    rcc.ahb2enr().modify(|_, w| {
+        w.gpioaen()
+            .set_bit()
+            .gpioben()
+            .set_bit()
+            .gpiocen()
+            .set_bit()
+            .adc12en()
+            .set_bit()
+    });
+    rcc.apb2enr().modify(|_, w| w.tim1en().set_bit());
+    rcc.apb1enr1().modify(|_, w| w.tim3en().set_bit().fdcanen().set_bit());
+    // SAFETY: FDCANSEL 0b10 selects PCLK1 (RM0440 §7.4.26).
+    rcc.ccipr().modify(|_, w| unsafe { w.fdcansel().bits(0b10) });
+}

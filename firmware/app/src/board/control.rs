@@ -1,0 +1,128 @@
+//! The control interrupt (ADC1_2, end of the injected sequence): one
+//! [`motor_control::ControllerConfig::process`] step per carrier period with the
+//! CORDIC as [`motor_control::Trig`].
+//!
+//! Order: read and acknowledge the conversions; trip on the break flag or a
+//! phase-current code at the converter's rail ([`crate::adc_frame::overcurrent`]);
+//! advance the setpoint supervision with the value the main loop received over CAN
+//! ([`crate::config::SETPOINT`]: timeout, ramp to zero); run the step; write
+//! `StepOutput::compare` to CCR1..3; enable the gates only while not tripped and the
+//! setpoint is alive or still ramping down (a tripped drive stays off until reset).
+//! i_d = 0 (the torque → i_q conversion (2.34) assumes it).
+
+use core::cell::Cell;
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+
+use cortex_m::interrupt::Mutex;
+use motor_control::setpoint::SetpointState;
+use motor_control::{ControllerState, Demand};
+use stm32g4::stm32g474 as pac;
+use stm32g4::stm32g474::interrupt;
+
+use super::cordic::Cordic;
+use super::{adc, pins, pwm};
+use crate::adc_frame::{self, Excitation};
+use crate::config::{CONTROLLER, SETPOINT};
+
+/// Control periods run (wrapping); the main loop refreshes the watchdog only when
+/// this advances.
+pub static TICKS: AtomicU32 = AtomicU32::new(0);
+/// Latest received i_q setpoint \[A\] as `f32` bits.
+static SETPOINT_BITS: AtomicU32 = AtomicU32::new(0);
+/// A setpoint arrived since the interrupt last looked.
+static SETPOINT_FRESH: AtomicBool = AtomicBool::new(false);
+
+/// Hands a received i_q setpoint \[A\] to the control interrupt.
+pub fn publish_setpoint(iq: f32) {
+    SETPOINT_BITS.store(iq.to_bits(), Ordering::Relaxed);
+    SETPOINT_FRESH.store(true, Ordering::Release);
+}
+
+/// The setpoint received since the last call, if any.
+fn take_setpoint() -> Option<f32> {
+    SETPOINT_FRESH
+        .swap(false, Ordering::Acquire)
+        .then(|| f32::from_bits(SETPOINT_BITS.load(Ordering::Relaxed)))
+}
+
+/// Everything the control interrupt owns.
+pub struct Control {
+    tim1: pac::TIM1,
+    adc1: pac::ADC1,
+    adc2: pac::ADC2,
+    gpioc: pac::GPIOC,
+    cordic: Cordic,
+    state: ControllerState,
+    setpoint: SetpointState,
+    tripped: bool,
+}
+
+/// Passes the [`Control`] from `run` to the interrupt once.
+pub static HANDOFF: Mutex<Cell<Option<Control>>> = Mutex::new(Cell::new(None));
+
+impl Control {
+    /// Takes the peripherals of the control path (configured by the caller).
+    pub fn new(tim1: pac::TIM1, adc1: pac::ADC1, adc2: pac::ADC2, gpioc: pac::GPIOC, cordic: Cordic) -> Self {
+        Self {
+            tim1,
+            adc1,
+            adc2,
+            gpioc,
+            cordic,
+            state: ControllerState::new(),
+            setpoint: SetpointState::new(),
+            tripped: false,
+        }
+    }
+
+    /// Latches a trip and switches the gates off at once.
+    fn trip(&mut self) {
+        self.tripped = true;
+        pwm::set_outputs(&self.tim1, false);
+    }
+
+    /// One control period.
+    pub fn step(&mut self) {
+        let Some(raw) = adc::read(&self.adc1, &self.adc2) else {
+            // A lost conversion: no valid currents this period.
+            return self.trip();
+        };
+        if pwm::break_tripped(&self.tim1) || adc_frame::overcurrent(&raw) {
+            self.trip();
+        }
+        let excitation = if pins::excitation_high(&self.gpioc) {
+            Excitation::Positive
+        } else {
+            Excitation::Negative
+        };
+        let sample = adc_frame::to_sample(&raw, excitation);
+        let iq = SETPOINT.process(&mut self.setpoint, take_setpoint());
+        let alive = !(self.setpoint.timed_out(&SETPOINT) && iq == 0.0);
+        let run = alive && !self.tripped;
+        let demand = if run {
+            Demand::Current {
+                id: 0.0,
+                iq,
+                feed_forward: true,
+            }
+        } else {
+            Demand::Off
+        };
+        let out = CONTROLLER.process(&mut self.state, &mut self.cordic, &sample, demand);
+        pwm::set_compare(&self.tim1, out.compare);
+        pwm::set_outputs(&self.tim1, run);
+        TICKS.fetch_add(1, Ordering::Relaxed);
+    }
+}
+
+/// The control interrupt.
+#[interrupt]
+fn ADC1_2() {
+    static mut CONTROL: Option<Control> = None;
+    if CONTROL.is_none() {
+        *CONTROL = cortex_m::interrupt::free(|cs| HANDOFF.borrow(cs).take());
+    }
+    if let Some(control) = CONTROL {
+        control.step();
+    }
+}

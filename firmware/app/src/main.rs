@@ -1,0 +1,32 @@
+//! The firmware image: `cargo run --release --target thumbv7em-none-eabihf -p
+//! motor-firmware` builds it for the motor named by `MOTOR` and flashes a connected
+//! STM32G474 board through `probe-rs` (see firmware/README.md).
+#![cfg_attr(target_os = "none", no_std, no_main)]
+
+// The board layer: peripherals, the control interrupt, exception and panic handlers.
+// `crate::config` etc. inside it name motor-config's modules.
+#[cfg(target_os = "none")]
+mod board;
+#[cfg(target_os = "none")]
+use motor_config::{adc_frame, can_frame, config, hw};
+
+#[cfg(target_os = "none")]
+mod target {
+    use cortex_m_rt::entry;
+
+    /// Reset entry: brings up the board and runs the main loop (never returns).
+    #[entry]
+    fn main() -> ! {
+        crate::board::run()
+    }
+}
+
+/// Host build: prints the register values this image would program.
+#[cfg(not(target_os = "none"))]
+fn main() {
+    use motor_config::{config, motor};
+    println!("motor: {}", motor::limits::SWITCHING_FREQUENCY_HZ);
+    println!("TIM1 ARR {} DTG {:#04x}", config::PWM_PERIOD, config::DEAD_TIME_DTG);
+    println!("ADC SMP {}", config::ADC_SMP);
+    println!("IWDG PR {} RLR {}", config::WATCHDOG.0, config::WATCHDOG.1);
+}

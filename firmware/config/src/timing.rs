@@ -1,0 +1,163 @@
+//! Register encodings computed from times and frequencies (pure, host-tested):
+//! TIM1 period and dead time, ADC sampling time, watchdog prescaler and reload.
+#![forbid(unsafe_code)]
+
+/// Picoseconds per second.
+const PS_PER_S: u64 = 1_000_000_000_000;
+/// Nanoseconds per second.
+const NS_PER_S: u64 = 1_000_000_000;
+
+/// Centre-aligned (up/down) PWM: one carrier period is `2·ARR` timer ticks, so
+/// `ARR = round(f_tim/(2·f_s))` (RM0440 §28.3.3, thesis A Fig. 3.4). `None` if it does
+/// not fit the 16-bit register or is zero.
+pub const fn centre_aligned_arr(timer_hz: u32, switching_hz: f32) -> Option<u16> {
+    let arr = timer_hz as f32 / (2.0 * switching_hz) + 0.5;
+    // Also rejects NaN, ∞ and f_s ≤ 0 (the comparisons are false).
+    if arr >= 1.0 && arr <= u16::MAX as f32 {
+        Some(arr as u16)
+    } else {
+        None
+    }
+}
+
+/// Dead-time length in `t_DTS` ticks of a TIMx_BDTR.DTG code (RM0440 §28.6.20):
+/// `0xx`: DTG; `10x`: (64 + DTG\[5:0\])·2; `110`: (32 + DTG\[4:0\])·8;
+/// `111`: (32 + DTG\[4:0\])·16.
+pub const fn dtg_ticks(dtg: u8) -> u32 {
+    let d = dtg as u32;
+    if d & 0x80 == 0 {
+        d
+    } else if d & 0xC0 == 0x80 {
+        (64 + (d & 0x3F)) * 2
+    } else if d & 0xE0 == 0xC0 {
+        (32 + (d & 0x1F)) * 8
+    } else {
+        (32 + (d & 0x1F)) * 16
+    }
+}
+
+/// The DTG code of the shortest dead time that is at least `dead_ns` with
+/// `t_DTS = 1/timer_hz` (CKD = 0): never shorter than requested, so shoot-through
+/// protection is kept. `None` beyond the longest encodable 1008 ticks.
+pub const fn dead_time_dtg(dead_ns: u32, timer_hz: u32) -> Option<u8> {
+    // Ticks, rounded up.
+    let ticks = (dead_ns as u64 * timer_hz as u64).div_ceil(NS_PER_S);
+    if ticks <= 127 {
+        Some(ticks as u8)
+    } else if ticks <= 254 {
+        Some(0x80 | (ticks.div_ceil(2) - 64) as u8)
+    } else if ticks <= 504 {
+        Some(0xC0 | (ticks.div_ceil(8) - 32) as u8)
+    } else if ticks <= 1008 {
+        Some(0xE0 | (ticks.div_ceil(16) - 32) as u8)
+    } else {
+        None
+    }
+}
+
+/// STM32G4 ADC_SMPR sampling times in half ADC clock cycles, codes 0..=7
+/// (RM0440 §21.7.6: 2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5 cycles).
+pub const SAMPLE_HALF_CYCLES: [u32; 8] = [5, 13, 25, 49, 95, 185, 495, 1281];
+
+/// Smallest ADC_SMPR code whose sampling time settles the sample-and-hold to
+/// 1 LSB: `t_sample ≥ n·τ`, `τ = (R_ADC + R_EXT)·C_ADC` (thesis A (7.2), (7.4)),
+/// `n` = the design's settling multiple. `None` if even 640.5 cycles is too short.
+pub const fn adc_smp_code(settling_multiple: u32, resistance_ohm: u32, capacitance_pf: u32, adc_hz: u32) -> Option<u8> {
+    // n·τ in ps (Ω·pF = ps).
+    let t_min_ps = settling_multiple as u64 * resistance_ohm as u64 * capacitance_pf as u64;
+    let mut code = 0;
+    while code < SAMPLE_HALF_CYCLES.len() {
+        // half_cycles/(2·f_adc) ≥ t_min  ⇔  half_cycles·10¹² ≥ 2·t_min_ps·f_adc.
+        if SAMPLE_HALF_CYCLES[code] as u64 * PS_PER_S >= 2 * t_min_ps * adc_hz as u64 {
+            return Some(code as u8);
+        }
+        code += 1;
+    }
+    None
+}
+
+/// IWDG prescaler code PR (divider 4·2^PR, PR ≤ 6) and reload RLR (≤ 4095) for a
+/// timeout of at least `lsi_ticks` LSI periods (RM0440 §41.3): the smallest divider
+/// that fits, reload rounded up. `None` if the timeout exceeds 256·4096 ticks.
+pub const fn iwdg_setting(lsi_ticks: u32) -> Option<(u8, u16)> {
+    let mut pr = 0;
+    while pr <= 6 {
+        let div = 4u32 << pr;
+        let reload = lsi_ticks.div_ceil(div);
+        if reload <= 0x0FFF {
+            let reload = if reload == 0 { 1 } else { reload };
+            return Some((pr as u8, reload as u16));
+        }
+        pr += 1;
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Thesis A: f_s = 20 kHz from a 170 MHz timer clock, centre-aligned:
+    /// 170e6/(2·20e3) = 4250 (hand calculation); 16 kHz → 5312.5 → 5313.
+    #[test]
+    fn pwm_period() {
+        assert_eq!(centre_aligned_arr(170_000_000, 20_000.0), Some(4250));
+        assert_eq!(centre_aligned_arr(170_000_000, 16_000.0), Some(5313));
+        assert_eq!(centre_aligned_arr(170_000_000, 1_000.0), None); // 85 000 > 65 535
+        assert_eq!(centre_aligned_arr(170_000_000, 0.0), None);
+        assert_eq!(centre_aligned_arr(170_000_000, f32::NAN), None);
+    }
+
+    /// Hand calculations at 170 MHz (5.88 ns per tick):
+    /// 500 ns = 85 ticks → DTG 85; 1 µs = 170 ticks → (64 + 21)·2 = 170 → 0x95;
+    /// 2 µs = 340 ticks → ⌈340/8⌉ = 43 = 32 + 11 → 0xCB (344 ticks);
+    /// 3 µs = 510 ticks → ⌈510/16⌉ = 32 → 0xE0 (512 ticks); 6 µs = 1020 > 1008 → None.
+    #[test]
+    fn dead_time_encoding() {
+        assert_eq!(dead_time_dtg(500, 170_000_000), Some(85));
+        assert_eq!(dead_time_dtg(1_000, 170_000_000), Some(0x95));
+        assert_eq!(dtg_ticks(0x95), 170);
+        assert_eq!(dead_time_dtg(2_000, 170_000_000), Some(0xCB));
+        assert_eq!(dtg_ticks(0xCB), 344);
+        assert_eq!(dead_time_dtg(3_000, 170_000_000), Some(0xE0));
+        assert_eq!(dtg_ticks(0xE0), 512);
+        assert_eq!(dead_time_dtg(6_000, 170_000_000), None);
+        assert_eq!(dtg_ticks(0xFF), 1008);
+    }
+
+    /// Property over every tick count: the chosen code is never shorter than asked,
+    /// and no code gives a shorter dead time that is still long enough.
+    #[test]
+    fn dead_time_is_minimal_and_safe() {
+        let all: Vec<u32> = (0..=255u8).map(dtg_ticks).collect();
+        for ticks in 0..=1008u32 {
+            // 1 GHz: one tick per ns.
+            let code = dead_time_dtg(ticks, 1_000_000_000).expect("encodable");
+            let got = dtg_ticks(code);
+            assert!(got >= ticks);
+            assert!(!all.iter().any(|&t| t >= ticks && t < got), "{ticks}: {got}");
+        }
+    }
+
+    /// Hand calculations, the same as codegen's ADC design (thesis A (7.4): 9τ):
+    /// τ = 1.1 kΩ·5 pF = 5.5 ns, 9τ = 49.5 ns = 2.10 cycles at 42.5 MHz → 2.5 cycles
+    /// (code 0); 10.1 kΩ: τ = 50.5 ns, 9τ = 454.5 ns = 19.3 cycles → 24.5 (code 3);
+    /// 100 kΩ: 9τ = 4.5 µs = 191 cycles → 247.5 (code 6); 1 MΩ: 1913 cycles → None.
+    #[test]
+    fn adc_sampling_time() {
+        assert_eq!(adc_smp_code(9, 1_100, 5, 42_500_000), Some(0));
+        assert_eq!(adc_smp_code(9, 10_100, 5, 42_500_000), Some(3));
+        assert_eq!(adc_smp_code(9, 100_000, 5, 42_500_000), Some(6));
+        assert_eq!(adc_smp_code(9, 1_000_000, 5, 42_500_000), None);
+    }
+
+    /// Hand calculations: 160 LSI ticks (5 ms at 32 kHz) → /4, reload 40;
+    /// 100 000 ticks → /32 (PR 3), reload 3125; 2 000 000 ticks > 256·4095 → None.
+    #[test]
+    fn watchdog_setting() {
+        assert_eq!(iwdg_setting(160), Some((0, 40)));
+        assert_eq!(iwdg_setting(100_000), Some((3, 3125)));
+        assert_eq!(iwdg_setting(2_000_000), None);
+        assert_eq!(iwdg_setting(0), Some((0, 1)));
+    }
+}
