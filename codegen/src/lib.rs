@@ -8,6 +8,8 @@
 pub mod constants;
 pub mod design;
 pub mod diagnostic;
+#[cfg(feature = "identify")]
+pub mod identify;
 pub mod render;
 #[cfg(feature = "verify")]
 pub mod report;

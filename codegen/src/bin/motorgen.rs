@@ -2,6 +2,8 @@
 
 #[path = "motorgen/firmware.rs"]
 mod firmware;
+#[path = "motorgen/identify.rs"]
+mod identify;
 #[path = "motorgen/report.rs"]
 mod report;
 #[path = "motorgen/verify.rs"]
@@ -88,6 +90,12 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long)]
         out: PathBuf,
+    },
+    /// Identify R, L, ψ_M or the resolver offset from recorded commissioning runs
+    /// (thesis A chapter 6) and write them into the spec's [motor.identified].
+    Identify {
+        #[command(subcommand)]
+        what: identify::What,
     },
     /// List the motors in a directory (default: motors/).
     List {
@@ -339,6 +347,7 @@ fn main() -> ExitCode {
         }
         Command::Verify { spec } => verify::run(&spec),
         Command::Report { spec, out } => report::run(&spec, &out),
+        Command::Identify { what } => identify::run(what),
         Command::List { dir } => {
             let dir = motors_dir(dir);
             let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {

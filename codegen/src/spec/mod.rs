@@ -597,7 +597,23 @@ impl<'a> Resolver_<'a> {
             if let (Some(_), Some(dq)) = (&p.inductance, p.d_inductance.as_ref().or(p.q_inductance.as_ref())) {
                 self.err(dq.span(), &format!("motor.{name}.d_inductance"), format!("conflicting inductance forms in [motor.{name}]: `inductance` and `d_inductance`/`q_inductance` are both given"), "either `inductance` (L_d = L_q) or both `d_inductance` and `q_inductance`, not both forms");
             }
+            // Identified values win key by key: one identified axis may stand next to a
+            // datasheet value for the other (`motorgen identify step` does one axis a run).
+            let datasheet_has = |q: bool| {
+                name == "identified"
+                    && m.datasheet.as_ref().is_some_and(|s| {
+                        let ds = s.get_ref();
+                        ds.inductance.is_some()
+                            || if q {
+                                ds.q_inductance.is_some()
+                            } else {
+                                ds.d_inductance.is_some()
+                            }
+                    })
+            };
             match (&p.d_inductance, &p.q_inductance) {
+                (Some(_), None) if datasheet_has(true) => {}
+                (None, Some(_)) if datasheet_has(false) => {}
                 (Some(d), None) => self.err(
                     d.span(),
                     &format!("motor.{name}.q_inductance"),

@@ -1,0 +1,533 @@
+//! `motorgen identify step|flux|resolver <spec> …`: identified values from recorded
+//! commissioning runs (thesis A chapter 6) into the spec's `[motor.identified]`.
+//!
+//! Every recording is read and evaluated first; the spec is only rewritten when all of
+//! them are good and the updated spec designs without error, through a temporary file
+//! in the same directory that is then renamed over the spec (nothing partial is ever
+//! written). `--dry-run` prints the change instead.
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Args, Subcommand, ValueEnum};
+use codegen::identify::recording::{self, Recording, RecordingKind};
+use codegen::identify::resolver::{self, RatioEstimate};
+use codegen::identify::step::{StepEstimate, StepSetup, identify_step};
+use codegen::identify::writeback::{self, Entry, Origin};
+use codegen::identify::{Spread, flux};
+use codegen::units::{self, Kind};
+use codegen::{Design, Diagnostic, Diagnostics, Source};
+use motor_control::commissioning::Axis;
+
+/// What to identify.
+#[derive(Subcommand)]
+pub enum What {
+    /// R and L of one axis and the transport delay from blocked-rotor voltage steps
+    /// (thesis A §6.2, (6.3)–(6.8)); writes phase_resistance and d_/q_inductance.
+    Step {
+        /// The motor spec to update.
+        spec: PathBuf,
+        /// The axis the recordings excite.
+        #[arg(long, value_enum)]
+        axis: AxisArg,
+        /// One or more `step` recordings (CSV, see `codegen::identify::recording`).
+        #[arg(long, required = true, num_args = 1..)]
+        csv: Vec<PathBuf>,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// ψ_M from zero-current runs at steady speed (thesis A §6.5, (6.10)); writes
+    /// flux_linkage.
+    Flux {
+        /// The motor spec to update.
+        spec: PathBuf,
+        /// One or more `flux` recordings.
+        #[arg(long, required = true, num_args = 1..)]
+        csv: Vec<PathBuf>,
+        #[command(flatten)]
+        common: Common,
+    },
+    /// Resolver offset from alignment runs (thesis A §6.3, (6.9)), written as
+    /// resolver_offset; pole-pair ratio and direction from rotation runs (§6.4),
+    /// checked against the spec's pole pairs.
+    Resolver {
+        /// The motor spec to update.
+        spec: PathBuf,
+        /// `resolver_offset` recordings.
+        #[arg(long, num_args = 1..)]
+        offset: Vec<PathBuf>,
+        /// `pole_pair_ratio` recordings.
+        #[arg(long, num_args = 1..)]
+        ratio: Vec<PathBuf>,
+        #[command(flatten)]
+        common: Common,
+    },
+}
+
+/// Options of every identification.
+#[derive(Args)]
+pub struct Common {
+    /// Print the change to the spec instead of writing it.
+    #[arg(long)]
+    dry_run: bool,
+    /// Identification date written to `date` (YYYY-MM-DD; default: today, UTC).
+    #[arg(long)]
+    date: Option<String>,
+    /// T_s of the recordings' `sample` column when they do not state it, e.g. "50 µs"
+    /// (default: 1/switching_frequency of the spec).
+    #[arg(long)]
+    sample_period: Option<String>,
+}
+
+/// `--axis`.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum AxisArg {
+    /// Direct axis.
+    D,
+    /// Quadrature axis.
+    Q,
+}
+
+/// Runs one identification; prints results or located errors.
+pub fn run(what: What) -> ExitCode {
+    match run_inner(what) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprint!("{e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+fn plain_error(file: &str, problem: String, accepted: &str) -> Diagnostics {
+    Diagnostics(vec![Diagnostic {
+        file: file.to_string(),
+        line: 1,
+        column: 1,
+        key: String::new(),
+        problem,
+        accepted: accepted.to_string(),
+        excerpt: String::new(),
+    }])
+}
+
+/// The spec's text and design.
+fn load(spec: &Path) -> Result<(String, Design), Diagnostics> {
+    let text = crate::read_spec(spec)?;
+    let design = codegen::design_source(&spec.display().to_string(), &text)?;
+    Ok((text, design))
+}
+
+/// Reads and parses every recording; all problems are reported together.
+fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Recording>, Diagnostics> {
+    let mut out = Vec::new();
+    let mut errors = Vec::new();
+    for f in files {
+        let name = f.display().to_string();
+        match std::fs::read_to_string(f) {
+            Ok(text) => match recording::parse(&name, &text, kind, ts) {
+                Ok(r) => out.push(r),
+                Err(e) => errors.extend(e.0),
+            },
+            Err(e) => errors.extend(
+                plain_error(
+                    &name,
+                    format!("cannot read the recording: {e}"),
+                    "a readable UTF-8 CSV recording",
+                )
+                .0,
+            ),
+        }
+    }
+    if errors.is_empty() {
+        Ok(out)
+    } else {
+        Err(Diagnostics(errors))
+    }
+}
+
+fn sample_period(common: &Common, design: &Design) -> Result<f64, Diagnostics> {
+    match &common.sample_period {
+        None => Ok(design.drive.sample_period_s),
+        Some(s) => units::parse(Kind::Time, s).ok().filter(|t| *t > 0.0).ok_or_else(|| {
+            plain_error(
+                "--sample-period",
+                format!("`{s}` is not a positive time"),
+                Kind::Time.accepted(),
+            )
+        }),
+    }
+}
+
+/// Today (UTC) as YYYY-MM-DD.
+fn today() -> String {
+    let secs = std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_secs());
+    writeback::date_from_unix_days((secs / 86_400) as i64)
+}
+
+fn names(files: &[PathBuf]) -> Vec<String> {
+    files
+        .iter()
+        .map(|f| {
+            f.file_name()
+                .map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned())
+        })
+        .collect()
+}
+
+/// The file name without its directory, for the result tables.
+fn short(file: &str) -> String {
+    Path::new(file)
+        .file_name()
+        .map_or_else(|| file.to_string(), |n| n.to_string_lossy().into_owned())
+}
+
+fn spread_note(label: &str, s: &Spread) -> String {
+    if s.count > 1 {
+        format!(
+            "{label}, mean of {} recordings, ±{:.2} % (1σ)",
+            s.count,
+            s.relative_percent()
+        )
+    } else {
+        format!("{label}, 1 recording")
+    }
+}
+
+/// Writes `entries` into the spec (or prints the change), after checking the new spec.
+fn write_back(
+    spec: &Path,
+    text: &str,
+    entries: &[Entry],
+    origin: &Origin<'_>,
+    dry_run: bool,
+) -> Result<(), Diagnostics> {
+    let file = spec.display().to_string();
+    let new = writeback::apply(text, entries, origin)
+        .map_err(|e| plain_error(&file, e, "a spec that `motorgen check` accepts"))?;
+    // The updated spec must still design; otherwise nothing is written.
+    let design = codegen::design_source(&file, &new)?;
+    if dry_run {
+        println!("--dry-run: {file} would change as follows (nothing written):");
+        print!("{}", writeback::line_diff(text, &new));
+        return Ok(());
+    }
+    let dir = spec
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .unwrap_or(Path::new("."));
+    let stem = spec
+        .file_name()
+        .map_or_else(|| "spec".into(), |n| n.to_string_lossy().into_owned());
+    let tmp = dir.join(format!(".{stem}.identify.tmp"));
+    let result = std::fs::write(&tmp, new.as_bytes()).and_then(|()| std::fs::rename(&tmp, spec));
+    if let Err(e) = result {
+        let _ = std::fs::remove_file(&tmp);
+        return Err(plain_error(
+            &file,
+            format!("cannot write the updated spec: {e}"),
+            "a writable spec file and directory",
+        ));
+    }
+    let keys: Vec<&str> = entries.iter().map(|e| e.key).collect();
+    println!("wrote [motor.identified] {} to {file}", keys.join(", "));
+    let prov: Vec<String> = design
+        .motor
+        .provenance
+        .iter()
+        .map(|(k, o)| format!("{k}: {}", format!("{:?}", o.source).to_lowercase()))
+        .collect();
+    println!("design provenance now: {}", prov.join(", "));
+    Ok(())
+}
+
+fn run_inner(what: What) -> Result<(), Diagnostics> {
+    match what {
+        What::Step {
+            spec,
+            axis,
+            csv,
+            common,
+        } => step(&spec, axis, &csv, &common),
+        What::Flux { spec, csv, common } => flux_cmd(&spec, &csv, &common),
+        What::Resolver {
+            spec,
+            offset,
+            ratio,
+            common,
+        } => resolver_cmd(&spec, &offset, &ratio, &common),
+    }
+}
+
+fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
+    let (text, design) = load(spec)?;
+    let ts = sample_period(common, &design)?;
+    let recs = recordings(csv, RecordingKind::Step, ts)?;
+    let (axis, name) = match axis {
+        AxisArg::D => (Axis::D, "d"),
+        AxisArg::Q => (Axis::Q, "q"),
+    };
+    let setup = StepSetup {
+        axis,
+        taps_q15: design.fir.taps_q15.clone(),
+        current_full_scale_a: design.scaling.phase_current.full_scale,
+        current_limit_a: design.motor.peak_current_a,
+        voltage_limit_v: design.current_loop.voltage_limit_v,
+    };
+    let mut estimates: Vec<StepEstimate> = Vec::new();
+    let mut errors = Vec::new();
+    for r in &recs {
+        match identify_step(r, &setup) {
+            Ok(e) => estimates.push(e),
+            Err(e) => errors.extend(e.0),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(Diagnostics(errors));
+    }
+    println!(
+        "{name} axis, {} recording(s), FIR order {} (group delay {} samples), T_s = {:.1} µs",
+        recs.len(),
+        design.fir.order,
+        design.fir.group_delay_samples,
+        recs[0].sample_period_s * 1e6
+    );
+    println!(
+        "  {:<20} {:>8} {:>10} {:>10} {:>10} {:>12} {:>12}",
+        "recording", "U [V]", "R [Ω]", "τ [ms]", "L [mH]", "t_5% [T_s]", "T_d [T_s]"
+    );
+    for (r, e) in recs.iter().zip(&estimates) {
+        println!(
+            "  {:<20} {:>8.3} {:>10.5} {:>10.4} {:>10.5} {:>12.2} {:>12.2}",
+            short(&r.file),
+            e.voltage_v,
+            e.resistance_ohm,
+            e.time_constant_s * 1e3,
+            e.inductance_h * 1e3,
+            e.crossing_5_samples,
+            e.delay_samples
+        );
+    }
+    let collect = |f: fn(&StepEstimate) -> f64| Spread::of(&estimates.iter().map(f).collect::<Vec<_>>());
+    let (Some(r), Some(l), Some(d)) = (
+        collect(|e| e.resistance_ohm),
+        collect(|e| e.inductance_h),
+        collect(|e| e.delay_samples),
+    ) else {
+        return Err(plain_error(
+            &spec.display().to_string(),
+            "no recordings".into(),
+            "--csv FILE…",
+        ));
+    };
+    println!(
+        "  mean: R = {:.5} Ω ± {:.2} %, L_{name} = {:.5} mH ± {:.2} %, transport delay {:.2} ± {:.2} samples (1σ)",
+        r.mean,
+        r.relative_percent(),
+        l.mean * 1e3,
+        l.relative_percent(),
+        d.mean,
+        d.std_dev
+    );
+    println!(
+        "  (the angle lead assumes {} samples of delay, angle_observer.lead_samples)",
+        design.angle_observer.lead_samples
+    );
+    let label = format!("step {name}");
+    let files = names(csv);
+    let date = common.date.clone().unwrap_or_else(today);
+    let entries = [
+        Entry {
+            key: "phase_resistance",
+            value: writeback::ohms(r.mean),
+            note: spread_note(&format!("R_{name} (6.3), {label}"), &r),
+        },
+        Entry {
+            key: if name == "d" { "d_inductance" } else { "q_inductance" },
+            value: writeback::henries(l.mean),
+            note: spread_note(&format!("L = R·T_r/ln 9 (6.8), {label}"), &l),
+        },
+    ];
+    let origin = Origin {
+        date: &date,
+        label: &label,
+        files: &files,
+    };
+    write_back(spec, &text, &entries, &origin, common.dry_run)
+}
+
+fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
+    let (text, design) = load(spec)?;
+    let ts = sample_period(common, &design)?;
+    let recs = recordings(csv, RecordingKind::Flux, ts)?;
+    let setup = flux::FluxSetup {
+        resistance_ohm: design.motor.phase_resistance_ohm,
+        d_inductance_h: design.motor.d_inductance_h,
+        max_current_a: 0.1 * design.motor.peak_current_a,
+        min_speed_rad_s: 0.05 * design.motor.max_electrical_speed_rad_s,
+        voltage_limit_v: design.current_loop.voltage_limit_v,
+    };
+    let mut values = Vec::new();
+    let mut errors = Vec::new();
+    for r in &recs {
+        match flux::identify_flux(r, &setup) {
+            Ok(e) => {
+                println!(
+                    "  {:<20} ω_e = {:>9.1} rad/s  ψ_M = {:.5} Wb (current correction {:+.2e} Wb)",
+                    short(&r.file),
+                    e.mean_speed_rad_s,
+                    e.flux_linkage_wb,
+                    -e.correction_wb
+                );
+                values.push(e.flux_linkage_wb);
+            }
+            Err(e) => errors.extend(e.0),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(Diagnostics(errors));
+    }
+    let Some(s) = Spread::of(&values) else {
+        return Err(plain_error(
+            &spec.display().to_string(),
+            "no recordings".into(),
+            "--csv FILE…",
+        ));
+    };
+    println!("  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
+    let files = names(csv);
+    let date = common.date.clone().unwrap_or_else(today);
+    let entries = [Entry {
+        key: "flux_linkage",
+        value: writeback::webers(s.mean),
+        note: spread_note("ψ_M = Σu_q/Σω_e at i = 0 (6.10), flux", &s),
+    }];
+    let origin = Origin {
+        date: &date,
+        label: "flux",
+        files: &files,
+    };
+    write_back(spec, &text, &entries, &origin, common.dry_run)
+}
+
+fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
+    let file = spec.display().to_string();
+    if offset.is_empty() && ratio.is_empty() {
+        return Err(plain_error(
+            "motorgen identify resolver",
+            "no recordings given".into(),
+            "--offset FILE… (resolver_offset runs) and/or --ratio FILE… (pole_pair_ratio runs)",
+        ));
+    }
+    let (text, design) = load(spec)?;
+    let ts = sample_period(common, &design)?;
+    let (np, nr) = (
+        design.angle_observer.motor_pole_pairs,
+        design.angle_observer.resolver_pole_pairs,
+    );
+    let mut errors = Vec::new();
+    // Ratio and direction first: an offset is meaningless with the wrong ratio.
+    let ratio_recs = recordings(ratio, RecordingKind::PolePairRatio, ts)?;
+    let mut ratios: Vec<RatioEstimate> = Vec::new();
+    for r in &ratio_recs {
+        match resolver::identify_ratio(r) {
+            Ok(e) => {
+                println!(
+                    "  {:<20} n_p/n_r = {:.4}, directions {}",
+                    short(&r.file),
+                    e.ratio,
+                    if e.directions_agree { "agree" } else { "DISAGREE" }
+                );
+                ratios.push(e);
+            }
+            Err(e) => errors.extend(e.0),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(Diagnostics(errors));
+    }
+    let expected = f64::from(np) / f64::from(nr);
+    let src = Source {
+        file: &file,
+        text: &text,
+    };
+    let at = writeback::value_span(&text, &["motor", "pole_pairs"]).unwrap_or(0..0);
+    for (r, e) in ratio_recs.iter().zip(&ratios) {
+        if !e.directions_agree {
+            errors.push(src.error(
+                at.clone(),
+                "motor.pole_pairs",
+                format!(
+                    "{}: the resolver turns against the stator field (§6.4 direction check)",
+                    r.file
+                ),
+                "swap two motor phases or the resolver's sine and cosine, then record again",
+            ));
+        } else if (e.ratio / expected - 1.0).abs() > 0.05 {
+            errors.push(src.error(
+                at.clone(),
+                "motor.pole_pairs",
+                format!(
+                    "{}: the measured n_p/n_r = {:.3} disagrees with the spec's {np}/{nr} = {expected:.3}",
+                    r.file, e.ratio
+                ),
+                format!(
+                    "motor.pole_pairs and resolver.pole_pairs whose ratio is {:.0} (e.g. pole_pairs = {:.0} for a 1-pole-pair resolver)",
+                    e.ratio.round(),
+                    e.ratio.round()
+                ),
+            ));
+        }
+    }
+    if !errors.is_empty() {
+        return Err(Diagnostics(errors));
+    }
+    if !ratios.is_empty() {
+        println!("  pole-pair ratio agrees with the spec ({np}/{nr}); directions agree");
+    }
+    if offset.is_empty() {
+        return Ok(());
+    }
+    let recs = recordings(offset, RecordingKind::ResolverOffset, ts)?;
+    let mut offsets = Vec::new();
+    for r in &recs {
+        match resolver::identify_offset(r, np, nr) {
+            Ok(e) => {
+                println!(
+                    "  {:<20} θ_off = {:.5} rad (θ_r within ±{:.5} rad over {} rows)",
+                    short(&r.file),
+                    e.offset_rad,
+                    e.deviation_rad,
+                    e.rows
+                );
+                offsets.push(e.offset_rad);
+            }
+            Err(e) => errors.extend(e.0),
+        }
+    }
+    if !errors.is_empty() {
+        return Err(Diagnostics(errors));
+    }
+    let Some((mean, dev)) = resolver::combine_offsets(&offsets, np, nr) else {
+        return Err(plain_error(&file, "no recordings".into(), "--offset FILE…"));
+    };
+    println!(
+        "  mean: θ_off = {mean:.5} rad (mod 2π·n_r/n_p), runs within ±{:.3}° electrical",
+        (dev * f64::from(np) / f64::from(nr)).to_degrees()
+    );
+    let files = names(offset);
+    let date = common.date.clone().unwrap_or_else(today);
+    let entries = [Entry {
+        key: "resolver_offset",
+        value: writeback::radians(mean),
+        note: format!("θ_off = θ_r aligned to phase U (6.9), {} run(s)", offsets.len()),
+    }];
+    let origin = Origin {
+        date: &date,
+        label: "resolver offset",
+        files: &files,
+    };
+    write_back(spec, &text, &entries, &origin, common.dry_run)
+}
