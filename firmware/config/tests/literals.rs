@@ -248,11 +248,7 @@ fn no_motor_or_tuning_literals_in_the_firmware() {
         }
         for l in literals(code) {
             let v = l.value.abs();
-            if generated.iter().any(|g| (g - v).abs() <= 1e-6 * g.max(1.0))
-                && !l.radix
-                && v > 32.0
-                && !is_round(v)
-            {
+            if generated.iter().any(|g| (g - v).abs() <= 1e-6 * g.max(1.0)) && !l.radix && v > 32.0 && !is_round(v) {
                 problems.push(format!(
                     "{}:{}: literal {} equals a generated motor constant",
                     path.display(),
