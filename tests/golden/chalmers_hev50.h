@@ -297,7 +297,7 @@ static const float SENSORLESS_HIGHPASS = 18.849556f;
 static const float SENSORLESS_LOWPASS = 735.0f;
 
 /** 246.269 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max, thesis B (4.59), (4.69), Table 4.1.
- *  Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 137.517 rad/s (θ̃ = 10.0°), I_max = 316.784 A. */
+ *  Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 65.8568 rad/s (θ̃ = 10.0°), I_max = 316.784 A. */
 static const float SENSORLESS_LOW_SPEED = 246.26897f;
 
 /** 492.538 rad/s: ω_hs = 2·ω_ls, thesis B Table 4.1.

@@ -438,7 +438,7 @@ pub mod sensorless {
     pub const LOWPASS: f32 = 735.0;
     /// 246.269 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
     ///
-    /// Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 137.517 rad/s (θ̃ = 10.0°), I_max = 316.784 A.
+    /// Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 65.8568 rad/s (θ̃ = 10.0°), I_max = 316.784 A.
     pub const LOW_SPEED: f32 = 246.26897;
     /// 492.538 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
     ///

@@ -301,14 +301,14 @@ pub mod sensorless {
     ///
     /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
     pub const LOWPASS: f32 = 0.0;
-    /// 2061.49 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
+    /// 0 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
     ///
-    /// Inputs: ω_min1 = 0 rad/s, ω_min2 = 2061.49 rad/s (θ̃ = 10.0°), I_max = 86.267 A.
-    pub const LOW_SPEED: f32 = 2061.4932;
-    /// 4122.99 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
+    /// Inputs: ω_min1 = 0 rad/s, ω_min2 = 0 rad/s (θ̃ = 10.0°), I_max = 86.267 A.
+    pub const LOW_SPEED: f32 = 0.0;
+    /// 0 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
     ///
     /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
-    pub const HIGH_SPEED: f32 = 4122.9863;
+    pub const HIGH_SPEED: f32 = 0.0;
     /// 10 rad/s: `Δω1 = ρ: γ0 = 0 below`, thesis B (4.83), §4.6.
     ///
     /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).

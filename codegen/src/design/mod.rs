@@ -346,6 +346,7 @@ fn sensorless_design(
         speed_max,
         current_bandwidth: spec.current_loop.bandwidth.value,
         switching: 2.0 * PI * spec.drive.switching_frequency.value,
+        voltage_max: spec.drive.dc_link_voltage.value / 3f64.sqrt(),
         speed_base: per_unit.map(|p| p.bases.angular_frequency_rad_s),
         pole_pairs: f64::from(m.pole_pairs),
         choices: sensorless::Choices {

@@ -30,6 +30,8 @@ pub struct Inputs {
     pub current_bandwidth: f64,
     /// ω_sw = 2π·f_sw [rad/s].
     pub switching: f64,
+    /// V_max = U_dc/√3, the largest phase-voltage amplitude [V].
+    pub voltage_max: f64,
     /// ω_base of the per-unit system [rad/s], if the spec defines one.
     pub speed_base: Option<f64>,
     /// Motor pole pairs (mechanical → electrical acceleration).
@@ -168,6 +170,15 @@ pub fn omega_min2(resistance_error: f64, id: f64, angle_error: f64, psi: f64, de
     (resistance_error * id / (angle_error * (psi - delta_l * id))).abs()
 }
 
+/// The MTPA d-current at current magnitude `current` (thesis B (3.10) on the circle
+/// i_d² + i_q² = I²): i_d = (ψ_m − √(ψ_m² + 8·ΔL²·I²))/(4·ΔL); 0 without saliency.
+pub fn mtpa_id(current: f64, psi: f64, delta_l: f64) -> f64 {
+    if delta_l <= 0.0 {
+        return 0.0;
+    }
+    (psi - (psi * psi + 8.0 * delta_l * delta_l * current * current).sqrt()) / (4.0 * delta_l)
+}
+
 /// |i_q| ≤ ψ_m/ΔL (4.66).
 pub fn iq_limit_bifurcation(psi: f64, delta_l: f64) -> f64 {
     psi / delta_l
@@ -177,6 +188,11 @@ pub fn iq_limit_bifurcation(psi: f64, delta_l: f64) -> f64 {
 pub fn iq_limit_resetting(rho: f64, psi: f64, gamma0: f64, speed_max: f64, delta_l: f64) -> f64 {
     rho * rho * psi / (gamma0 * speed_max * delta_l)
 }
+
+/// The largest share of V_max the carrier may take by default: thesis B §4.3.1 allows
+/// V_e = 0.2 pu "for high-frequency signal injection" (V_max = 1 pu at the nominal DC
+/// link, Appendix A).
+pub const MAX_INJECTION_SHARE: f64 = 0.2;
 
 /// The design, with the warnings it raises. ρ above α_c/10 is not checked here
 /// (the caller reports it at the spec key that set it).
@@ -194,10 +210,31 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
     };
     let delta_l = inp.lq - inp.ld;
     let salient = delta_l > 0.0;
-    let injection = salient.then(|| {
-        let lo = 5.0 * inp.current_bandwidth;
+    // Default carrier: as high as (4.34) allows, ω_sw/10, but no higher than the ω_e at
+    // which (4.35) takes MAX_INJECTION_SHARE of V_max. A default must meet (4.34)'s lower
+    // bound 5α_c too; where it cannot, injection is left to the spec
+    // (`injection_frequency`, `injection_voltage`), as the thesis does for its own motor.
+    let lo = 5.0 * inp.current_bandwidth;
+    let voltage_limited = if salient {
+        MAX_INJECTION_SHARE * inp.voltage_max * 10.0 * delta_l / (inp.current_base * inp.ld * inp.lq)
+    } else {
+        0.0
+    };
+    let we_default = (inp.switching / 10.0).min(voltage_limited);
+    let chosen = c.injection_frequency.is_some() || c.injection_voltage.is_some();
+    let injectable = salient && (chosen || we_default >= lo);
+    if salient && !injectable {
+        warnings.push(format!(
+            "sensorless: no signal injection by default: ω_e ≥ 5α_c = {lo:.0} rad/s (4.34) with V_e ≤ {:.0} % of V_max \
+             (4.35) needs ω_e ≤ {voltage_limited:.0} rad/s and ω_e ≤ ω_sw/10 = {:.0} rad/s; set \
+             sensorless.injection_frequency (and injection_voltage) to inject below 5α_c (thesis B §4.3.5)",
+            MAX_INJECTION_SHARE * 100.0,
+            inp.switching / 10.0
+        ));
+    }
+    let injection = injectable.then(|| {
         let hi = inp.switching / 10.0;
-        let we = c.injection_frequency.unwrap_or(hi);
+        let we = c.injection_frequency.unwrap_or(we_default);
         if we < lo || we > hi {
             warnings.push(format!(
                 "sensorless: carrier ω_e = {we:.0} rad/s is outside 5α_c = {lo:.0} … ω_sw/10 = {hi:.0} rad/s \
@@ -244,10 +281,11 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
     } else {
         0.0
     };
-    // (4.69) at the worst case i_d = −I_max (|i_d|/(ψ − ΔL·i_d) grows with −i_d).
+    // (4.69) at the MTPA d-current of base current: with R̃ = 2R and θ̃ = 10° this is
+    // thesis B's "ω_min2 ≈ 0.05 pu" for its motor (i_d = −0.44 pu).
     let w2 = omega_min2(
         c.resistance_error * inp.resistance,
-        -inp.current_max,
+        mtpa_id(inp.current_base, inp.psi, delta_l),
         c.angle_error,
         inp.psi,
         delta_l,
@@ -368,6 +406,20 @@ mod tests {
         assert!((out.acceleration_tracked_rad_s2 - 1000.0).abs() < 1e-9);
     }
 
+    /// Thesis B after (4.69): θ̃ = 10°, R̃_s = 2R_s "gives ω_min2 ≈ 0.05 pu", at the MTPA
+    /// d-current of base current.
+    #[test]
+    fn omega_min2_is_0_05_pu() {
+        let id = mtpa_id(i_base(), PSI, LQ - LD);
+        // Hand: (0.104 − √(0.010816 + 0.044603))/(1.32e-3) = (0.104 − 0.235413)/1.32e-3
+        // = −99.56 A = −0.44 pu.
+        assert!((id + 99.56).abs() < 0.01, "{id}");
+        let w = omega_min2(2.0 * R, id, 10f64.to_radians(), PSI, LQ - LD);
+        // Hand: 0.0158·99.56/(0.174533·(0.104 + 0.032855)) = 1.5730/0.023886 = 65.86 rad/s.
+        assert!((w - 65.86).abs() < 0.02, "{w}");
+        assert_eq!((w / w_base() * 100.0).round() / 100.0, 0.05);
+    }
+
     /// (4.69) by hand for the Chalmers motor with R̃ = 2R at i_d = −I_base, θ̃ = 10°.
     #[test]
     fn omega_min2_by_hand() {
@@ -395,16 +447,21 @@ mod tests {
             speed_max: 2.0 * w_base(),
             current_bandwidth: 1470.0,
             switching: 2.0 * PI * 10e3,
+            voltage_max: v_base(),
             speed_base: Some(w_base()),
             pole_pairs: 2.0,
             choices,
         }
     }
 
-    /// Table 4.1 defaults and the properties tying the outputs together.
+    /// Table 4.1 defaults and the properties tying the outputs together; the carrier
+    /// at 500 Hz as the spec sets it (thesis B §4.5.1).
     #[test]
     fn defaults_follow_table_4_1() {
-        let (out, warnings) = design(&chalmers(choices()));
+        let (out, warnings) = design(&chalmers(Choices {
+            injection_frequency: Some(2.0 * PI * 500.0),
+            ..choices()
+        }));
         assert_eq!(out.rho_rule, RhoRule::CurrentLoopBound);
         assert_eq!(out.rho_rad_s, 147.0);
         assert_eq!(out.gamma1, 147.0 * 147.0);
@@ -413,8 +470,7 @@ mod tests {
         assert_eq!(out.omega_ls_rad_s, out.omega_min1_rad_s.max(out.omega_min2_rad_s));
         assert_eq!((out.resetting_lower_rad_s, out.resetting_upper_rad_s), (147.0, 294.0));
         let inj = out.injection.as_ref().unwrap();
-        // Default ω_e = ω_sw/10 = 2π·1 kHz, below 5α_c = 7350 rad/s: warned (4.34).
-        assert!((inj.frequency_rad_s - 2.0 * PI * 1e3).abs() < 1e-9);
+        // 500 Hz is below 5α_c = 7350 rad/s: warned (4.34).
         assert!(warnings.iter().any(|w| w.contains("(4.34)")));
         assert_eq!(inj.voltage_v, inj.voltage_min_v);
         assert_eq!(inj.lowpass_rad_s, 5.0 * 147.0);
@@ -426,6 +482,27 @@ mod tests {
         // (4.92) with γ0 = ρ: ρ·ψ/(ω_max·ΔL).
         let lim = out.iq_limit_resetting_a.unwrap();
         assert!((lim - 147.0 * PSI / (2.0 * w_base() * (LQ - LD))).abs() < 1e-9);
+    }
+
+    /// Without a carrier in the spec: (4.35) at 0.2·V_max allows ω_e ≤
+    /// 0.2·184.75·10·0.33e-3/(226.27·0.23e-3·0.56e-3) = 4184 rad/s, below 5α_c = 7350
+    /// rad/s, so the default cannot meet (4.34): no injection, warned.
+    #[test]
+    fn no_default_carrier_when_4_34_and_4_35_cannot_both_hold() {
+        let (out, warnings) = design(&chalmers(choices()));
+        assert!(out.injection.is_none());
+        let w = warnings
+            .iter()
+            .find(|w| w.contains("no signal injection by default"))
+            .unwrap();
+        assert!(w.contains("4184"), "{w}");
+        // A faster switching frequency does not help; a slower current loop does:
+        // α_c = 800 rad/s → 5α_c = 4000 rad/s ≤ 4184 rad/s, so ω_e = 4184 rad/s.
+        let mut slow = chalmers(choices());
+        slow.current_bandwidth = 800.0;
+        let inj = design(&slow).0.injection.unwrap();
+        assert!((inj.frequency_rad_s - 4184.0).abs() < 1.0, "{}", inj.frequency_rad_s);
+        assert!((inj.voltage_v - 0.2 * v_base()).abs() < 1e-9);
     }
 
     /// A non-salient motor has no injection and no ω_min1; its ω_ls comes from (4.69).
