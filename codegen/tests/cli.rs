@@ -2,23 +2,13 @@
 //! located messages (file:line:column, key, problem, accepted), exit non-zero,
 //! print nothing on stdout and never panic.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{motorgen, repo};
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
+use std::path::{Path, PathBuf};
 
 fn fischer() -> String {
     std::fs::read_to_string(repo().join("motors/fischer-ti085.toml")).unwrap()
-}
-
-fn motorgen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_motorgen"))
-        .args(args)
-        .current_dir(repo())
-        .output()
-        .unwrap()
 }
 
 /// Writes `bytes` to a fresh file under the test temp dir and returns its path.

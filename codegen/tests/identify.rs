@@ -11,8 +11,10 @@
 //!   `motorgen design` shows provenance "identified" → `motorgen verify` passes.
 //! * Bad recordings fail with located errors and write nothing.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+mod common;
+use common::{motorgen, repo};
+
+use std::path::PathBuf;
 
 use codegen::identify::Spread;
 use codegen::identify::recording::{self, RecordingKind, StepRun, write_step_csv};
@@ -20,23 +22,8 @@ use codegen::identify::step::{StepSetup, identify_step};
 use codegen::{Design, Source};
 use motor_control::commissioning::{Axis, Progress, VoltageStep, VoltageStepState};
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn motorgen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_motorgen"))
-        .args(args)
-        .current_dir(repo())
-        .output()
-        .unwrap()
-}
-
 fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("identify").join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::tmp("identify", name)
 }
 
 fn design_of(stem: &str) -> (String, Design) {

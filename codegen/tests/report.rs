@@ -3,26 +3,14 @@
 //! load without console messages, every plot must be in the DOM after load as an
 //! `<svg>` with lines and text, and a screenshot is taken (kept in the test temp dir).
 
+mod common;
+use common::{motorgen, repo};
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
-}
-
-fn motorgen(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_motorgen"))
-        .args(args)
-        .current_dir(repo())
-        .output()
-        .unwrap()
-}
-
 fn tmp(name: &str) -> PathBuf {
-    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("report").join(name);
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    common::tmp("report", name)
 }
 
 fn motors() -> Vec<String> {

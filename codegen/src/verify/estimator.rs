@@ -23,7 +23,7 @@ use motor_control::transforms::Dq;
 
 use super::plant::{SpeedProfile, wrap};
 use super::sim::{Bench, angle_q31};
-use super::{Check, ScenarioResult, Series, Setup, format_value};
+use super::{Check, ScenarioResult, Setup, format_value, series};
 use crate::design::Design;
 
 /// Initial speed error in units of ρ: Fig. 4.17's 0.5 pu drop at ρ = 0.1 pu.
@@ -281,12 +281,5 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
         reference: "thesis B (4.7), (4.51), (4.76)–(4.83), Figs. 4.17, 4.18, App. D",
         checks,
         traces,
-    }
-}
-
-fn series(label: &str, values: Vec<f64>) -> Series {
-    Series {
-        label: label.into(),
-        values,
     }
 }

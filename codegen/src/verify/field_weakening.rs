@@ -20,7 +20,7 @@ use motor_control::transforms::{Dq, INV_SQRT_3};
 
 use super::plant::{MotorModel, SpeedProfile};
 use super::sim::Bench;
-use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
+use super::{Check, ScenarioResult, Series, Setup, Trace, format_value, series};
 use crate::design::Design;
 
 /// Electrical base speed ω_base [rad/s] of (2.60), from the design.
@@ -328,13 +328,6 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
         reference: "thesis B (2.50)–(2.57), (2.60), Fig. 2.15, App. D",
         checks,
         traces,
-    }
-}
-
-fn series(label: &str, values: Vec<f64>) -> Series {
-    Series {
-        label: label.into(),
-        values,
     }
 }
 

@@ -65,6 +65,14 @@ pub struct Series {
     pub values: Vec<f64>,
 }
 
+/// A labelled series.
+pub(crate) fn series(label: &str, values: Vec<f64>) -> Series {
+    Series {
+        label: label.into(),
+        values,
+    }
+}
+
 /// Recorded signals of a scenario, for plots.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Trace {

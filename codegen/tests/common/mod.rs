@@ -1,0 +1,29 @@
+//! Helpers shared by the CLI-level integration tests: the repository root, `motorgen`
+//! run as a user runs it, and fresh temp directories.
+
+#![allow(dead_code)] // each test crate uses its own subset
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+/// The repository root.
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// `motorgen <args>` in the repository root.
+pub fn motorgen(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_motorgen"))
+        .args(args)
+        .current_dir(repo())
+        .output()
+        .unwrap()
+}
+
+/// An empty directory `<target tmp>/<group>/<name>`.
+pub fn tmp(group: &str, name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join(group).join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
