@@ -123,6 +123,60 @@ pub fn summary(d: &Design) -> String {
                 t.smp_code, t.cycles
             ))
         )?;
+        if let Some(fw) = &d.field_weakening {
+            writeln!(
+                s,
+                "field weakening: V'_max = {} V_max = {:.2} V, α_fw = {:.2} rad/s ({:?}), ω_base = {:.1} rad/s, γ(ω_base) = {:.5} A/(V²·s) (2.60)",
+                fw.voltage_fraction,
+                fw.voltage_limit_v,
+                fw.bandwidth_rad_s,
+                fw.bandwidth_rule,
+                fw.base_speed_rad_s,
+                fw.gain_at_base_speed
+            )?;
+            writeln!(
+                s,
+                "  {:.2} A ≤ i_d^ref ≤ i_d,MTPA (2.56); MTPA at I_max: i_d = {:.2} A, mode-B i_q = {:.2} A (2.57); {}-point MTPA table, max interpolation error {:.4} A (3.10)",
+                fw.id_min_a,
+                fw.id_mtpa_at_current_max_a,
+                fw.iq_mode_b_at_mtpa_a,
+                fw.mtpa.iq_a.len(),
+                fw.mtpa.max_interpolation_error_a
+            )?;
+            if let Some(lm) = &fw.loss_minimisation {
+                writeln!(
+                    s,
+                    "  loss-minimising i_d: {}×{} table (speed × i_q), max interpolation error {:.3} A (3.3)–(3.14)",
+                    lm.table.speeds_rad_s.len(),
+                    lm.table.iq_a.len(),
+                    lm.table.max_interpolation_error_a
+                )?;
+            }
+        }
+        if let Some(se) = &d.sensorless {
+            writeln!(
+                s,
+                "sensorless: ρ = {:.1} rad/s ({:?}, ≤ α_c/10 = {:.1}), γ1 = ρ² = {:.1}, γ2 = 2ρ = {:.1} (4.7)",
+                se.rho_rad_s, se.rho_rule, se.rho_max_rad_s, se.gamma1, se.gamma2
+            )?;
+            if let Some(inj) = &se.injection {
+                writeln!(
+                    s,
+                    "  injection: ω_e = {:.0} rad/s (range {:.0} … {:.0}, 4.34), V_e = {:.2} V (≥ {:.2} V, 4.35), K_e = {:.3} A (4.19)",
+                    inj.frequency_rad_s,
+                    inj.frequency_min_rad_s,
+                    inj.frequency_max_rad_s,
+                    inj.voltage_v,
+                    inj.voltage_min_v,
+                    inj.gain_ke_a
+                )?;
+            }
+            writeln!(
+                s,
+                "  ω_min1 = {:.1} (4.59), ω_min2 = {:.1} (4.69), ω_ls = {:.1}, ω_hs = {:.1} rad/s (Table 4.1)",
+                se.omega_min1_rad_s, se.omega_min2_rad_s, se.omega_ls_rad_s, se.omega_hs_rad_s
+            )?;
+        }
         for w in &d.warnings {
             writeln!(s, "warning: {w}")?;
         }

@@ -83,6 +83,27 @@ fn seed_motors_design_and_check() {
     }
 }
 
+/// The summary carries the thesis-B rules. Hand check for the Chalmers spec
+/// (α_c = 1470 rad/s, thesis B Table B.2): ρ = α_c/10 = 147 rad/s, γ1 = ρ² = 21609,
+/// γ2 = 2ρ = 294 (4.7); V'_max = 0.9·V_max.
+#[test]
+fn summary_shows_field_weakening_and_sensorless() {
+    let out = motorgen(&["design", "motors/chalmers-hev50.toml"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let s = String::from_utf8_lossy(&out.stdout);
+    for needle in [
+        "field weakening: V'_max = 0.9 V_max",
+        "ρ = 147.0 rad/s",
+        "γ1 = ρ² = 21609.0, γ2 = 2ρ = 294.0 (4.7)",
+        "17-point MTPA table",
+    ] {
+        assert!(s.contains(needle), "{needle:?} not in\n{s}");
+    }
+    // Fischer has no [sensorless] section and is not salient: no injection line.
+    let out = motorgen(&["design", "motors/fischer-ti085.toml"]);
+    assert!(!String::from_utf8_lossy(&out.stdout).contains("injection:"));
+}
+
 #[test]
 fn syntax_error() {
     let (t, line) = mutate("pole_pairs = 4 ", "pole_pairs = = 4 ");
