@@ -1,17 +1,27 @@
 //! The firmware workspace lives apart from the host workspace (Cargo has no stable
 //! per-package target); these tests run its host tests and its target build so that
 //! `cargo test --workspace` covers everything.
+//!
+//! Every cargo run here uses the firmware workspace's own target directory,
+//! `firmware/target` — the one a user's `motorgen firmware` and `cargo clippy` in
+//! `firmware/` use — so each profile's dependencies (the STM32G4 PAC, the build script's
+//! design engine) compile once; cargo's lock serialises the runs.
 
 use std::process::Command;
 
-fn cargo_in_firmware(args: &[&str], target_dir: &str) {
-    let repo = motor_tests::repo();
-    let out = Command::new(env!("CARGO"))
+/// `cargo` in `firmware/`, building in `firmware/target`.
+fn cargo(args: &[&str]) -> Command {
+    let firmware = motor_tests::repo().join("firmware");
+    let mut cargo = Command::new(env!("CARGO"));
+    cargo
         .args(args)
-        .current_dir(repo.join("firmware"))
-        .env("CARGO_TARGET_DIR", repo.join("target").join(target_dir))
-        .output()
-        .expect("cargo runs");
+        .current_dir(&firmware)
+        .env("CARGO_TARGET_DIR", firmware.join("target"));
+    cargo
+}
+
+fn cargo_in_firmware(args: &[&str]) {
+    let out = cargo(args).output().expect("cargo runs");
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(
@@ -26,15 +36,12 @@ fn cargo_in_firmware(args: &[&str], target_dir: &str) {
 
 #[test]
 fn firmware_control_core_host_tests_pass() {
-    cargo_in_firmware(&["test", "--locked", "--workspace"], "firmware-host");
+    cargo_in_firmware(&["test", "--locked", "--workspace"]);
 }
 
 #[test]
 fn firmware_control_core_builds_for_the_cortex_m4f() {
-    cargo_in_firmware(
-        &["build", "--locked", "--release", "--target", "thumbv7em-none-eabihf"],
-        "firmware-target",
-    );
+    cargo_in_firmware(&["build", "--locked", "--release", "--target", "thumbv7em-none-eabihf"]);
 }
 
 /// A bad spec fails the firmware build with the CLI's located message (`cargo::error=`),
@@ -64,10 +71,7 @@ fn firmware_build_reports_spec_errors_like_the_cli() {
             vec!["MOTOR=no-such-motor".into(), "bad-motor, good-motor".into()],
         ),
     ] {
-        let out = Command::new(env!("CARGO"))
-            .args(["build", "--locked", "-p", "motor-firmware"])
-            .current_dir(repo.join("firmware"))
-            .env("CARGO_TARGET_DIR", repo.join("target").join("firmware-host"))
+        let out = cargo(&["build", "--locked", "-p", "motor-firmware"])
             .env("MOTOR", motor)
             .env("MOTORS_DIR", &dir)
             .output()

@@ -2,13 +2,17 @@
 //! `target/firmware/`, is a valid STM32G474 flash image and fits in 64 KiB; an unknown
 //! stem and a bad spec are refused before anything is built or written.
 //!
-//! `CARGO_BIN_EXE_motorgen` exists only inside the codegen package, so the binary is
-//! built here with cargo (in its own target directory: the outer `cargo test` holds
-//! the lock of the default one) and run as a process.
+//! The image builds in the firmware workspace's own target directory, `firmware/target`,
+//! where `motorgen firmware` builds it for a user and where `tests/firmware.rs` builds the
+//! control core: one target directory, so the STM32G4 PAC and the build script's design
+//! engine compile once per profile.
 
-use std::path::{Path, PathBuf};
+mod common;
+
+use std::path::Path;
 use std::process::{Command, Output};
-use std::sync::OnceLock;
+
+use common::repo;
 
 /// STM32G474RE memory map (RM0440 §2.2, Table 3 / §2.3): flash from 0x0800_0000
 /// (512 KiB); SRAM1 80 KiB at 0x2000_0000, SRAM2 16 KiB at 0x2001_4000 and the CCM
@@ -17,48 +21,14 @@ use std::sync::OnceLock;
 const FLASH_START: u32 = 0x0800_0000;
 const RAM_END: u32 = 0x2002_0000;
 
-/// Builds `motorgen` once and returns its path.
-fn motorgen_exe() -> &'static Path {
-    static EXE: OnceLock<PathBuf> = OnceLock::new();
-    EXE.get_or_init(|| {
-        let repo = motor_tests::repo();
-        let out = Command::new(env!("CARGO"))
-            .args([
-                "build",
-                "--locked",
-                "-p",
-                "codegen",
-                "--bin",
-                "motorgen",
-                "--message-format=json",
-            ])
-            .current_dir(&repo)
-            .env("CARGO_TARGET_DIR", repo.join("target").join("motorgen-cli"))
-            .output()
-            .expect("cargo runs");
-        assert!(
-            out.status.success(),
-            "building motorgen failed:\n{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        String::from_utf8_lossy(&out.stdout)
-            .lines()
-            .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
-            .filter(|m| m["reason"] == "compiler-artifact" && m["target"]["name"] == "motorgen")
-            .find_map(|m| m["executable"].as_str().map(PathBuf::from))
-            .expect("cargo reports the motorgen executable")
-    })
-}
-
-/// Runs `motorgen firmware <args>` from the repository root; the firmware builds in the
-/// target directory `tests/firmware.rs` also uses for the thumbv7em build.
+/// Runs `motorgen firmware <args>` from the repository root.
 fn firmware(args: &[&str]) -> Output {
-    let repo = motor_tests::repo();
-    Command::new(motorgen_exe())
+    let repo = repo();
+    Command::new(env!("CARGO_BIN_EXE_motorgen"))
         .arg("firmware")
         .args(args)
         .current_dir(&repo)
-        .env("CARGO_TARGET_DIR", repo.join("target").join("firmware-target"))
+        .env("CARGO_TARGET_DIR", repo.join("firmware").join("target"))
         .env_remove("MOTOR")
         .env_remove("MOTORS_DIR")
         .output()
@@ -89,7 +59,7 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
         "no RAM line in\n{stdout}"
     );
 
-    let dir = motor_tests::repo().join("target").join("firmware");
+    let dir = repo().join("target").join("firmware");
     let elf = std::fs::read(dir.join("fischer-ti085.elf")).expect("the .elf is written");
     assert_eq!(&elf[..4], b"\x7fELF");
     let bin = std::fs::read(dir.join("fischer-ti085.bin")).expect("the .bin is written");
@@ -115,10 +85,17 @@ fn unknown_stem_lists_the_motors_and_writes_nothing() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(out.stdout.is_empty());
     assert!(stderr.contains("no motor `no-such-motor`"), "{stderr}");
-    for (stem, _, _) in motor_tests::motors() {
+    let stems = std::fs::read_dir(repo().join("motors"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect::<Vec<_>>();
+    assert!(stems.len() >= 3, "the seed motors are in motors/: {stems:?}");
+    for stem in stems {
         assert!(stderr.contains(&stem), "accepted stems should list {stem}:\n{stderr}");
     }
-    let dir = motor_tests::repo().join("target").join("firmware");
+    let dir = repo().join("target").join("firmware");
     for ext in ["elf", "bin"] {
         assert!(!dir.join(format!("no-such-motor.{ext}")).exists());
     }
@@ -128,7 +105,7 @@ fn unknown_stem_lists_the_motors_and_writes_nothing() {
 fn bad_spec_fails_with_its_location_before_cargo_runs() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("firmware-bad-motors");
     std::fs::create_dir_all(&dir).unwrap();
-    let good = std::fs::read_to_string(motor_tests::repo().join("motors/fischer-ti085.toml")).unwrap();
+    let good = std::fs::read_to_string(repo().join("motors/fischer-ti085.toml")).unwrap();
     let bad = good.replacen("inductance = \"0.393 mH\"", "inductance = 0.000393", 1);
     assert_ne!(bad, good);
     // 1-based line of the edited key, counted by the test itself; column 14 is the value.
@@ -145,7 +122,7 @@ fn bad_spec_fails_with_its_location_before_cargo_runs() {
         assert!(stderr.contains(expected), "expected {expected:?} in\n{stderr}");
     }
     assert!(!stderr.contains("Compiling"), "cargo ran for a bad spec:\n{stderr}");
-    let out_dir = motor_tests::repo().join("target").join("firmware");
+    let out_dir = repo().join("target").join("firmware");
     assert!(!out_dir.join("bad-image.elf").exists());
     assert!(!out_dir.join("bad-image.bin").exists());
 }
