@@ -85,12 +85,7 @@ fn unknown_stem_lists_the_motors_and_writes_nothing() {
     assert_eq!(out.status.code(), Some(1), "{stderr}");
     assert!(out.stdout.is_empty());
     assert!(stderr.contains("no motor `no-such-motor`"), "{stderr}");
-    let stems = std::fs::read_dir(repo().join("motors"))
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
-        .collect::<Vec<_>>();
+    let stems = common::motor_stems();
     assert!(stems.len() >= 3, "the seed motors are in motors/: {stems:?}");
     for stem in stems {
         assert!(stderr.contains(&stem), "accepted stems should list {stem}:\n{stderr}");

@@ -4,24 +4,13 @@
 //! `<svg>` with lines and text, and a screenshot is taken (kept in the test temp dir).
 
 mod common;
-use common::{motorgen, repo};
+use common::{motor_stems, motorgen, repo};
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 fn tmp(name: &str) -> PathBuf {
     common::tmp("report", name)
-}
-
-fn motors() -> Vec<String> {
-    let mut v: Vec<String> = std::fs::read_dir(repo().join("motors"))
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
-        .collect();
-    v.sort();
-    v
 }
 
 /// Headless Chromium: `$CHROMIUM` or `/usr/bin/chromium`. Missing is a failure, not a skip.
@@ -130,7 +119,7 @@ const FLUX_PLOTS: &[&str] = &[
 
 #[test]
 fn report_loads_in_headless_chromium_with_every_plot() {
-    for stem in motors() {
+    for stem in motor_stems() {
         let dir = tmp(&stem);
         let spec = format!("motors/{stem}.toml");
         let out = motorgen(&["report", &spec, "--out", dir.to_str().unwrap()]);

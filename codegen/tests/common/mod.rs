@@ -11,6 +11,18 @@ pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
+/// Stems of every `*.toml` in `motors/`, sorted.
+pub fn motor_stems() -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(repo().join("motors"))
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .map(|p| p.file_stem().unwrap().to_string_lossy().into_owned())
+        .collect();
+    v.sort();
+    v
+}
+
 /// `motorgen <args>` in the repository root.
 pub fn motorgen(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_motorgen"))
