@@ -110,11 +110,9 @@ fn design_extra(d: &codegen::design::Design) -> String {
         || "not in the spec: 0".to_string(),
         |rad| format!("{rad:.6} rad = {:.4}°, wrapped into ±π, ·2^31/π", rad.to_degrees()),
     );
-    let dead = opt(d.drive.dead_time_s.map(|s| format!("{}", (s * 1e9).round() as u32)));
-    let dead_doc = d.drive.dead_time_s.map_or_else(
-        || "not in the spec".to_string(),
-        |s| format!("{} ns", (s * 1e9).round()),
-    );
+    let dead_ns = d.drive.dead_time_s.map(|s| (s * 1e9).round() as u32);
+    let dead = opt(dead_ns.map(|ns| ns.to_string()));
+    let dead_doc = dead_ns.map_or_else(|| "not in the spec".to_string(), |ns| format!("{ns} ns"));
     let smp = opt(d.adc.sample_time.as_ref().map(|t| t.smp_code.to_string()));
     let smp_doc = d.adc.sample_time.as_ref().map_or_else(
         || "no `[adc]` section".to_string(),
