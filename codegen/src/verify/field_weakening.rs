@@ -19,8 +19,9 @@ use motor_control::step::{Demand, StepOutput};
 use motor_control::transforms::{Dq, INV_SQRT_3};
 
 use super::plant::{MotorModel, SpeedProfile};
+use super::scenarios::trace;
 use super::sim::Bench;
-use super::{Check, ScenarioResult, Series, Setup, Trace, format_value, series};
+use super::{Check, ScenarioResult, Setup, format_value, series};
 use crate::design::Design;
 
 /// Electrical base speed ω_base [rad/s] of (2.60), from the design.
@@ -329,8 +330,4 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
         checks,
         traces,
     }
-}
-
-fn trace(title: &str, y_label: &str, t: &[f64], series: Vec<Series>) -> Trace {
-    super::scenarios::trace(title, y_label, t, series)
 }
