@@ -10,6 +10,7 @@
 
 use serde::Serialize;
 
+use super::sampled_loop::{self, LoopGains, SampledLoop};
 use crate::spec::Method;
 
 /// Guideline of thesis A §5.4.1: first-order loops below 30 % of f_s.
@@ -50,8 +51,71 @@ pub struct AxisGains {
     /// Designed closed-loop poles, real and imaginary parts [rad/s].
     pub designed_poles: Vec<[f64; 2]>,
     /// The bandwidth α these gains were designed for [rad/s]: the spec's, or the lower
-    /// delay-compensated one (`design::discrete_loop`).
+    /// delay-compensated one of the first-order methods (`design::discrete_loop`).
     pub bandwidth_rad_s: f64,
+    /// The sampled loop with these gains: poles, margins, overshoot
+    /// ([`sampled_loop`], 1.5·T_s delay).
+    #[serde(flatten)]
+    pub sampled: SampledLoop,
+}
+
+impl AxisGains {
+    /// The gains as the sampled loop sees them.
+    pub fn loop_gains(&self) -> LoopGains {
+        loop_gains(self.kp, self.ki, self.active_damping_ohm, self.prefilter.as_ref())
+    }
+}
+
+fn loop_gains(kp: f64, ki: f64, active_damping: f64, prefilter: Option<&Prefilter>) -> LoopGains {
+    LoopGains {
+        kp,
+        ki,
+        active_damping,
+        prefilter: prefilter.map_or(1.0, |p| p.discrete_coefficient),
+    }
+}
+
+/// One axis's PI before the sampled-loop analysis (what the design methods produce).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Pi {
+    /// K_p [V/A].
+    pub kp: f64,
+    /// K_i [V/(A·s)].
+    pub ki: f64,
+    /// R_a [Ω].
+    pub active_damping_ohm: f64,
+    /// Reference prefilter (pole placement).
+    pub prefilter: Option<Prefilter>,
+    /// Designed closed-loop poles [rad/s].
+    pub designed_poles: Vec<[f64; 2]>,
+    /// Bandwidth α designed for [rad/s].
+    pub bandwidth_rad_s: f64,
+}
+
+impl Pi {
+    /// The gains as the sampled loop sees them.
+    pub fn loop_gains(&self) -> LoopGains {
+        loop_gains(self.kp, self.ki, self.active_damping_ohm, self.prefilter.as_ref())
+    }
+
+    /// Series form, anti-windup, K_i·T_s and the sampled-loop figures for the plant
+    /// `r` [Ω], `l` [H] at `ts` [s].
+    pub fn finish(self, r: f64, l: f64, ts: f64) -> AxisGains {
+        let sampled = sampled_loop::analyse(&self.loop_gains(), r, l, ts);
+        AxisGains {
+            kp: self.kp,
+            ki: self.ki,
+            ka: self.kp,
+            kb: self.ki / self.kp,
+            active_damping_ohm: self.active_damping_ohm,
+            anti_windup_gain: 1.0 / self.kp,
+            ki_ts: self.ki * ts,
+            prefilter: self.prefilter,
+            designed_poles: self.designed_poles,
+            bandwidth_rad_s: self.bandwidth_rad_s,
+            sampled,
+        }
+    }
 }
 
 /// Why a current-loop design is refused.
@@ -89,7 +153,8 @@ pub fn overshoot(zeta: f64) -> f64 {
 }
 
 /// Designs one axis with resistance `r` [Ω], inductance `l` [H], bandwidth `alpha` [rad/s],
-/// damping `zeta` (pole placement), sample period `ts` [s].
+/// damping `zeta` (pole placement), sample period `ts` [s], by the continuous rules of the
+/// module documentation, and analyses it on the sampled loop.
 pub fn design_axis(
     method: Method,
     axis: char,
@@ -99,6 +164,19 @@ pub fn design_axis(
     zeta: f64,
     ts: f64,
 ) -> Result<AxisGains, CurrentLoopError> {
+    continuous(method, axis, r, l, alpha, zeta, ts).map(|pi| pi.finish(r, l, ts))
+}
+
+/// The continuous design rules of the module documentation (no sampled-loop analysis).
+pub fn continuous(
+    method: Method,
+    axis: char,
+    r: f64,
+    l: f64,
+    alpha: f64,
+    zeta: f64,
+    ts: f64,
+) -> Result<Pi, CurrentLoopError> {
     let (kp, ki, ra, prefilter, poles) = match method {
         Method::Imc => {
             let ka = l * alpha; // (5.9)
@@ -152,14 +230,10 @@ pub fn design_axis(
             ) // (2.38), (2.39)
         }
     };
-    Ok(AxisGains {
+    Ok(Pi {
         kp,
         ki,
-        ka: kp,
-        kb: ki / kp,
         active_damping_ohm: ra,
-        anti_windup_gain: 1.0 / kp,
-        ki_ts: ki * ts,
         prefilter,
         designed_poles: poles,
         bandwidth_rad_s: alpha,

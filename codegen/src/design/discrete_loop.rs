@@ -10,29 +10,45 @@
 //! r_f(n+1) = r_f(n) + c·(1 − r_f(n))                         prefilter (5.16), c = 1 − e^(−T_s/τ_f)
 //! ```
 //!
-//! The continuous designs (IMC (5.8)/(2.41): rise time ln 9/α) hold while α·T_s ≪ 1. Close to
-//! the sampling rate the delay speeds the loop up (the discrete integrator and the delay turn
-//! the first-order loop into a second-order one: for IMC z² − z + α·T_s = 0). With
-//! `compensate_delay` the design lowers α per axis until this model rises in ln 9/α_spec.
+//! The continuous designs (IMC (5.8)/(2.41): rise time ln 9/α; pole placement (5.14):
+//! poles at −ζω_n ± jω_n√(1 − ζ²)) hold while α·T_s ≪ 1. Close to the sampling rate the
+//! delay speeds the loop up and then destabilises it (the discrete integrator and the
+//! delay turn the first-order loop into a second-order one: for IMC z² − z + α·T_s = 0;
+//! [`super::sampled_loop`] computes its poles and margins).
+//!
+//! # Delay compensation (`current_loop.compensate_delay`, on by default)
+//!
+//! A user asks for α and gets α in the sampled loop:
+//!
+//! * first-order methods (IMC, IMC with active damping): "α" is the rise time ln 9/α of
+//!   (5.8)/(2.41). Each axis is designed by the method's own rule for the bandwidth
+//!   α' ≤ α at which this model's step rises in ln 9/α ([`delay_compensated`]);
+//! * pole placement: "α" is the dominant pole pair of (5.13)–(5.15). The two gains place
+//!   two roots of the sampled loop's cubic characteristic polynomial exactly at
+//!   z = e^{s·T_s} of the designed s = −ζω_n ± jω_n√(1 − ζ²); the third root is what the
+//!   delay adds, and the prefilter coefficient c = k_i·T_s/k_p cancels the discrete PI zero
+//!   1 − k_i·T_s/k_p exactly, as (5.16) cancels the continuous one
+//!   ([`pole_placement`]).
 
-use super::current_loop::{AxisGains, CurrentLoopError, design_axis};
+use super::current_loop::{AxisGains, CurrentLoopError, Pi, Prefilter, continuous, natural_frequency};
+use super::designed_response::designed_rise_time;
+use super::sampled_loop::{LoopGains, Promise, SampledPlant};
 use crate::spec::Method;
 
 /// Unit step response of one axis at the sample instants t_n (index 0: the reference steps),
 /// `n` samples, by the difference equations of the module documentation.
-pub fn step_response(g: &AxisGains, r: f64, l: f64, ts: f64, n: usize) -> Vec<f64> {
-    let a = (-r * ts / l).exp();
-    let b = -(-r * ts / l).exp_m1() / r;
-    let c = g.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient);
+pub fn step_response(g: &LoopGains, r: f64, l: f64, ts: f64, n: usize) -> Vec<f64> {
+    let p = SampledPlant::new(r, l, ts);
+    let c = g.prefilter;
     let (mut i, mut integral, mut rf, mut v_prev) = (0.0, 0.0, 0.0, 0.0);
     let mut out = Vec::with_capacity(n);
     for _ in 0..n {
         out.push(i);
         rf += c * (1.0 - rf);
         let e = rf - i;
-        let v = g.kp * e + g.ki * integral - g.active_damping_ohm * i;
+        let v = g.kp * e + g.ki * integral - g.active_damping * i;
         integral += ts * e;
-        i = a * i + b * v_prev;
+        i = p.a * i + p.b * v_prev;
         v_prev = v;
     }
     out
@@ -52,27 +68,46 @@ pub fn rise_time(y: &[f64], dt: f64) -> Option<f64> {
 }
 
 /// Rise time [s] of one axis designed with bandwidth `alpha` (first-order methods).
-pub fn predicted_rise_time(g: &AxisGains, r: f64, l: f64, ts: f64, alpha: f64) -> Option<f64> {
+pub fn predicted_rise_time(g: &LoopGains, r: f64, l: f64, ts: f64, alpha: f64) -> Option<f64> {
     // 12 time constants of the designed loop (or at least 200 samples) cover the 90 % point.
     let n = ((12.0 / alpha / ts).ceil() as usize).clamp(200, 2_000_000);
     rise_time(&step_response(g, r, l, ts, n), ts)
 }
 
-/// Designs one axis with the bandwidth α' ≤ `alpha` whose discrete loop (this module) rises in
-/// ln 9/`alpha`, found by bisection (the rise time falls monotonically with α'). First-order
-/// methods only (IMC, IMC with active damping); returns the gains and α'.
+/// One axis designed so that the sampled loop delivers the requested `alpha` (module
+/// documentation): [`first_order_compensated`] for IMC and IMC with active damping,
+/// [`pole_placement`] for pole placement (damping `zeta`).
 pub fn delay_compensated(
     method: Method,
     axis: char,
     r: f64,
     l: f64,
     alpha: f64,
+    zeta: f64,
     ts: f64,
-) -> Result<(AxisGains, f64), CurrentLoopError> {
+) -> Result<AxisGains, CurrentLoopError> {
+    let pi = match method {
+        Method::PolePlacement => pole_placement(axis, r, l, alpha, zeta, ts)?,
+        _ => first_order_compensated(method, axis, r, l, alpha, ts)?.0,
+    };
+    Ok(pi.finish(r, l, ts))
+}
+
+/// Designs one axis with the bandwidth α' ≤ `alpha` whose discrete loop (this module) rises in
+/// ln 9/`alpha`, found by bisection (the rise time falls monotonically with α'). First-order
+/// methods only (IMC, IMC with active damping); returns the gains and α'.
+pub fn first_order_compensated(
+    method: Method,
+    axis: char,
+    r: f64,
+    l: f64,
+    alpha: f64,
+    ts: f64,
+) -> Result<(Pi, f64), CurrentLoopError> {
     let target = 9f64.ln() / alpha;
-    let rise = |a: f64| -> Result<(AxisGains, Option<f64>), CurrentLoopError> {
-        let g = design_axis(method, axis, r, l, a, 0.0, ts)?;
-        let t = predicted_rise_time(&g, r, l, ts, a);
+    let rise = |a: f64| -> Result<(Pi, Option<f64>), CurrentLoopError> {
+        let g = continuous(method, axis, r, l, a, 0.0, ts)?;
+        let t = predicted_rise_time(&g.loop_gains(), r, l, ts, a);
         Ok((g, t))
     };
     let (g, t) = rise(alpha)?;
@@ -90,19 +125,182 @@ pub fn delay_compensated(
         }
     }
     let a = 0.5 * (lo + hi);
-    Ok((design_axis(method, axis, r, l, a, 0.0, ts)?, a))
+    Ok((continuous(method, axis, r, l, a, 0.0, ts)?, a))
+}
+
+/// Pole placement on the sampled loop (module documentation): the roots p₁, p₂ = e^{s·T_s}
+/// of the designed pair (5.13)–(5.15) and the third p₃ = 1 + a − (p₁ + p₂) (the z² coefficient
+/// −(1 + a) is fixed by the plant and the delay) give, from
+/// z³ − (1 + a)z² + (a + b·k_p)z + b(k_i·T_s − k_p) = (z² − S·z + P)(z − p₃),
+/// S = p₁ + p₂, P = p₁·p₂:
+///
+/// ```text
+/// k_p = (P + S·p₃ − a)/b,   k_i·T_s = k_p − P·p₃/b,   c = k_i·T_s/k_p
+/// ```
+///
+/// A k_p ≤ 0 (the discrete counterpart of ω_n·ζ < R/(2L), thesis A §5.4.1) is refused as
+/// a right-half-plane zero with the continuous rule's smallest bandwidth. Close to the
+/// sampling rate p₃ leaves the unit circle (and k_i may turn negative): such gains are
+/// returned and refused by the floors of [`super::sampled_loop`].
+pub fn pole_placement(axis: char, r: f64, l: f64, alpha: f64, zeta: f64, ts: f64) -> Result<Pi, CurrentLoopError> {
+    // The continuous design: its RHP-zero rule, its designed poles.
+    let cont = continuous(Method::PolePlacement, axis, r, l, alpha, zeta, ts)?;
+    let wn = natural_frequency(alpha, zeta);
+    let p = SampledPlant::new(r, l, ts);
+    let (sum, product) = if zeta < 1.0 {
+        let (re, im) = (-zeta * wn * ts, wn * (1.0 - zeta * zeta).sqrt() * ts);
+        (2.0 * re.exp() * im.cos(), (2.0 * re).exp())
+    } else {
+        let d = wn * (zeta * zeta - 1.0).sqrt() * ts;
+        let (s1, s2) = (-zeta * wn * ts + d, -zeta * wn * ts - d);
+        (s1.exp() + s2.exp(), (s1 + s2).exp())
+    };
+    let p3 = 1.0 + p.a - sum;
+    let kp = (product + sum * p3 - p.a) / p.b;
+    let ki_ts = kp - product * p3 / p.b;
+    if kp <= 0.0 {
+        let wn_min = r / (2.0 * l * zeta);
+        return Err(CurrentLoopError::RhpZero {
+            axis,
+            min_bandwidth_rad_s: wn_min * alpha / wn,
+        });
+    }
+    let c = ki_ts / kp;
+    Ok(Pi {
+        kp,
+        ki: ki_ts / ts,
+        prefilter: Some(Prefilter {
+            time_constant_s: kp / (ki_ts / ts),
+            pole_rad_s: ki_ts / ts / kp,
+            discrete_coefficient: c,
+        }),
+        ..cont
+    })
+}
+
+/// One axis as the design step builds it: [`delay_compensated`] when `compensate`, else the
+/// continuous rule of [`super::current_loop`], analysed on the sampled loop.
+#[allow(clippy::too_many_arguments)]
+pub fn axis(
+    method: Method,
+    axis: char,
+    r: f64,
+    l: f64,
+    alpha: f64,
+    zeta: f64,
+    ts: f64,
+    compensate: bool,
+) -> Result<AxisGains, CurrentLoopError> {
+    if compensate {
+        delay_compensated(method, axis, r, l, alpha, zeta, ts)
+    } else {
+        continuous(method, axis, r, l, alpha, zeta, ts).map(|pi| pi.finish(r, l, ts))
+    }
+}
+
+/// The method's designed step overshoot [%]: 0 for the first-order methods (thesis A
+/// (5.8), thesis B (2.41)), e^(−πζ/√(1−ζ²)) for pole placement (thesis A §5.4.1).
+pub fn designed_overshoot_pct(method: Method, zeta: f64) -> f64 {
+    match method {
+        Method::PolePlacement => 100.0 * super::current_loop::overshoot(zeta),
+        _ => 0.0,
+    }
+}
+
+/// What the method designs at bandwidth `alpha` [rad/s] (damping `zeta` for pole
+/// placement): its overshoot, and with `compensate` its rise time, ln 9/α (thesis A (5.8))
+/// or the second-order step's with ω_n of (5.15) ([`designed_rise_time`]).
+pub fn promise(method: Method, alpha: f64, zeta: f64, compensate: bool) -> Promise {
+    let second = (method == Method::PolePlacement).then(|| (natural_frequency(alpha, zeta), zeta));
+    Promise {
+        overshoot_pct: designed_overshoot_pct(method, zeta),
+        rise_time_s: compensate.then(|| designed_rise_time(alpha, second)),
+    }
+}
+
+/// A current-loop request shared by both axes, for [`largest_bandwidth`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Request {
+    /// Tuning method.
+    pub method: Method,
+    /// R [Ω].
+    pub r: f64,
+    /// L_d, L_q [H].
+    pub l: [f64; 2],
+    /// ζ (pole placement).
+    pub zeta: f64,
+    /// T_s [s].
+    pub ts: f64,
+    /// `compensate_delay`.
+    pub compensate: bool,
+}
+
+impl Request {
+    /// Both axes at bandwidth `alpha`, or the first floor breach or design error.
+    pub fn breach_at(&self, alpha: f64) -> Option<String> {
+        let promise = promise(self.method, alpha, self.zeta, self.compensate);
+        for (name, l) in [('d', self.l[0]), ('q', self.l[1])] {
+            match axis(self.method, name, self.r, l, alpha, self.zeta, self.ts, self.compensate) {
+                Ok(g) => {
+                    if let Some(b) = g.sampled.breach(&promise) {
+                        return Some(format!("{name} axis: {b}"));
+                    }
+                }
+                Err(e) => return Some(format!("{e:?}")),
+            }
+        }
+        None
+    }
+
+    /// The smallest bandwidth the method accepts [rad/s]: above the right-half-plane-zero
+    /// limit of pole placement, above R/L of active damping (2.43), else 10⁻⁴ of `alpha`.
+    fn lowest(&self, alpha: f64) -> f64 {
+        let rl = self.l.iter().map(|l| self.r / l).fold(0.0, f64::max);
+        match self.method {
+            Method::Imc => alpha * 1e-4,
+            Method::ImcActiveDamping => rl * 1.001,
+            Method::PolePlacement => {
+                let wn_over_alpha = natural_frequency(1.0, self.zeta);
+                rl / (2.0 * self.zeta) / wn_over_alpha * 1.001
+            }
+        }
+    }
+}
+
+/// The largest bandwidth [rad/s] up to `alpha` whose sampled loop meets the floors of
+/// [`super::sampled_loop`] on both axes, by bisection on a logarithmic scale (to 0.1 %);
+/// `None` if even the method's smallest bandwidth does not.
+pub fn largest_bandwidth(req: &Request, alpha: f64) -> Option<f64> {
+    if req.breach_at(alpha).is_none() {
+        return Some(alpha);
+    }
+    let mut lo = req.lowest(alpha).min(alpha);
+    if req.breach_at(lo).is_some() {
+        return None;
+    }
+    let mut hi = alpha;
+    while hi / lo > 1.001 {
+        let mid = (lo * hi).sqrt();
+        if req.breach_at(mid).is_none() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Some(lo)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::current_loop::design_axis;
 
     /// Far below the sampling rate the sampled IMC loop rises as the continuous design,
     /// ln 9/α (thesis A (5.8)): Fischer, α = 100 rad/s at 20 kHz → 21.97 ms ± 1 %.
     #[test]
     fn slow_loop_rises_as_designed() {
         let g = design_axis(Method::Imc, 'd', 0.126, 0.393e-3, 100.0, 0.0, 5e-5).unwrap();
-        let t = predicted_rise_time(&g, 0.126, 0.393e-3, 5e-5, 100.0).unwrap();
+        let t = predicted_rise_time(&g.loop_gains(), 0.126, 0.393e-3, 5e-5, 100.0).unwrap();
         assert!((t / (9f64.ln() / 100.0) - 1.0).abs() < 0.01, "{t}");
     }
 
@@ -116,7 +314,7 @@ mod tests {
     fn fast_loop_rises_early_as_the_root_locus_says() {
         let (r, l, ts, alpha) = (7.9e-3, 0.23e-3, 1e-4, 1470.0);
         let g = design_axis(Method::Imc, 'd', r, l, alpha, 0.0, ts).unwrap();
-        let t = predicted_rise_time(&g, r, l, ts, alpha).unwrap();
+        let t = predicted_rise_time(&g.loop_gains(), r, l, ts, alpha).unwrap();
         let root = (1.0 + (1.0f64 - 4.0 * alpha * ts).sqrt()) / 2.0;
         let hand = 9f64.ln() / (-root.ln() / ts);
         assert!((t / hand - 1.0).abs() < 0.08, "{t} vs {hand}");
@@ -129,19 +327,74 @@ mod tests {
     fn compensation_restores_the_rise_time() {
         let (r, l, ts, alpha) = (7.9e-3, 0.23e-3, 1e-4, 1470.0);
         for m in [Method::Imc, Method::ImcActiveDamping] {
-            let (g, a) = delay_compensated(m, 'd', r, l, alpha, ts).unwrap();
+            let (g, a) = first_order_compensated(m, 'd', r, l, alpha, ts).unwrap();
             assert!(a < alpha && a > 0.5 * alpha, "{m:?}: {a}");
-            let y = step_response(&g, r, l, ts, 2_000);
+            let y = step_response(&g.loop_gains(), r, l, ts, 2_000);
             let t = rise_time(&y, ts).unwrap();
             assert!((t / (9f64.ln() / alpha) - 1.0).abs() < 1e-6, "{m:?}: {t}");
             let peak = y.iter().copied().fold(0.0, f64::max);
             assert!(peak < 1.005, "{m:?}: overshoot {peak}");
             // The plant pole R/L = 34 rad/s is cancelled only approximately in discrete time:
             // a slow residue remains, gone after 40 time constants.
-            let y = step_response(&g, r, l, ts, 12_000);
+            let y = step_response(&g.loop_gains(), r, l, ts, 12_000);
             assert!((y[11_999] - 1.0).abs() < 1e-6, "{m:?}: DC gain 1: {}", y[11_999]);
         }
-        let (_, a) = delay_compensated(Method::Imc, 'd', 0.126, 0.393e-3, 100.0, 5e-5).unwrap();
+        let (_, a) = first_order_compensated(Method::Imc, 'd', 0.126, 0.393e-3, 100.0, 5e-5).unwrap();
         assert!((a / 100.0 - 1.0).abs() < 0.02, "{a}");
+    }
+
+    /// Sampled pole placement puts two closed-loop poles exactly at e^{s·T_s} of the
+    /// designed pair. Hand numbers (30-digit arithmetic), Unimotor q axis (R = 0.65 Ω,
+    /// L = 7.6 mH, thesis A Table 6.1), α = 100 rad/s, ζ = 1/√2 (so ω_n = α), T_s = 50 µs:
+    /// s = −70.711 ± 70.711j rad/s, ζω_n·T_s = 0.0035355, so
+    /// S = 2·e^{−0.0035355}·cos 0.0035355 = 1.9929290, P = e^{−0.0070711} = 0.9929539;
+    /// a = e^{−0.65·50e-6/7.6e-3} = 0.9957328, b = (1 − a)/R = 0.0065649;
+    /// p₃ = 1 + a − S = 0.0028039; k_p = (P + S·p₃ − a)/b = 0.427872 V/A (continuous
+    /// (5.14): 0.424802), k_i·T_s = k_p − P·p₃/b = 0.0037841, i.e. k_i = 75.681 V/(A·s)
+    /// (continuous: 76), prefilter c = k_i·T_s/k_p = 0.0088439.
+    #[test]
+    fn sampled_pole_placement_by_hand() {
+        let (r, l, ts) = (0.65, 7.6e-3, 5e-5);
+        let z = std::f64::consts::FRAC_1_SQRT_2;
+        let pi = pole_placement('q', r, l, 100.0, z, ts).unwrap();
+        assert!((pi.kp - 0.427_872).abs() < 1e-6, "{}", pi.kp);
+        assert!((pi.ki - 75.681).abs() < 1e-3, "{}", pi.ki);
+        let c = pi.prefilter.as_ref().unwrap().discrete_coefficient;
+        assert!((c - 0.008_843_9).abs() < 1e-7, "{c}");
+        let g = pi.finish(r, l, ts);
+        let want = nalgebra::Complex::new(-70.710_678, 70.710_678);
+        let hit = g
+            .sampled
+            .poles_s_rad_s
+            .iter()
+            .flatten()
+            .filter(|p| (nalgebra::Complex::new(p[0], p[1].abs()) - want).norm() < 1e-6)
+            .count();
+        assert_eq!(hit, 2, "{:?}", g.sampled.poles_s_rad_s);
+        // The prefilter cancels the PI zero: the step is that of c·b·k_p·z/char(z), with
+        // DC gain 1 and the designed overshoot e^(−π) = 4.32 % to within the third pole.
+        let y = step_response(&g.loop_gains(), r, l, ts, 40_000);
+        assert!((y[39_999] - 1.0).abs() < 1e-6, "{}", y[39_999]);
+        let os = g.sampled.overshoot_pct.unwrap();
+        assert!((os - 100.0 * (-std::f64::consts::PI).exp()).abs() < 0.1, "{os}");
+    }
+
+    /// Near the sampling rate the third pole p₃ = 1 + a − S leaves the unit circle: the
+    /// sampled loop is then unstable although two poles sit where designed.
+    #[test]
+    fn sampled_pole_placement_fails_where_the_delay_pole_escapes() {
+        // ω_n·T_s = 1, ζ = 0.7071: S = 2e^{−0.7071}·cos 0.7071 = 0.7498, so
+        // p₃ = 1 + 0.9957 − 0.7498 = 1.246 > 1.
+        let (r, l, ts) = (0.65, 7.6e-3, 5e-5);
+        let z = std::f64::consts::FRAC_1_SQRT_2;
+        let g = pole_placement('q', r, l, 1.0 / ts, z, ts).unwrap().finish(r, l, ts);
+        assert!((g.sampled.spectral_radius - 1.246).abs() < 1e-3, "{}", g.sampled.spectral_radius);
+        assert!(g.sampled
+            .breach(&crate::design::sampled_loop::Promise {
+                overshoot_pct: 4.32,
+                rise_time_s: None
+            })
+            .is_some());
+        assert!(g.sampled.spectral_radius > 1.0, "{}", g.sampled.spectral_radius);
     }
 }

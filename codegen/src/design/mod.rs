@@ -7,7 +7,9 @@
 pub mod adc;
 pub mod angle_observer;
 pub mod current_loop;
+pub mod designed_response;
 pub mod discrete_loop;
+pub mod sampled_loop;
 
 pub mod field_weakening;
 pub mod fir;

@@ -18,8 +18,9 @@ pub struct CurrentLoopSpec {
     pub bandwidth: Param,
     /// ζ for pole placement.
     pub damping: Option<Param>,
-    /// Design each axis for the rise time ln 9/α of the sampled loop with its 1.5·T_s delay
-    /// (first-order methods; see `design::discrete_loop`).
+    /// Design each axis so that the sampled loop with its 1.5·T_s delay delivers α (the
+    /// rise time ln 9/α of the first-order methods, the dominant pole pair of pole
+    /// placement; see `design::discrete_loop`). On unless `compensate_delay = false`.
     pub compensate_delay: bool,
 }
 
@@ -62,19 +63,7 @@ impl Resolver_<'_> {
             }
             (None, _) => None,
         };
-        let compensate_delay = match (&c.compensate_delay, method) {
-            (Some(v), Method::PolePlacement) if *v.get_ref() => {
-                self.err(
-                    v.span(),
-                    "current_loop.compensate_delay",
-                    "delay compensation is designed for the first-order loops only",
-                    "compensate_delay = false, or method = \"imc\" or \"imc_active_damping\"",
-                );
-                false
-            }
-            (Some(v), _) => *v.get_ref(),
-            (None, _) => false,
-        };
+        let compensate_delay = c.compensate_delay.as_ref().is_none_or(|v| *v.get_ref());
         Some(CurrentLoopSpec {
             method,
             method_span: c.method.span(),

@@ -239,7 +239,7 @@ mod tests {
     fn discrete_step_settles_at_one_after_the_delay() {
         let d = fischer();
         let y = crate::design::discrete_loop::step_response(
-            &d.current_loop.q,
+            &d.current_loop.q.loop_gains(),
             d.motor.phase_resistance_ohm,
             d.motor.q_inductance_h,
             d.drive.sample_period_s,

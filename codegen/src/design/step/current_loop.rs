@@ -1,5 +1,7 @@
-//! The current-loop section: the bandwidth guideline (thesis A §5.4.1), both axes' gains,
-//! the sampled loop's rise time with its 1.5·T_s delay, the hot-winding variant
+//! The current-loop section: both axes' gains, judged on the sampled loop with its 1.5·T_s
+//! delay (poles, margins, overshoot: `design::sampled_loop`; a breach of its floors is an
+//! error at `current_loop.bandwidth` naming the largest bandwidth that meets them), the
+//! bandwidth guidelines of thesis A §5.4.1 (warnings), the hot-winding variant
 //! (thesis B 2.24) and the feed-forward constants (5.3), (2.34).
 
 use std::f64::consts::PI;
@@ -8,7 +10,9 @@ use serde::Serialize;
 
 use super::Context;
 use crate::design::current_loop::{self, AxisGains, CurrentLoopError};
-use crate::design::{discrete_loop, thermal};
+use crate::design::discrete_loop::{self, Request};
+use crate::design::sampled_loop::{MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
+use crate::design::thermal;
 use crate::diagnostic::{Diagnostic, Source};
 use crate::spec::{Method, Spec};
 
@@ -38,17 +42,22 @@ pub struct CurrentLoopOut {
     pub damping: Option<f64>,
     /// ω_n from (5.15) (pole placement).
     pub natural_frequency_rad_s: Option<f64>,
-    /// Guideline ceiling for α [rad/s]: 30 % (1st order) or 17 % (2nd order) of f_s.
+    /// Guideline ceiling for α [rad/s]: 30 % (1st order) or 17 % (2nd order) of f_s
+    /// (thesis A §5.4.1; a warning, the sampled-loop floors decide).
     pub bandwidth_limit_rad_s: f64,
-    /// Designed 10–90 % rise time [s]: ln 9/α for first-order loops.
+    /// Designed 10–90 % rise time [s]: ln 9/α for first-order loops, the second-order
+    /// step's with ω_n, ζ for pole placement (`design::designed_response`).
     pub rise_time_s: Option<f64>,
     /// 10–90 % rise time [s] of the sampled d- and q-axis loops with the 1.5·T_s delay
-    /// (`discrete_loop`), first-order methods.
+    /// (`discrete_loop`).
     pub sampled_rise_time_s: Option<[f64; 2]>,
-    /// Each axis designed for a lower α so that the sampled loop rises in ln 9/α.
+    /// Each axis designed so that the sampled loop delivers α (`discrete_loop`): on unless
+    /// the spec sets `compensate_delay = false`.
     pub compensate_delay: bool,
     /// Designed step overshoot (with prefilter for pole placement), fraction.
     pub overshoot: f64,
+    /// The floors every axis's sampled loop meets (`design::sampled_loop`).
+    pub floors: Floors,
     /// d-axis gains.
     pub d: AxisGains,
     /// q-axis gains.
@@ -59,6 +68,20 @@ pub struct CurrentLoopOut {
     pub voltage_limit_v: f64,
     /// Feed-forward constants.
     pub feedforward: FeedForward,
+}
+
+/// The sampled-loop floors of `design::sampled_loop`, as applied to this design.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Floors {
+    /// Smallest phase margin [°].
+    pub min_phase_margin_deg: f64,
+    /// Smallest gain margin [dB].
+    pub min_gain_margin_db: f64,
+    /// Largest step overshoot [%]: the method's designed one plus the allowance.
+    pub max_overshoot_pct: f64,
+    /// Largest relative deviation of the sampled rise time from the designed one (with
+    /// delay compensation; null without).
+    pub rise_tolerance: Option<f64>,
 }
 
 /// Gains designed for the hot winding resistance.
@@ -84,29 +107,51 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     let limit = current_loop::bandwidth_limit(c.method, fs);
     if c.bandwidth.value >= limit {
         let pct = if c.method == Method::PolePlacement { 17 } else { 30 };
-        cx.errors.push(cx.src.error(
-            c.bandwidth.span.clone(),
-            &c.bandwidth.key,
-            format!(
-                "bandwidth α = {:.1} rad/s ({:.0} Hz) is not below {pct} % of f_s = {fs} Hz (thesis A §5.4.1)",
-                c.bandwidth.value,
-                c.bandwidth.value / (2.0 * PI)
-            ),
-            format!("a bandwidth below {:.0} rad/s", limit),
+        cx.warnings.push(format!(
+            "current loop: α = {:.1} rad/s ({:.0} Hz) is not below {pct} % of f_s = {fs} Hz, the guideline of thesis A §5.4.1 (the sampled-loop margins are what the design checks)",
+            c.bandwidth.value,
+            c.bandwidth.value / (2.0 * PI)
         ));
     }
     let r = m.phase_resistance.value;
     let gains = axes(spec, r, ts)
         .map_err(|e| cx.errors.push(loop_error(&cx.src, spec, e)))
         .ok();
-    let sampled_rise = gains.as_ref().and_then(|(gd, gq)| {
-        if c.method == Method::PolePlacement {
-            return None;
-        }
-        let rise = |g: &AxisGains, l: f64| discrete_loop::predicted_rise_time(g, r, l, ts, g.bandwidth_rad_s);
-        Some([rise(gd, m.d_inductance.value)?, rise(gq, m.q_inductance.value)?])
-    });
-    if let Some(t) = sampled_rise {
+    let zeta = c.damping.as_ref().map_or(0.0, |d| d.value);
+    let promise = discrete_loop::promise(c.method, c.bandwidth.value, zeta, c.compensate_delay);
+    let designed_os = promise.overshoot_pct;
+    if let Some((gd, gq)) = &gains
+        && let Some((axis, breach)) = [('d', gd), ('q', gq)]
+            .iter()
+            .find_map(|(a, g)| g.sampled.breach(&promise).map(|b| (*a, b)))
+    {
+        let req = request(spec, r, ts);
+        let best = discrete_loop::largest_bandwidth(&req, c.bandwidth.value);
+        let b = &c.bandwidth;
+        cx.errors.push(cx.src.error(
+            b.span.clone(),
+            &b.key,
+            format!(
+                "the sampled {axis}-axis loop at α = {:.1} rad/s (f_s = {fs} Hz, 1.5·T_s delay{}) is {breach}; the floors are phase margin ≥ {MIN_PHASE_MARGIN_DEG}°, gain margin ≥ {MIN_GAIN_MARGIN_DB} dB (Åström & Murray §10.3), overshoot ≤ {:.1} % (designed {designed_os:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %){}",
+                b.value,
+                if c.compensate_delay { ", delay-compensated" } else { "" },
+                designed_os + OVERSHOOT_ALLOWANCE_PCT,
+                promise.rise_time_s.map_or(String::new(), |t| format!(
+                    " and a rise time within {:.0} % of the designed {:.4} ms",
+                    RISE_TOLERANCE * 100.0,
+                    t * 1e3
+                )),
+            ),
+            match best {
+                Some(a) => format!(
+                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes for this motor at f_s = {fs} Hz, or a higher f_s"
+                ),
+                None => "a higher f_s: no bandwidth meets the floors for this motor at this f_s".to_string(),
+            },
+        ));
+    }
+    let sampled_rise = gains.as_ref().and_then(|(gd, gq)| Some([gd.sampled.rise_time_s?, gq.sampled.rise_time_s?]));
+    if let (Some(t), true) = (sampled_rise, c.method != Method::PolePlacement) {
         let want = 9f64.ln() / c.bandwidth.value;
         let worst = t[0].min(t[1]);
         if (worst / want - 1.0).abs() > 0.10 {
@@ -114,8 +159,10 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
                 "current loop: sampled at f_s = {fs} Hz with the 1.5·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
                 worst * 1e3,
                 want * 1e3,
-                if worst < want {
-                    "set current_loop.compensate_delay = true or raise f_s"
+                if c.compensate_delay {
+                    "the delay compensation cannot reach α: lower the bandwidth or raise f_s"
+                } else if worst < want {
+                    "remove current_loop.compensate_delay = false or raise f_s"
                 } else {
                     "raise f_s or lower the bandwidth"
                 }
@@ -135,10 +182,19 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             .as_ref()
             .map(|z| current_loop::natural_frequency(c.bandwidth.value, z.value)),
         bandwidth_limit_rad_s: limit,
-        rise_time_s: (c.method != Method::PolePlacement).then(|| 9f64.ln() / c.bandwidth.value),
+        rise_time_s: Some(crate::design::designed_response::designed_rise_time(
+            c.bandwidth.value,
+            (c.method == Method::PolePlacement).then(|| (current_loop::natural_frequency(c.bandwidth.value, zeta), zeta)),
+        )),
         sampled_rise_time_s: sampled_rise,
         compensate_delay: c.compensate_delay,
-        overshoot: c.damping.as_ref().map_or(0.0, |z| current_loop::overshoot(z.value)),
+        overshoot: designed_os / 100.0,
+        floors: Floors {
+            min_phase_margin_deg: MIN_PHASE_MARGIN_DEG,
+            min_gain_margin_db: MIN_GAIN_MARGIN_DB,
+            max_overshoot_pct: designed_os + OVERSHOOT_ALLOWANCE_PCT,
+            rise_tolerance: promise.rise_time_s.map(|_| RISE_TOLERANCE),
+        },
         d,
         q,
         hot,
@@ -153,18 +209,43 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     })
 }
 
+/// The spec's current-loop request with resistance `r` [Ω] at sample period `ts` [s].
+fn request(spec: &Spec, r: f64, ts: f64) -> Request {
+    let c = &spec.current_loop;
+    Request {
+        method: c.method,
+        r,
+        l: [spec.motor.d_inductance.value, spec.motor.q_inductance.value],
+        zeta: c.damping.as_ref().map_or(0.0, |d| d.value),
+        ts,
+        compensate: c.compensate_delay,
+    }
+}
+
 /// The same gains for R_s at the maximum winding temperature (2.24), if `[thermal]` is given;
 /// a warning (not an error) when that design is infeasible.
 fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
     let t = cx.spec.thermal.as_ref()?;
     let r_hot = thermal::resistance_at(r, t.reference_temperature.value, t.max_winding_temperature.value);
     match axes(cx.spec, r_hot, ts) {
-        Ok((d, q)) => Some(HotVariant {
+        Ok((d, q)) => {
+            let c = &cx.spec.current_loop;
+            let zeta = c.damping.as_ref().map_or(0.0, |z| z.value);
+            let promise = discrete_loop::promise(c.method, c.bandwidth.value, zeta, c.compensate_delay);
+            for (axis, g) in [('d', &d), ('q', &q)] {
+                if let Some(b) = g.sampled.breach(&promise) {
+                    cx.warnings.push(format!(
+                        "hot-resistance variant (R_s = {r_hot:.4} Ω): the sampled {axis}-axis loop is {b}"
+                    ));
+                }
+            }
+            Some(HotVariant {
             temperature_c: t.max_winding_temperature.value,
             phase_resistance_ohm: r_hot,
             d,
             q,
-        }),
+        })
+        }
         Err(_) => {
             cx.warnings.push(format!(
                 "no hot-resistance variant: the design is infeasible with R_s({} °C) = {r_hot:.4} Ω",
@@ -177,19 +258,10 @@ fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
 
 /// Both axes' gains for resistance `r` [Ω] and sample period `ts` [s].
 fn axes(spec: &Spec, r: f64, ts: f64) -> Result<(AxisGains, AxisGains), CurrentLoopError> {
-    let c = &spec.current_loop;
-    let zeta = c.damping.as_ref().map_or(0.0, |d| d.value);
-    let axis = |name: char, l: f64| {
-        if c.compensate_delay {
-            discrete_loop::delay_compensated(c.method, name, r, l, c.bandwidth.value, ts).map(|(g, _)| g)
-        } else {
-            current_loop::design_axis(c.method, name, r, l, c.bandwidth.value, zeta, ts)
-        }
-    };
-    Ok((
-        axis('d', spec.motor.d_inductance.value)?,
-        axis('q', spec.motor.q_inductance.value)?,
-    ))
+    let req = request(spec, r, ts);
+    let alpha = spec.current_loop.bandwidth.value;
+    let axis = |name: char, l: f64| discrete_loop::axis(req.method, name, r, l, alpha, req.zeta, ts, req.compensate);
+    Ok((axis('d', req.l[0])?, axis('q', req.l[1])?))
 }
 
 fn loop_error(src: &Source<'_>, spec: &Spec, e: CurrentLoopError) -> Diagnostic {
