@@ -85,6 +85,34 @@ pub fn design(wn: f64, zeta: f64, fs: f64, error: ObserverError) -> Result<Obser
     })
 }
 
+/// Largest electrical angle the observer may lag by at the drive's largest acceleration
+/// [°]: the transient angle error thesis B §4.4.2 allows its estimator ("allowing for an
+/// angular error of 10°"; the default of `sensorless.max_angle_error`). At 10° the
+/// torque-producing current keeps cos 10° = 98.5 % of its value.
+pub const MAX_TRACKING_ERROR_DEG: f64 = 10.0;
+
+/// Steady lag [rad of resolver angle] of the type-2 observer while the resolver angle
+/// accelerates at `a_r` [rad/s²]: the double integrator follows the parabola only through
+/// a constant error whose integral action supplies the acceleration, K_i·e = a_r (thesis A
+/// (4.12)–(4.15)); e = sin Δ for the trig-identity error (4.8), e = Δ for atan2. `None`
+/// when no steady lag exists (a_r ≥ K_i with the trig identity: the observer slips).
+pub fn ramp_lag(a_r: f64, ki: f64, error: ObserverError) -> Option<f64> {
+    let x = a_r / ki;
+    match error {
+        ObserverError::TrigIdentity => (x < 1.0).then(|| x.asin()),
+        ObserverError::Atan2 => Some(x),
+    }
+}
+
+/// Smallest ω_n [rad/s] whose [`ramp_lag`] at `a_r` [rad/s²] is `lag` [rad of resolver
+/// angle, < π/2]: K_i = ω_n² (4.15) = a_r/sin(lag) (trig identity) or a_r/lag (atan2).
+pub fn min_natural_frequency(a_r: f64, lag: f64, error: ObserverError) -> f64 {
+    match error {
+        ObserverError::TrigIdentity => (a_r / lag.sin()).sqrt(),
+        ObserverError::Atan2 => (a_r / lag).sqrt(),
+    }
+}
+
 /// Angular lag of a delay of `k` samples at electrical speed `we` [rad/s], Δθ_e = k·ω_e·T_s (4.23) [rad].
 pub fn lag_angle(k: f64, we: f64, fs: f64) -> f64 {
     k * we / fs
@@ -130,6 +158,23 @@ mod tests {
             design(0.01, 1.0, 20e3, ObserverError::TrigIdentity),
             Err(ObserverGainError::Underflow { gain: "ki", .. })
         ));
+    }
+
+    /// The ATO of thesis A §4.4.2 (ω_n = 70 rad/s, K_i = 4900 rad/s²) on Fischer's
+    /// default acceleration, 20 000 rpm in 10 s = 209.44 rad/s² (`acceleration`, n_r = 1):
+    /// sin Δ = 209.44/4900 = 0.042743 → Δ = 2.4497° of resolver angle = 9.799° electrical
+    /// (n_p = 4), inside the 10° allowance; the ω_n that lags exactly 10° electrical
+    /// (2.5° resolver) is √(209.44/sin 2.5°) = √4801.9 = 69.296 rad/s.
+    #[test]
+    fn type_2_lag_by_hand() {
+        let lag = ramp_lag(209.44, 4900.0, ObserverError::TrigIdentity).unwrap();
+        assert!((lag.to_degrees() - 2.4497).abs() < 1e-4, "{}", lag.to_degrees());
+        let wn = min_natural_frequency(209.44, 2.5f64.to_radians(), ObserverError::TrigIdentity);
+        assert!((wn - 69.296).abs() < 1e-3, "{wn}");
+        assert_eq!(ramp_lag(4900.0, 4900.0, ObserverError::TrigIdentity), None);
+        // atan2: linear in Δ, 209.44/4900 rad = 2.4490°.
+        let lag = ramp_lag(209.44, 4900.0, ObserverError::Atan2).unwrap();
+        assert!((lag.to_degrees() - 2.4490).abs() < 1e-4, "{}", lag.to_degrees());
     }
 
     /// Thesis A (4.23): one sample of delay at f_e = 1333 Hz and f_s = 20 kHz lags by 24°.

@@ -4,6 +4,7 @@
 //! them through `step`, one step per section of the [`Design`]; each step applies its
 //! design-rule checks and reports violations at the key that caused them.
 
+pub mod acceleration;
 pub mod adc;
 pub mod angle_observer;
 pub mod current_loop;

@@ -1,4 +1,5 @@
-//! `[drive]`: the inverter operating point (switching frequency, DC-link voltage range, dead time).
+//! `[drive]`: the inverter operating point (switching frequency, DC-link voltage range, dead
+//! time) and the largest shaft acceleration the drive must follow.
 
 use super::raw::RawSpec;
 use super::resolve::Resolver_;
@@ -16,6 +17,9 @@ pub struct Drive {
     pub dc_link_voltage_min: Param,
     /// Dead time [s], if given.
     pub dead_time: Option<Param>,
+    /// Largest shaft acceleration |dω_m/dt| [rad/s², mechanical], if given
+    /// (`design::acceleration` falls back to peak torque/inertia, then a default).
+    pub max_acceleration: Option<Param>,
 }
 
 impl Resolver_<'_> {
@@ -55,6 +59,12 @@ impl Resolver_<'_> {
             );
         }
         let dead_time = self.opt_quantity("drive.dead_time", d.dead_time.as_ref(), Kind::Time, true);
+        let max_acceleration = self.opt_quantity(
+            "drive.max_acceleration",
+            d.max_acceleration.as_ref(),
+            Kind::AngularAcceleration,
+            true,
+        );
         let udc = udc?;
         let dc_link_voltage_min = umin.unwrap_or_else(|| Param {
             source: Provenance::Default,
@@ -67,6 +77,7 @@ impl Resolver_<'_> {
             dc_link_voltage: udc,
             dc_link_voltage_min,
             dead_time,
+            max_acceleration,
         })
     }
 }

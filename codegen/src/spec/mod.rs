@@ -102,8 +102,9 @@ pub struct Spec {
     pub inverter: Option<InverterSpec>,
     /// `[field_weakening]` and `[losses]` (thesis B §2.3, chapter 3).
     pub field_weakening: FieldWeakeningSpec,
-    /// `[sensorless]` (thesis B chapter 4).
-    pub sensorless: SensorlessSpec,
+    /// `[sensorless]` (thesis B chapter 4), if the spec has the section: only then is the
+    /// estimator designed.
+    pub sensorless: Option<SensorlessSpec>,
 }
 
 /// Parses and resolves a spec. `source.file` is only used in messages.

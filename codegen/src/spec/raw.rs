@@ -186,6 +186,9 @@ pub struct RawDrive {
     pub dc_link_voltage_min: Option<Val>,
     #[serde(default)]
     pub dead_time: Option<Val>,
+    /// Largest shaft acceleration the drive must follow (mechanical).
+    #[serde(default)]
+    pub max_acceleration: Option<Val>,
 }
 
 /// Current-loop tuning method.

@@ -1,6 +1,7 @@
 //! `[sensorless]`: inputs of the sensorless estimator design rules (thesis B chapter 4,
-//! Table 4.1). The section is optional; every key is optional or has a documented
-//! default taken from the thesis.
+//! Table 4.1). The section is optional: the estimator is designed, emitted and verified
+//! only for a spec that has it (a drive with a resolver or encoder has no estimator).
+//! Every key is optional or has a documented default taken from the thesis.
 
 use serde::Deserialize;
 
@@ -52,6 +53,8 @@ pub struct RawSensorless {
 /// the design says so).
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct SensorlessSpec {
+    /// Span of the `[sensorless]` section, for rules that no single key decides.
+    pub span: std::ops::Range<usize>,
     /// ρ [rad/s], if given.
     pub bandwidth: Option<Param>,
     /// Largest shaft acceleration [rad/s², mechanical], if given.
@@ -73,10 +76,12 @@ pub struct SensorlessSpec {
 }
 
 impl Resolver_<'_> {
-    pub(super) fn sensorless(&mut self, raw: &RawSpec) -> Option<SensorlessSpec> {
-        let Some(s) = raw.sensorless.as_ref().map(|s| s.get_ref()) else {
-            return Some(SensorlessSpec::default());
+    /// `Some(None)` without the section, `None` when a key is bad.
+    pub(super) fn sensorless(&mut self, raw: &RawSpec) -> Option<Option<SensorlessSpec>> {
+        let Some(section) = raw.sensorless.as_ref() else {
+            return Some(None);
         };
+        let s = section.get_ref();
         let q = |r: &mut Self, key: &str, v: &Option<Val>, kind: Kind| r.opt_quantity(key, v.as_ref(), kind, true);
         let bandwidth = q(self, "sensorless.bandwidth", &s.bandwidth, Kind::AngularFrequency);
         let max_acceleration = q(
@@ -128,7 +133,8 @@ impl Resolver_<'_> {
                 "a ratio R̃_s/R_s above 0 and below 100, e.g. 2 (thesis B §4.4.2 assumes R̃_s = 2R_s)",
             )
         });
-        Some(SensorlessSpec {
+        Some(Some(SensorlessSpec {
+            span: section.span(),
             bandwidth,
             max_acceleration,
             max_angle_error: max_angle_error.filter(|p| p.value < std::f64::consts::FRAC_PI_2),
@@ -138,7 +144,7 @@ impl Resolver_<'_> {
             lowpass,
             resistance_error,
             speed_noise,
-        })
+        }))
     }
 }
 

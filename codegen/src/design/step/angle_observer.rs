@@ -49,6 +49,11 @@ pub struct ObserverOut {
     pub lead_q16: i32,
     /// Lag k·ω_e,max·T_s at maximum speed [deg] (4.23).
     pub lead_at_max_speed_deg: f64,
+    /// Steady lag of the observer at the drive's largest acceleration
+    /// (`drive.max_acceleration_rad_s2`), in electrical degrees (`angle_observer::ramp_lag`).
+    pub lag_at_max_acceleration_deg: f64,
+    /// The largest the design accepts [electrical °] (`angle_observer::MAX_TRACKING_ERROR_DEG`).
+    pub max_lag_deg: f64,
 }
 
 /// The observer section, or `None` with the broken rules in `cx.errors`.
@@ -89,6 +94,33 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
         ));
     }
     let obs = obs?;
+    // The observer must follow the drive's largest acceleration within the allowed angle.
+    let (acc, rule) = cx.max_acceleration();
+    let a_r = f64::from(nr) * acc;
+    let per_electrical = f64::from(nr) / f64::from(np);
+    let limit_r = angle_observer::MAX_TRACKING_ERROR_DEG.to_radians() * per_electrical;
+    let lag_r = angle_observer::ramp_lag(a_r, obs.ki, o.error);
+    if lag_r.is_none_or(|l| l > limit_r * (1.0 + 1e-12)) {
+        let wn_min = angle_observer::min_natural_frequency(a_r, limit_r, o.error);
+        cx.errors.push(cx.src.error(
+            o.natural_frequency.span.clone(),
+            &o.natural_frequency.key,
+            format!(
+                "at the drive's largest acceleration {acc:.1} rad/s² ({:.0} rpm/s; {}) the observer (K_i = ω_n² = {:.0} rad/s²) {} (type-2 loop: K_i·sin Δ = n_r·ω̇_m, thesis A §4.4); field orientation allows {}° electrical (thesis B §4.4.2)",
+                acc * 30.0 / PI,
+                rule.describe(),
+                obs.ki,
+                match lag_r {
+                    Some(l) => format!("lags by {:.1}° electrical", l / per_electrical * 180.0 / PI),
+                    None => "cannot follow at all (n_r·ω̇_m ≥ K_i: it slips cycles)".to_string(),
+                },
+                angle_observer::MAX_TRACKING_ERROR_DEG
+            ),
+            format!(
+                "a natural frequency of at least {wn_min:.0} rad/s, or drive.max_acceleration if the drive accelerates slower than that"
+            ),
+        ));
+    }
     let offset = spec.resolver.offset.as_ref().map(|p| p.value);
     let lead = o.lead_samples.value;
     Some(ObserverOut {
@@ -113,5 +145,7 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
         lead_samples: lead,
         lead_q16: (lead * 65_536.0).round() as i32,
         lead_at_max_speed_deg: angle_observer::lag_angle(lead, 2.0 * PI * fe_max, fs).to_degrees(),
+        lag_at_max_acceleration_deg: lag_r.map_or(f64::INFINITY, |l| (l / per_electrical).to_degrees()),
+        max_lag_deg: angle_observer::MAX_TRACKING_ERROR_DEG,
     })
 }

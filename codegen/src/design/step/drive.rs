@@ -3,6 +3,7 @@
 use serde::Serialize;
 
 use super::Context;
+use crate::design::acceleration::AccelerationRule;
 use crate::design::sampling;
 
 /// Inverter operating point.
@@ -20,6 +21,11 @@ pub struct DriveOut {
     pub dc_link_voltage_min_v: f64,
     /// Dead time [s].
     pub dead_time_s: Option<f64>,
+    /// Largest shaft acceleration the drive must follow [rad/s², mechanical]
+    /// (`design::acceleration`).
+    pub max_acceleration_rad_s2: f64,
+    /// Where it came from.
+    pub max_acceleration_rule: AccelerationRule,
 }
 
 /// The drive section; f_s below 12·f_e,max (1.1) is an error at `drive.switching_frequency`.
@@ -40,6 +46,7 @@ pub(in crate::design) fn drive(cx: &mut Context<'_>) -> DriveOut {
             ),
         ));
     }
+    let (acceleration, rule) = cx.max_acceleration();
     DriveOut {
         switching_frequency_hz: fs,
         sample_period_s: 1.0 / fs,
@@ -47,5 +54,7 @@ pub(in crate::design) fn drive(cx: &mut Context<'_>) -> DriveOut {
         dc_link_voltage_v: spec.drive.dc_link_voltage.value,
         dc_link_voltage_min_v: spec.drive.dc_link_voltage_min.value,
         dead_time_s: spec.drive.dead_time.as_ref().map(|p| p.value),
+        max_acceleration_rad_s2: acceleration,
+        max_acceleration_rule: rule,
     }
 }

@@ -36,6 +36,19 @@ impl Context<'_> {
         self.spec.drive.switching_frequency.value
     }
 
+    /// The largest shaft acceleration [rad/s², mechanical] and its rule
+    /// (`design::acceleration`).
+    pub fn max_acceleration(&self) -> (f64, super::acceleration::AccelerationRule) {
+        let m = &self.spec.motor;
+        let v = |p: &Option<crate::spec::Param>| p.as_ref().map(|p| p.value);
+        super::acceleration::max_acceleration(
+            v(&self.spec.drive.max_acceleration),
+            v(&m.peak_torque),
+            v(&m.inertia),
+            m.max_speed.value,
+        )
+    }
+
     /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).
     pub fn max_electrical_frequency(&self) -> f64 {
         let m = &self.spec.motor;

@@ -1,6 +1,6 @@
-//! The sensorless section (thesis B chapter 4) for a motor with known ψ_M: the
-//! estimator design, with ρ above α_c/10 (Table 4.1) an error at the `[sensorless]` key
-//! that set it.
+//! The sensorless section (thesis B chapter 4) for a spec with a `[sensorless]` section
+//! and a motor with known ψ_M: the estimator design, with ρ above α_c/10 (Table 4.1) an
+//! error at the `[sensorless]` key that set it.
 
 use std::f64::consts::{PI, SQRT_2};
 
@@ -10,7 +10,8 @@ use crate::design::sensorless;
 use crate::diagnostic::Diagnostic;
 use crate::spec::{DEFAULT_RESISTANCE_ERROR, Param, angle_error_rad};
 
-/// The estimator design and its notes (warnings), `None` without ψ_M.
+/// The estimator design and its notes (warnings), `None` without a `[sensorless]`
+/// section or without ψ_M (an error then, at the section: the rules need ψ_M).
 pub(in crate::design) fn sensorless(
     cx: &Context<'_>,
     per_unit: Option<&PerUnitOut>,
@@ -19,10 +20,17 @@ pub(in crate::design) fn sensorless(
     let src = &cx.src;
     let speed_max = 2.0 * PI * cx.max_electrical_frequency();
     let m = &spec.motor;
-    let Some(psi) = m.flux_linkage.as_ref().map(|p| p.value) else {
+    let Some(s) = spec.sensorless.as_ref() else {
         return Ok(None);
     };
-    let s = &spec.sensorless;
+    let Some(psi) = m.flux_linkage.as_ref().map(|p| p.value) else {
+        return Err(Box::new(src.error(
+            s.span.clone(),
+            "sensorless",
+            "the sensorless estimator (thesis B chapter 4) needs the flux linkage ψ_M (back-EMF estimation (4.51), (4.59))",
+            "motor.datasheet.flux_linkage (or torque_constant / back_emf_constant), or remove [sensorless]",
+        )));
+    };
     let i_max = SQRT_2 * m.peak_current.value;
     let value = |p: &Option<Param>| p.as_ref().map(|p| p.value);
     let inp = sensorless::Inputs {
@@ -77,6 +85,44 @@ pub(in crate::design) fn sensorless(
             ),
             accepted,
         )));
+    }
+    // The estimator must follow the drive's largest acceleration within θ̃max (4.74).
+    let (acc, rule) = cx.max_acceleration();
+    let rho_needed = sensorless::rho_from_acceleration(inp.pole_pairs * acc, out.angle_error_rad);
+    if out.rho_rad_s < rho_needed * (1.0 - 1e-9) {
+        let tracked = out.rho_rad_s.powi(2) * out.angle_error_rad.sin() / inp.pole_pairs;
+        let what = format!(
+            "the estimator bandwidth ρ = {:.1} rad/s follows a shaft acceleration of at most ρ²·sin θ̃max/n_p = {tracked:.1} rad/s² ({:.0} rpm/s) within θ̃max = {:.1}° (thesis B (4.74)), but the drive accelerates at {acc:.1} rad/s² ({:.0} rpm/s; {}): that needs ρ ≥ {rho_needed:.1} rad/s",
+            out.rho_rad_s,
+            tracked * 30.0 / PI,
+            out.angle_error_rad.to_degrees(),
+            acc * 30.0 / PI,
+            rule.describe(),
+        );
+        let (span, key, accepted) = match (&s.bandwidth, &s.max_acceleration) {
+            (Some(p), _) => (
+                p.span.clone(),
+                p.key.clone(),
+                format!("a bandwidth of at least {rho_needed:.1} rad/s (and at most α_c/10 = {:.1} rad/s)", out.rho_max_rad_s),
+            ),
+            (None, Some(p)) => (
+                p.span.clone(),
+                p.key.clone(),
+                format!("at least the drive's acceleration, {:.0} rpm/s", acc * 30.0 / PI),
+            ),
+            (None, None) => {
+                let b = &spec.current_loop.bandwidth;
+                (
+                    b.span.clone(),
+                    b.key.clone(),
+                    format!(
+                        "a current-loop bandwidth of at least 10·ρ = {:.0} rad/s (the default ρ = α_c/10, Table 4.1), a larger sensorless.max_angle_error, or a smaller drive.max_acceleration",
+                        10.0 * rho_needed
+                    ),
+                )
+            }
+        };
+        return Err(Box::new(src.error(span, key, what, accepted)));
     }
     Ok(Some((out, notes)))
 }
