@@ -43,6 +43,65 @@ pub fn mode_b_iq(i_max: f64, id: f64) -> f64 {
     (i_max * i_max - id * id).max(0.0).sqrt()
 }
 
+/// The speed [rad/s, electrical] at which the full-current MTPA point (i_d, i_q) reaches
+/// V'_max with the resistive drop (2.52): |v|² = (R·i_d − ω·L_q·i_q)² + (R·i_q + ω·(L_d·i_d +
+/// ψ_m))² = V'_max², the positive root of the quadratic in ω. Field weakening starts there.
+pub fn onset_speed(m: &LossModel, v_prime: f64) -> f64 {
+    let (id, iq) = loss_minimisation::mtpa_corner(m.psi, m.lq - m.ld, m.i_max);
+    let (xd, xq) = (-m.lq * iq, m.ld * id + m.psi);
+    let a = xd * xd + xq * xq;
+    let b = 2.0 * m.rs * (id * xd + iq * xq);
+    let c = m.rs * m.rs * (id * id + iq * iq) - v_prime * v_prime;
+    (-b + (b * b - 4.0 * a * c).max(0.0).sqrt()) / (2.0 * a)
+}
+
+/// How far |v| rises above V'_max [V] while the speed rises at `acceleration`
+/// [rad/s², electrical] into field weakening at `onset` [rad/s] ([`onset_speed`]), with
+/// the full torque demand on the current circle (Mode B (2.57), i_q = √(I_max² − i_d²)).
+///
+/// Linearised at the onset's MTPA corner (i_d, i_q) and voltage (v_d, v_q) (2.52): (2.55)
+/// moves i_d at γ·(V'² − |v|²) ≈ −2γV'·δ with δ = |v| − V'_max, and |v| answers with
+/// s = ∂|v|/∂i_d = (v_d·∂v_d/∂i_d + v_q·∂v_q/∂i_d)/|v|, ∂v_d/∂i_d = R + ω·L_q·i_d/i_q,
+/// ∂v_q/∂i_d = ω·L_d − R·i_d/i_q. With γ of (2.60) (ω_fw = max(ω_base, ω)) the loop's
+/// bandwidth is α = α_fw·s/(ω_fw·L_d) — below α_fw, since (2.60) assumes s = ω·L_d. The
+/// speed drives δ at ψ_s·ω̇_e (ψ_s = V'_max/ω, the stator flux), so dδ/dt = −α·δ + ψ_s·ω̇_e,
+/// and the current loop follows i_d^ref a ramp lag `lag` [s] behind
+/// (`discrete_loop::ramp_lag`): δ = ψ_s·ω̇_e·(1/α + τ_v). The onset is where δ is largest
+/// and α smallest (deeper in field weakening v_q/|v| → 1 and s → ω·L_d), so the estimate
+/// is on the safe side.
+pub fn voltage_overshoot(m: &LossModel, v_prime: f64, onset: f64, base_speed: f64, acceleration: f64, alpha_fw: f64, lag: f64) -> f64 {
+    let alpha = alpha_fw * voltage_sensitivity(m, onset) / (base_speed.max(onset) * m.ld);
+    v_prime / onset * acceleration * (1.0 / alpha + lag)
+}
+
+/// s = ∂|v|/∂i_d [V/A] at the full-current MTPA corner at speed `w` on the current circle
+/// (see [`voltage_overshoot`]).
+pub fn voltage_sensitivity(m: &LossModel, w: f64) -> f64 {
+    let (id, iq) = loss_minimisation::mtpa_corner(m.psi, m.lq - m.ld, m.i_max);
+    let vd = m.rs * id - w * m.lq * iq;
+    let vq = m.rs * iq + w * (m.ld * id + m.psi);
+    let diq = -id / iq;
+    let dvd = m.rs - w * m.lq * diq;
+    let dvq = w * m.ld + m.rs * diq;
+    (vd * dvd + vq * dvq) / vd.hypot(vq)
+}
+
+/// The smallest α_fw [rad/s] whose [`voltage_overshoot`] stays within `allowed` [V];
+/// `None` when the current loop's lag alone uses it up.
+pub fn min_bandwidth_for_overshoot(
+    m: &LossModel,
+    v_prime: f64,
+    onset: f64,
+    base_speed: f64,
+    acceleration: f64,
+    lag: f64,
+    allowed: f64,
+) -> Option<f64> {
+    let per_rate = allowed / (v_prime / onset * acceleration) - lag;
+    let ratio = voltage_sensitivity(m, onset) / (base_speed.max(onset) * m.ld);
+    (per_rate > 0.0).then(|| 1.0 / (per_rate * ratio))
+}
+
 /// Which rule set α_fw.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -134,6 +193,9 @@ pub struct FieldWeakeningOut {
     pub mtpa: MtpaTable,
     /// Loss-minimising table, when R_c or inverter losses are given.
     pub loss_minimisation: Option<LossMinimisation>,
+    /// Predicted rise of |v| above V'_max at the drive's largest acceleration [V]
+    /// ([`voltage_overshoot`]); null when the current loop is not designed.
+    pub voltage_overshoot_at_max_acceleration_v: Option<f64>,
 }
 
 /// α_fw [rad/s], the rule, and α_s if a speed-loop rule was used.
@@ -201,6 +263,7 @@ pub fn design(inp: &Inputs) -> FieldWeakeningOut {
             max_interpolation_error_a: mtpa_err,
         },
         loss_minimisation,
+        voltage_overshoot_at_max_acceleration_v: None,
     }
 }
 

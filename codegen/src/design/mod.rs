@@ -83,7 +83,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     let angle_observer = step::angle_observer::angle_observer(&mut cx);
     let fir = step::fir::fir(&mut cx);
     let adc = step::adc::adc(&mut cx);
-    let field_weakening = step::field_weakening::field_weakening(&mut cx);
+    let field_weakening = step::field_weakening::field_weakening(&mut cx, current_loop.as_ref());
     let (true, Some(current_loop), Some(angle_observer), Some(fir)) =
         (cx.errors.is_empty(), current_loop, angle_observer, fir)
     else {

@@ -130,12 +130,14 @@ pub fn top_speed(d: &Design, base: f64) -> f64 {
     w
 }
 
-/// Peak acceleration of the resolver angle as a fraction of the observer's K_i: the
-/// observer then lags by at most asin 0.05 ≈ 2.9° (resolver) on the ramp (thesis A §4.4).
-pub const RAMP_ACCELERATION: f64 = 0.05;
+/// cos φ of the largest turn of the current vector the tracking criterion of
+/// [`field_weakening`] allows: 95 % of it stays along the reference, as the torque
+/// criterion asks.
+pub const TRACKING_TURN_COS: f64 = 0.95;
 
-/// Speed ramp (cosine-shaped, peak acceleration [`RAMP_ACCELERATION`]·K_i) from ω_base/2
-/// to [`top_speed`] under full torque demand (i_q^0 = I_max), then held.
+/// Speed ramp (cosine-shaped, peak acceleration the drive's largest,
+/// `drive.max_acceleration_rad_s2`) from ω_base/2 to [`top_speed`] under full torque
+/// demand (i_q^0 = I_max), then held.
 ///
 /// Criteria (thesis B §2.3, Fig. 2.15):
 /// * the voltage never uses up the margin: peak |v| ≤ (V'_max + V_max)/2 — without field
@@ -144,7 +146,18 @@ pub const RAMP_ACCELERATION: f64 = 0.05;
 /// * the current stays in the circle (2.50): peak |i| ≤ 1.05·I_max (tracking and
 ///   harmonics);
 /// * the torque at the top speed is at least 95 % of the most the current circle and the
-///   V'_max ellipse allow there ([`max_torque`]).
+///   V'_max ellipse allow there ([`max_torque`]);
+/// * the electrical angle the controller transforms with stays within the design's
+///   field-orientation allowance (`angle_observer.max_lag_deg`, 10°: thesis B §4.4.2)
+///   of the true one during and after the ramp;
+/// * the currents track their references during and after the ramp:
+///   `|i_dq − i_dq^ref| ≤ 2·sin(φ/2)·|i^ref|max + |di^ref/dt|max·τ_v + ripple` with
+///   φ = acos 0.95 = 18.2°. A current vector turned by φ off its reference (a frame error
+///   turns it so) moves by 2·sin(φ/2)·|i| and keeps cos φ of it along the reference: φ is the
+///   largest turn that leaves the 95 % of the torque criterion above. The sampled current
+///   loop follows a reference moving at di^ref/dt with the steady lag τ_v·di^ref/dt of its
+///   type-1 loop (`current_loop.ramp_lag_s`); the ripple is |i − i^ref| in the last half
+///   of the hold before the ramp (harmonics, quantisation).
 pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
     let cfg = field_weakening_config(s.design);
     run(s, cfg)
@@ -164,15 +177,14 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
         };
     };
     let np = f64::from(m.pole_pairs);
-    let nr = f64::from(d.angle_observer.resolver_pole_pairs);
     let ts = d.drive.sample_period_s;
     let base = f64::from(fw.base_speed);
     let top = top_speed(d, base);
     let start = 0.5 * base;
     // Cosine speed profile ω(t) = ω_0 + Δ·(1 − cos πτ)/2, τ = (t − t_0)/T: the
     // acceleration rises and falls smoothly (no step for the observer), peaking at
-    // a = Δ·π/(2T) = RAMP_ACCELERATION·K_i (resolver angle).
-    let acc_e = RAMP_ACCELERATION * d.angle_observer.ki / nr * np;
+    // a = Δ·π/(2T) = n_p·ω̇_m,max (electrical), the drive's largest acceleration.
+    let acc_e = np * d.drive.max_acceleration_rad_s2;
     let alpha_fw = f64::from(fw.bandwidth);
     // Time scale from the designed α_fw (not the config under test, which may be broken,
     // e.g. α_fw = 0).
@@ -204,9 +216,13 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
     let v_prime = voltage_fraction(d) * v_max_design;
     let mut st = FieldWeakeningState::default();
     let mut prev = StepOutput::default();
-    let (mut t, mut w, mut id, mut iq, mut idr, mut iqr, mut v) =
-        (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
+    let (mut t, mut w, mut id, mut iq, mut idr, mut iqr, mut v, mut ang) =
+        (vec![], vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
     let (mut peak_v, mut peak_i) = (0.0f64, 0.0f64);
+    // Tracking: ripple in the hold before the ramp, then the peak error, the reference
+    // magnitude and rate during and after it, and the peak angle error.
+    let (mut ripple, mut peak_err, mut peak_ref, mut peak_rate, mut peak_angle) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let mut prev_ref: Option<(f64, f64)> = None;
     for _ in 0..n {
         b.plant.speed = segment(b.plant.t);
         let v_max = s.cfg.voltage_margin * effective_dc_link(prev.u_dc, s.cfg.dc_link_min) * INV_SQRT_3;
@@ -235,11 +251,29 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
         idr.push(f64::from(id_ref));
         iqr.push(f64::from(iq_ref));
         v.push(vm);
+        let (rd, rq) = (f64::from(id_ref), f64::from(iq_ref));
+        let err = (smp.i[0] - rd).hypot(smp.i[1] - rq);
+        let angle = smp.angle_error();
+        ang.push(angle.to_degrees());
+        if smp.t >= 0.5 * t0 && smp.t < t0 {
+            ripple = ripple.max(err);
+        }
         if smp.t >= t0 {
             peak_v = peak_v.max(vm);
             peak_i = peak_i.max(smp.i[0].hypot(smp.i[1]));
+            peak_err = peak_err.max(err);
+            peak_ref = peak_ref.max(rd.hypot(rq));
+            peak_angle = peak_angle.max(angle.abs());
+            if let Some((pd, pq)) = prev_ref {
+                peak_rate = peak_rate.max((rd - pd).hypot(rq - pq) / ts);
+            }
         }
+        prev_ref = Some((rd, rq));
     }
+    let theta_allowed = d.angle_observer.max_lag_deg.to_radians();
+    let lag = d.current_loop.ramp_lag_s;
+    let frame_term = 2.0 * (0.5 * TRACKING_TURN_COS.acos()).sin() * peak_ref;
+    let bound = frame_term + peak_rate * lag + ripple;
     let tail = ((0.25 * hold / ts) as usize).clamp(1, n);
     let mean = |x: &[f64]| x[n - tail..].iter().sum::<f64>() / tail as f64;
     let v_end = mean(&v);
@@ -286,6 +320,35 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
             criterion: "≥ 95 % of the most |i| ≤ I_max and |v| ≤ V'_max allow there".into(),
             pass: torque_end >= 0.95 * t_max,
         },
+        Check {
+            quantity: format!(
+                "peak electrical angle error |θ̂_e − θ_e| (ω̇_m = {}, {})",
+                format_value(d.drive.max_acceleration_rad_s2 * 30.0 / PI, "rpm/s"),
+                d.drive.max_acceleration_rule.describe()
+            ),
+            measured: peak_angle.to_degrees(),
+            designed: Some(d.angle_observer.lag_at_max_acceleration_deg),
+            unit: "°",
+            criterion: format!(
+                "≤ θ̃ = {}° (the design's field-orientation allowance, thesis B §4.4.2)",
+                d.angle_observer.max_lag_deg
+            ),
+            pass: peak_angle <= theta_allowed,
+        },
+        Check {
+            quantity: "peak |i_dq − i_dq^ref| during and after the ramp".into(),
+            measured: peak_err,
+            designed: Some(bound),
+            unit: "A",
+            criterion: format!(
+                "≤ 2·sin(φ/2)·|i^ref|max ({}, φ = acos 0.95) + |di^ref/dt|max·τ_v ({} · {}) + ripple ({})",
+                format_value(frame_term, "A"),
+                format_value(peak_rate, "A/s"),
+                format_value(lag * 1e3, "ms"),
+                format_value(ripple, "A")
+            ),
+            pass: peak_err <= bound,
+        },
     ];
     let traces = vec![
         trace(
@@ -314,6 +377,12 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
             "ω_e [rad/s]",
             &t,
             vec![series("ω_e", w)],
+        ),
+        trace(
+            "Field weakening: electrical angle error of the controller's frame",
+            "θ̂_e − θ_e [°]",
+            &t,
+            vec![series("θ̂_e − θ_e", ang)],
         ),
     ];
     ScenarioResult {

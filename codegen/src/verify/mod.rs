@@ -14,7 +14,8 @@
 //! | [`controller`] | [`ControllerConfig`] from a [`Design`] |
 //! | [`sim`] | controller + plant with the thesis-A §4.6 timing |
 //! | [`figures`] | rise time, overshoot, settling; designed responses |
-//! | [`scenarios`] | the scenarios and their criteria |
+//! | [`scenarios`] | the current-loop scenarios and their criteria |
+//! | [`observer`] | the angle-observer scenarios: lock, run-up at the drive's acceleration, type-2 lag |
 //! | [`frequency`] | frequency responses of the discrete designs (for the report) |
 //! | [`field_weakening`] | field weakening to 2× base speed (thesis B Fig. 2.15) |
 //! | [`estimator`] | sensorless estimator recovery, cycle slips (thesis B Figs. 4.17, 4.18) |
@@ -24,6 +25,7 @@ pub mod estimator;
 pub mod field_weakening;
 pub mod figures;
 pub mod frequency;
+pub mod observer;
 pub mod plant;
 pub mod scenarios;
 pub mod sim;
@@ -310,12 +312,17 @@ pub const SCENARIOS: &[Scenario] = &[
     },
     Scenario {
         id: "ato_lock",
-        run: scenarios::ato_lock,
+        run: observer::ato_lock,
         applies: always,
     },
     Scenario {
         id: "ato_ramp",
-        run: scenarios::ato_ramp,
+        run: observer::ato_ramp,
+        applies: always,
+    },
+    Scenario {
+        id: "ato_type2",
+        run: observer::ato_type2,
         applies: always,
     },
     Scenario {

@@ -9,28 +9,21 @@
 //!   i_d excursion must shrink at least 3× (thesis A Figs. 5.4 vs 5.6).
 //! * [`dc_link_step`] — U_dc drops 20 % at speed under load; the 1/U_dc feed-forward
 //!   (5.1) must limit the current error to the one-period kick (criterion below).
-//! * [`ato_lock`] — observer started π/2 off: it locks, no cycle slip, within the
-//!   designed linear settling time plus margin (thesis A (4.12)–(4.15)).
-//! * [`ato_ramp`] — speed ramp to the maximum speed: the lag during the ramp is the
-//!   designed a/K_i, and zero (within the integer dead zone) at constant speed (type-2
-//!   loop, thesis A §4.4).
+//!
+//! The angle-observer scenarios are in [`super::observer`].
 
-use std::f64::consts::PI;
-
-use motor_control::ato::AtoState;
 use motor_control::step::Demand;
 
-use super::figures::{designed_rise_time, designed_step, settling_time, step_figures};
-use super::plant::{SpeedProfile, wrap};
-use super::sim::{Bench, angle_q31, q31_angle};
+use super::figures::{designed_rise_time, designed_step, step_figures};
+use super::sim::Bench;
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use crate::design::sampled_loop::{OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
-use crate::spec::{Method, ObserverError};
+use crate::spec::Method;
 
 /// Most points kept per trace (the report plots them; more adds bytes, not information).
 const TRACE_POINTS: usize = 1500;
 
-fn check(quantity: impl Into<String>, measured: f64, designed: Option<f64>, unit: &'static str) -> Check {
+pub(super) fn check(quantity: impl Into<String>, measured: f64, designed: Option<f64>, unit: &'static str) -> Check {
     Check {
         quantity: quantity.into(),
         measured,
@@ -42,7 +35,7 @@ fn check(quantity: impl Into<String>, measured: f64, designed: Option<f64>, unit
 }
 
 impl Check {
-    fn criterion(mut self, text: impl Into<String>, pass: bool) -> Check {
+    pub(super) fn criterion(mut self, text: impl Into<String>, pass: bool) -> Check {
         self.criterion = text.into();
         self.pass = pass;
         self
@@ -76,7 +69,7 @@ pub(super) fn trace(title: impl Into<String>, y_label: &str, t_s: &[f64], series
     }
 }
 
-fn series(label: impl Into<String>, values: Vec<f64>) -> Series {
+pub(super) fn series(label: impl Into<String>, values: Vec<f64>) -> Series {
     Series {
         label: label.into(),
         values,
@@ -84,7 +77,7 @@ fn series(label: impl Into<String>, values: Vec<f64>) -> Series {
 }
 
 /// Samples for `seconds` at T_s.
-fn samples(s: &Setup<'_>, seconds: f64) -> usize {
+pub(super) fn samples(s: &Setup<'_>, seconds: f64) -> usize {
     (seconds / s.design.drive.sample_period_s).ceil() as usize
 }
 
@@ -448,232 +441,6 @@ pub fn dc_link_step(s: &Setup<'_>) -> ScenarioResult {
             format_value(a, "A")
         ),
         reference: "thesis A (5.1), Fig. 5.2, §4.6",
-        checks,
-        traces,
-    }
-}
-
-/// Time [s] for the continuous ATO (thesis A (4.12)–(4.14)) started `e0` rad off at rest
-/// to stay within `threshold`: ë + K_p·ė + K_i·e = 0, e(0) = e0, ė(0) = −K_p·e0.
-pub fn designed_lock_time(kp: f64, ki: f64, e0: f64, threshold: f64) -> f64 {
-    let wn = ki.sqrt();
-    let dt = 1e-3 / wn;
-    let (mut e, mut v) = (e0, -kp * e0);
-    let mut t = 0.0;
-    let mut last_out = 0.0;
-    let f = |e: f64, v: f64| (v, -kp * v - ki * e);
-    while t < 60.0 / wn {
-        let k1 = f(e, v);
-        let k2 = f(e + dt / 2.0 * k1.0, v + dt / 2.0 * k1.1);
-        let k3 = f(e + dt / 2.0 * k2.0, v + dt / 2.0 * k2.1);
-        let k4 = f(e + dt * k3.0, v + dt * k3.1);
-        e += dt / 6.0 * (k1.0 + 2.0 * k2.0 + 2.0 * k3.0 + k4.0);
-        v += dt / 6.0 * (k1.1 + 2.0 * k2.1 + 2.0 * k3.1 + k4.1);
-        t += dt;
-        if e.abs() >= threshold {
-            last_out = t;
-        }
-    }
-    last_out
-}
-
-/// Initial observer error of [`ato_lock`] [rad].
-pub const LOCK_INITIAL_ERROR: f64 = PI / 2.0;
-/// Lock threshold [rad] (1°).
-pub const LOCK_THRESHOLD: f64 = PI / 180.0;
-
-/// Observer started π/2 away from the resolver angle at standstill (gates off).
-pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
-    let o = &s.design.angle_observer;
-    let ts = s.design.drive.sample_period_s;
-    let mut b = s.bench(0.0);
-    b.state.observer = AtoState::locked(angle_q31(b.plant.theta_r() - LOCK_INITIAL_ERROR), 0);
-    let wn = o.natural_frequency_rad_s;
-    let n = samples(s, 25.0 / (o.damping.min(1.0) * wn));
-    let mut e = Vec::with_capacity(n);
-    let mut unwrapped = Vec::with_capacity(n);
-    let mut acc = 0.0f64;
-    for k in 0..n {
-        let smp = b.step(Demand::Off);
-        let err = wrap(smp.theta_r - q31_angle(smp.out.theta_r));
-        acc = if k == 0 { err } else { acc + wrap(err - acc) };
-        e.push(err);
-        unwrapped.push(acc);
-    }
-    let lock = settling_time(&e, ts, LOCK_THRESHOLD);
-    let designed = designed_lock_time(o.kp, o.ki, LOCK_INITIAL_ERROR, LOCK_THRESHOLD);
-    let slips = unwrapped.last().map_or(0.0, |x| (x / (2.0 * PI)).round().abs());
-    // Started at +π/2 (estimate behind), the trig-identity error sin Δ is only 2/π of the
-    // linear one at the start: allow 25 % over the linear design.
-    let checks = vec![
-        check(
-            "lock time (|θ_r − θ̂_r| < 1° for good) from π/2",
-            lock.map_or(f64::INFINITY, |t| t * 1e3),
-            Some(designed * 1e3),
-            "ms",
-        )
-        .criterion(
-            "locks within 1.25× the linear design",
-            lock.is_some_and(|t| t <= 1.25 * designed),
-        ),
-        check("cycle slips", slips, Some(0.0), "").criterion("0", slips == 0.0),
-    ];
-    let t: Vec<f64> = (0..n).map(|k| k as f64 * ts).collect();
-    let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<_>>();
-    let linear: Vec<f64> = {
-        // The designed linear response on the same grid, for the plot.
-        let (kp, ki) = (o.kp, o.ki);
-        let (mut x, mut v) = (LOCK_INITIAL_ERROR, -kp * LOCK_INITIAL_ERROR);
-        let sub = 10;
-        let h = ts / sub as f64;
-        t.iter()
-            .map(|_| {
-                let out = x;
-                for _ in 0..sub {
-                    let acc = -kp * v - ki * x;
-                    // Semi-implicit Euler on a 1/(10 f_s) grid: ω_n·h ≤ 1e-3, plot accuracy.
-                    v += h * acc;
-                    x += h * v;
-                }
-                out
-            })
-            .collect()
-    };
-    let traces = vec![trace(
-        "ATO lock from π/2 at standstill",
-        "θ_r − θ̂_r [°]",
-        &t,
-        vec![
-            series("simulated (firmware ATO)", deg(&e)),
-            series("designed (linear)", deg(&linear)),
-        ],
-    )];
-    ScenarioResult {
-        id: "ato_lock",
-        title: format!(
-            "Angle tracking observer locking from a π/2 error (ω_n = {}, ζ = {}, {})",
-            format_value(wn, "rad/s"),
-            o.damping,
-            match o.error {
-                ObserverError::TrigIdentity => "trig-identity error",
-                ObserverError::Atan2 => "atan2 error",
-            }
-        ),
-        reference: "thesis A (4.8)–(4.15), (4.19), (4.22)",
-        checks,
-        traces,
-    }
-}
-
-/// Designed lag of [`ato_ramp`] as a fraction of K_i: a = 0.1·K_i → Δ = asin 0.1 (trig
-/// identity) or 0.1 rad (atan2).
-pub const RAMP_LAG_FRACTION: f64 = 0.1;
-
-/// Speed ramp 0 → maximum speed at a = 0.1·K_i (resolver angle), then constant.
-pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
-    let d = s.design;
-    let o = &d.angle_observer;
-    let nr = f64::from(o.resolver_pole_pairs);
-    // Design intent K_i = ω_n² (4.15); the Q1.31 integer realises it to ki_quantisation_error.
-    let acc_r = RAMP_LAG_FRACTION * o.ki;
-    let lag_design = match o.error {
-        ObserverError::TrigIdentity => RAMP_LAG_FRACTION.asin(),
-        ObserverError::Atan2 => RAMP_LAG_FRACTION,
-    };
-    let w_max = d.motor.max_speed_rad_s;
-    let ramp = w_max / (acc_r / nr);
-    let hold = 20.0 / (o.damping.min(1.0) * o.natural_frequency_rad_s);
-    let profile = SpeedProfile {
-        from: 0.0,
-        to: w_max,
-        start: 0.0,
-        acceleration: acc_r / nr,
-    };
-    let mut b = Bench::new(s.cfg, s.plant(profile));
-    let n = samples(s, ramp + hold);
-    let mut t = Vec::with_capacity(n);
-    let mut e = Vec::with_capacity(n);
-    let mut w_true = Vec::with_capacity(n);
-    let mut w_est = Vec::with_capacity(n);
-    let speed_per_lsb = f64::from(s.cfg.speed_per_lsb);
-    for _ in 0..n {
-        let smp = b.step(Demand::Off);
-        t.push(smp.t);
-        e.push(wrap(smp.theta_r - q31_angle(smp.out.theta_r)));
-        w_true.push(nr * smp.omega_m);
-        w_est.push(f64::from(smp.out.omega_r) * speed_per_lsb);
-    }
-    let mean = |v: &[f64]| v.iter().sum::<f64>() / v.len().max(1) as f64;
-    let in_ramp: Vec<f64> = t
-        .iter()
-        .zip(&e)
-        .filter(|(t, _)| **t >= 0.5 * ramp && **t < ramp)
-        .map(|(_, e)| *e)
-        .collect();
-    let lag = mean(&in_ramp);
-    let tail = (n / 10).max(1).min(samples(s, 0.25 * hold).max(1));
-    let e_ss = e.iter().rev().take(tail).fold(0.0f64, |m, x| m.max(x.abs()));
-    let w_err = mean(&w_est[n - tail..]) - mean(&w_true[n - tail..]);
-    // Integer dead zone (ato.rs): the integral term K̃_i·ẽ^i rounds to 0 while
-    // |ẽ^i| < 2^30/K̃_i^i, i.e. |sin Δ| < 1/(2·K̃_i^i) (trig) or |Δ| < π/(2·K̃_i^i) (atan2).
-    let dead = match o.error {
-        ObserverError::TrigIdentity => (0.5 / f64::from(o.ki_q31)).min(1.0).asin(),
-        ObserverError::Atan2 => PI * 0.5 / f64::from(o.ki_q31),
-    };
-    let checks = vec![
-        check(
-            format!("angle lag during the ramp (a = {})", format_value(acc_r, "rad/s²")),
-            lag.to_degrees(),
-            Some(lag_design.to_degrees()),
-            "°",
-        )
-        .criterion(
-            "within 10 % of designed (type-2 loop: sin Δ = a/K_i)",
-            (lag / lag_design - 1.0).abs() <= 0.10,
-        ),
-        check(
-            format!(
-                "angle error at {} (constant speed)",
-                format_value(w_max * 30.0 / PI, "rpm")
-            ),
-            e_ss.to_degrees(),
-            Some(0.0),
-            "°",
-        )
-        .criterion(
-            format!(
-                "zero: ≤ 2× the Q1.31 integral dead zone ({})",
-                format_value(dead.to_degrees(), "°")
-            ),
-            e_ss <= 2.0 * dead,
-        ),
-        check("speed error at constant speed", w_err, Some(0.0), "rad/s").criterion(
-            format!("≤ 0.1 % of ω_r,max ({})", format_value(1e-3 * nr * w_max, "rad/s")),
-            w_err.abs() <= 1e-3 * nr * w_max,
-        ),
-    ];
-    let traces = vec![
-        trace(
-            "ATO angle error on a speed ramp to the maximum speed",
-            "θ_r − θ̂_r [°]",
-            &t,
-            vec![series("simulated", e.iter().map(|x| x.to_degrees()).collect())],
-        ),
-        trace(
-            "ATO speed on the ramp",
-            "resolver speed [rad/s]",
-            &t,
-            vec![series("true", w_true), series("observed ω̂_r", w_est)],
-        ),
-    ];
-    ScenarioResult {
-        id: "ato_ramp",
-        title: format!(
-            "Angle tracking observer on a ramp 0 → {} at {} (resolver)",
-            format_value(w_max * 30.0 / PI, "rpm"),
-            format_value(acc_r, "rad/s²")
-        ),
-        reference: "thesis A §4.4 (4.12)–(4.15), (4.22)",
         checks,
         traces,
     }

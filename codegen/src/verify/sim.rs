@@ -39,6 +39,8 @@ pub struct Sample {
     pub out: StepOutput,
     /// True resolver angle θ_r(t_n) [rad].
     pub theta_r: f64,
+    /// True electrical angle θ_e(t_n) = n_p·θ_m [rad].
+    pub theta_e: f64,
     /// True mechanical speed [rad/s].
     pub omega_m: f64,
 }
@@ -94,6 +96,7 @@ impl Bench {
             i: self.plant.i,
             out: StepOutput::default(),
             theta_r: self.plant.theta_r(),
+            theta_e: self.plant.theta_e(),
             omega_m: self.plant.omega_m(),
         };
         let out = self.cfg.process(&mut self.state, &mut SoftTrig, &sample, demand);
@@ -109,6 +112,14 @@ impl Bench {
 /// Angle [rad] → π-scaled Q1.31 stored integer (wrapping).
 pub fn angle_q31(theta: f64) -> i32 {
     (wrap(theta) / PI * Q31).round() as i64 as i32
+}
+
+impl Sample {
+    /// The electrical angle the controller transforms with, minus the true one, wrapped
+    /// [rad]: its field-orientation error.
+    pub fn angle_error(&self) -> f64 {
+        wrap(q31_angle(self.out.theta_e) - self.theta_e)
+    }
 }
 
 /// π-scaled Q1.31 stored integer → angle [rad].

@@ -58,6 +58,10 @@ pub struct CurrentLoopOut {
     pub overshoot: f64,
     /// The floors every axis's sampled loop meets (`design::sampled_loop`).
     pub floors: Floors,
+    /// Lag of the sampled loop behind a reference ramp [s], the larger axis
+    /// (`discrete_loop::ramp_lag`): a current reference moving at di/dt is followed
+    /// τ_v·di/dt behind.
+    pub ramp_lag_s: f64,
     /// d-axis gains.
     pub d: AxisGains,
     /// q-axis gains.
@@ -171,6 +175,10 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     }
     let hot = hot_variant(cx, r, ts);
     let (d, q) = gains?;
+    let ramp_lag = [(&d, m.d_inductance.value), (&q, m.q_inductance.value)]
+        .iter()
+        .map(|(g, l)| discrete_loop::ramp_lag(&g.loop_gains(), r, *l, ts, g.bandwidth_rad_s))
+        .fold(0.0, f64::max);
     let psi = m.flux_linkage.as_ref().map(|p| p.value);
     let kt = psi.map(|p| 1.5 * f64::from(m.pole_pairs) * p);
     Some(CurrentLoopOut {
@@ -195,6 +203,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             max_overshoot_pct: designed_os + OVERSHOOT_ALLOWANCE_PCT,
             rise_tolerance: promise.rise_time_s.map(|_| RISE_TOLERANCE),
         },
+        ramp_lag_s: ramp_lag,
         d,
         q,
         hot,

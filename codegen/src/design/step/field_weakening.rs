@@ -1,14 +1,20 @@
 //! The field-weakening section (thesis B §2.3, chapter 3) for a motor with known ψ_M:
-//! α_fw ≪ α_c is enforced at the key that set α_fw.
+//! α_fw ≪ α_c, and α_fw fast enough to keep |v| within the voltage margin at the drive's
+//! largest acceleration, are enforced at the key that set α_fw.
 
 use std::f64::consts::{PI, SQRT_2};
 
 use super::Context;
-use crate::design::field_weakening::{self, FieldWeakeningOut};
+use super::current_loop::CurrentLoopOut;
+use crate::design::field_weakening::{self, BandwidthRule, FieldWeakeningOut};
 use crate::design::{loss_minimisation, sampling};
 
-/// The field-weakening design, or `None` without ψ_M or with the broken rule in `cx.errors`.
-pub(in crate::design) fn field_weakening(cx: &mut Context<'_>) -> Option<FieldWeakeningOut> {
+/// The field-weakening design, or `None` without ψ_M or with the broken rule in `cx.errors`;
+/// `current_loop` (if designed) gives the current loop's ramp lag for the acceleration rule.
+pub(in crate::design) fn field_weakening(
+    cx: &mut Context<'_>,
+    current_loop: Option<&CurrentLoopOut>,
+) -> Option<FieldWeakeningOut> {
     let spec = cx.spec;
     let m = &spec.motor;
     let psi = m.flux_linkage.as_ref().map(|p| p.value).filter(|p| *p > 0.0)?;
@@ -45,7 +51,7 @@ pub(in crate::design) fn field_weakening(cx: &mut Context<'_>) -> Option<FieldWe
     let ceiling = field_weakening::MAX_BANDWIDTH_FRACTION * inp.current_bandwidth;
     if alpha_fw > ceiling {
         let (span, key, what, fix) = match (rule, &f.speed_loop_bandwidth, mech) {
-            (field_weakening::BandwidthRule::SpeedLoop, Some(p), _) => (
+            (BandwidthRule::SpeedLoop, Some(p), _) => (
                 p.span.clone(),
                 p.key.clone(),
                 format!("α_fw = 10·α_s = {alpha_fw:.1} rad/s"),
@@ -78,5 +84,69 @@ pub(in crate::design) fn field_weakening(cx: &mut Context<'_>) -> Option<FieldWe
         ));
         return None;
     }
-    Some(field_weakening::design(&inp))
+    let mut out = field_weakening::design(&inp);
+    // |v| must stay within half the margin V_max − V'_max while the shaft accelerates at the
+    // drive's largest rate (`motorgen verify` holds the field-weakening run to it).
+    let lag = current_loop?.ramp_lag_s;
+    let (acc, acc_rule) = cx.max_acceleration();
+    let acc_e = f64::from(m.pole_pairs) * acc;
+    let allowed = 0.5 * (inp.voltage_max - out.voltage_limit_v);
+    let onset = field_weakening::onset_speed(&inp.model, out.voltage_limit_v);
+    let delta = field_weakening::voltage_overshoot(
+        &inp.model,
+        out.voltage_limit_v,
+        onset,
+        out.base_speed_rad_s,
+        acc_e,
+        alpha_fw,
+        lag,
+    );
+    out.voltage_overshoot_at_max_acceleration_v = Some(delta);
+    if delta > allowed {
+        let need = field_weakening::min_bandwidth_for_overshoot(
+            &inp.model,
+            out.voltage_limit_v,
+            onset,
+            out.base_speed_rad_s,
+            acc_e,
+            lag,
+            allowed,
+        );
+        let a_max = acc * allowed / delta;
+        let (span, key, how) = match (rule, &f.speed_loop_bandwidth, mech) {
+            (BandwidthRule::SpeedLoop, Some(p), _) => (p.span.clone(), p.key.clone(), "a speed-loop bandwidth α_s = α_fw/10 of at least"),
+            (_, _, Some((_, j))) => (j.span.clone(), j.key.clone(), "b/J = α_fw/10 of at least"),
+            _ => (
+                spec.current_loop.bandwidth.span.clone(),
+                spec.current_loop.bandwidth.key.clone(),
+                "a current-loop bandwidth α_c = 10·α_fw (default α_fw = α_c/10, Fig. 2.15) of at least",
+            ),
+        };
+        let fix = match need {
+            Some(n) if n <= ceiling => format!(
+                "{how} {:.1} (α_fw ≥ {n:.0} rad/s), a smaller field_weakening.voltage_fraction (more margin), or a drive.max_acceleration of at most {:.0} rpm/s",
+                if rule == BandwidthRule::DefaultSpeedLoop { 10.0 * n } else { n / 10.0 },
+                a_max * 30.0 / PI
+            ),
+            _ => format!(
+                "a smaller field_weakening.voltage_fraction (more margin), a faster current loop, or a drive.max_acceleration of at most {:.0} rpm/s",
+                a_max * 30.0 / PI
+            ),
+        };
+        cx.errors.push(cx.src.error(
+            span,
+            key,
+            format!(
+                "at the drive's largest acceleration {acc:.1} rad/s² ({:.0} rpm/s; {}) the field-weakening loop (α_fw = {alpha_fw:.1} rad/s, current-loop ramp lag {:.3} ms) lets |v| rise {delta:.1} V above V'_max = {:.1} V, more than half the margin to V_max = {:.1} V ({allowed:.1} V): δ = (V'_max/ω_on)·n_p·ω̇_m·(1/α + τ_v) at the onset ω_on = {onset:.0} rad/s, α = α_fw·(∂|v|/∂i_d)/(ω_fw·L_d): (2.55), (2.60) linearised",
+                acc * 30.0 / PI,
+                acc_rule.describe(),
+                lag * 1e3,
+                out.voltage_limit_v,
+                inp.voltage_max
+            ),
+            fix,
+        ));
+        return None;
+    }
+    Some(out)
 }
