@@ -120,7 +120,7 @@ fn closed_pipe_exits_quietly() {
 /// An output directory holding the previous set ("old" in each file).
 fn old_set(name: &str) -> (PathBuf, Vec<PathBuf>) {
     let dir = common::tmp("output", name);
-    let files: Vec<PathBuf> = ["fischer-ti085.rs", "fischer-ti085.h", "fischer-ti085.md"]
+    let files: Vec<PathBuf> = ["fischer_ti085.rs", "fischer_ti085.h", "fischer-ti085.md"]
         .iter()
         .map(|f| dir.join(f))
         .collect();
@@ -150,17 +150,17 @@ fn temporaries(dir: &Path) -> Vec<String> {
 fn generate_writes_the_set_all_or_nothing() {
     let (dir, files) = old_set("generate_killed");
     let out = dir.display().to_string();
-    let limited = |trap: &str| {
+    let limited = |trap: &str, out: &str| {
         Command::new("bash")
             .arg("-c")
             .arg(format!("{trap} ulimit -f 4; exec \"$0\" generate \"$1\" --out \"$2\""))
             .arg(env!("CARGO_BIN_EXE_motorgen"))
             .arg(spec())
-            .arg(&out)
+            .arg(out)
             .output()
             .unwrap()
     };
-    let o = limited("");
+    let o = limited("", &out);
     assert_eq!(o.status.signal(), Some(SIGXFSZ), "{}", text_of(&o));
     assert!(all_old(&files));
     let left = temporaries(&dir);
@@ -174,7 +174,7 @@ fn generate_writes_the_set_all_or_nothing() {
 
     let (dir, files) = old_set("generate_efbig");
     let out = dir.display().to_string();
-    let o = limited("trap '' XFSZ;");
+    let o = limited("trap '' XFSZ;", &out);
     assert_eq!(o.status.code(), Some(EXIT_IO), "{}", text_of(&o));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("File too large") && err.contains("no file was replaced"), "{err}");
@@ -196,7 +196,7 @@ fn generate_refuses_before_replacing_any_file() {
         .unwrap();
     assert_eq!(o.status.code(), Some(EXIT_IO), "{}", text_of(&o));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("fischer-ti085.h") && err.contains("no file was replaced"), "{err}");
+    assert!(err.contains("fischer_ti085.h") && err.contains("no file was replaced"), "{err}");
     assert!(all_old(&files));
     assert!(temporaries(&dir).is_empty());
 }
