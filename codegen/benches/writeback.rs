@@ -66,9 +66,15 @@ fn main() {
     }
     let me = std::env::current_exe().expect("this bench's path");
     println!("writeback --dry-run path (apply + design + line diff), one child process per size");
-    println!("{:>14} {:>10} {:>14} {:>11}", "comment lines", "time [s]", "peak RSS [MB]", "diff lines");
+    println!(
+        "{:>14} {:>10} {:>14} {:>11}",
+        "comment lines", "time [s]", "peak RSS [MB]", "diff lines"
+    );
     for lines in SIZES {
-        let out = Command::new(&me).env(CHILD, lines.to_string()).output().expect("run the child");
+        let out = Command::new(&me)
+            .env(CHILD, lines.to_string())
+            .output()
+            .expect("run the child");
         assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
         let text = String::from_utf8_lossy(&out.stdout);
         let f: Vec<&str> = text.split_whitespace().collect();

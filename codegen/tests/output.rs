@@ -167,7 +167,11 @@ fn generate_writes_the_set_all_or_nothing() {
     assert_eq!(left.len(), 1, "{left:?}");
     let o = motorgen().args(["generate", &spec(), "--out", &out]).output().unwrap();
     assert!(o.status.success(), "{}", text_of(&o));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("removed"), "{}", text_of(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("removed"),
+        "{}",
+        text_of(&o)
+    );
     assert_eq!(String::from_utf8_lossy(&o.stdout).matches("wrote ").count(), 3);
     assert!(temporaries(&dir).is_empty());
     assert!(std::fs::read_to_string(&files[0]).unwrap().contains("pub const"));
@@ -177,7 +181,10 @@ fn generate_writes_the_set_all_or_nothing() {
     let o = limited("trap '' XFSZ;", &out);
     assert_eq!(o.status.code(), Some(EXIT_IO), "{}", text_of(&o));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("File too large") && err.contains("no file was replaced"), "{err}");
+    assert!(
+        err.contains("File too large") && err.contains("no file was replaced"),
+        "{err}"
+    );
     assert!(all_old(&files));
     assert!(temporaries(&dir).is_empty());
 }
@@ -196,7 +203,10 @@ fn generate_refuses_before_replacing_any_file() {
         .unwrap();
     assert_eq!(o.status.code(), Some(EXIT_IO), "{}", text_of(&o));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("fischer_ti085.h") && err.contains("no file was replaced"), "{err}");
+    assert!(
+        err.contains("fischer_ti085.h") && err.contains("no file was replaced"),
+        "{err}"
+    );
     assert!(all_old(&files));
     assert!(temporaries(&dir).is_empty());
 }

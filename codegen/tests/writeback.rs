@@ -127,7 +127,10 @@ fn concurrent_identifications_lose_nothing() {
     let (d_then_q, q_then_d) = (sequential("d", "q"), sequential("q", "d"));
     assert_ne!(d_then_q, q_then_d);
     for t in [&d_then_q, &q_then_d] {
-        assert!(t.contains("d_inductance = \"0.41") && t.contains("q_inductance = \"0.43"), "{t}");
+        assert!(
+            t.contains("d_inductance = \"0.41") && t.contains("q_inductance = \"0.43"),
+            "{t}"
+        );
     }
     assert!(d_then_q.contains("phase_resistance = \"0.14") && d_then_q.contains("step d: d.csv; step q: q.csv"));
     assert!(q_then_d.contains("phase_resistance = \"0.13") && q_then_d.contains("step q: q.csv; step d: d.csv"));
@@ -219,7 +222,11 @@ fn symlinks_are_written_through_and_hard_links_reported() {
     ok(&b.run(&link, "q", &[]));
     assert!(std::fs::symlink_metadata(&link).unwrap().file_type().is_symlink());
     assert_eq!(std::fs::read_link(&link).unwrap(), Path::new("real/motor.toml"));
-    assert!(std::fs::read_to_string(&target).unwrap().contains("q_inductance = \"0.43"));
+    assert!(
+        std::fs::read_to_string(&target)
+            .unwrap()
+            .contains("q_inductance = \"0.43")
+    );
     let in_real: Vec<_> = std::fs::read_dir(&real_dir).unwrap().collect();
     assert_eq!(in_real.len(), 1, "{in_real:?}");
 
@@ -269,11 +276,7 @@ fn comment_before_a_single_inductance_is_kept() {
 /// line, with what to write instead.
 #[test]
 fn inline_identified_table_is_refused_at_its_line() {
-    let spec = fischer_text().replacen(
-        "[motor]\n",
-        "[motor]\nidentified = { inductance = \"0.40 mH\" }\n",
-        1,
-    );
+    let spec = fischer_text().replacen("[motor]\n", "[motor]\nidentified = { inductance = \"0.40 mH\" }\n", 1);
     let b = Bench::new("inline", &spec);
     let check = common::motorgen(&["check", &b.spec.display().to_string()]);
     ok(&check);
@@ -285,7 +288,10 @@ fn inline_identified_table_is_refused_at_its_line() {
         err.contains(&format!("{}:{line}:14: `motor.identified`", b.spec.display())),
         "{err}"
     );
-    assert!(err.contains("inline table") && err.contains("[motor.identified]"), "{err}");
+    assert!(
+        err.contains("inline table") && err.contains("[motor.identified]"),
+        "{err}"
+    );
     assert_eq!(b.text(), spec);
 }
 
@@ -399,7 +405,8 @@ fn dry_run_on_a_long_spec() {
     assert_eq!(diff.len(), 6, "{stdout}");
     let header = 40_000 + line_of(&fischer_text(), "[motor.datasheet]");
     assert!(
-        diff.iter().any(|l| l.trim_start_matches('+').trim_start() == format!("{header} | [motor.identified]")),
+        diff.iter()
+            .any(|l| l.trim_start_matches('+').trim_start() == format!("{header} | [motor.identified]")),
         "{stdout}"
     );
     assert_eq!(b.text(), spec);

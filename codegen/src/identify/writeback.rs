@@ -1,15 +1,22 @@
 //! Identified values into the spec's `[motor.identified]` section with `toml_edit`:
 //! every other line, comment and the layout of the file stay as they were.
 //!
-//! * A written key gets a trailing comment saying how it was identified (the old value's
-//!   comment described the old value and is replaced).
+//! * Only changed lines are touched ([`apply`]): the others keep their bytes and line
+//!   endings, a byte-order mark stays, new lines take the file's line ending.
+//! * A written key gets a trailing comment `# identified: …` saying how it was
+//!   identified. The next identification replaces such a comment; any other trailing
+//!   comment on a replaced value (the user's) is kept on a line above the key, as
+//!   `# was <old value>: <comment>`.
 //! * `date` is set to the identification date (a TOML date) and `source` lists the
 //!   recordings per routine (`step q: a.csv, b.csv; flux: f.csv`): the entry of the
-//!   routine just run is replaced, the others are kept.
+//!   routine just run is replaced, the others are kept; their comments stay.
 //! * `[motor.identified]` wins over `[motor.datasheet]` key by key (see `spec`), so one
 //!   identified axis may stand next to a datasheet value for the other. If the
 //!   identified section holds a single `inductance` (L_d = L_q) and one axis is
-//!   identified, the other axis keeps that value as `d_inductance`/`q_inductance`.
+//!   identified, the other axis keeps that value as `d_inductance`/`q_inductance` in
+//!   its place, with its comments.
+//! * An inline `identified = {…}` or `motor = {…}` is refused ([`Refusal`]): it cannot
+//!   hold the comments.
 
 use std::ops::Range;
 
@@ -183,9 +190,13 @@ fn add_comment_line(decor: &mut toml_edit::Decor, line: &str) {
 
 /// The `toml_edit` part of [`apply`] on LF text.
 fn edit(text: &str, entries: &[Entry], origin: &Origin<'_>) -> Result<String, Refusal> {
-    let mut doc: DocumentMut = text
-        .parse()
-        .map_err(|e| Refusal::at(&[], format!("the spec is not valid TOML: {e}"), "a spec that `motorgen check` accepts"))?;
+    let mut doc: DocumentMut = text.parse().map_err(|e| {
+        Refusal::at(
+            &[],
+            format!("the spec is not valid TOML: {e}"),
+            "a spec that `motorgen check` accepts",
+        )
+    })?;
     let motor = match doc.get_mut("motor") {
         Some(Item::Table(t)) => t,
         Some(_) => {
@@ -195,7 +206,13 @@ fn edit(text: &str, entries: &[Entry], origin: &Origin<'_>) -> Result<String, Re
                 "`[motor]` as a section (a `[motor]` header with one `key = value` per line)",
             ));
         }
-        None => return Err(Refusal::at(&[], "the spec has no [motor] table", "a spec that `motorgen check` accepts")),
+        None => {
+            return Err(Refusal::at(
+                &[],
+                "the spec has no [motor] table",
+                "a spec that `motorgen check` accepts",
+            ));
+        }
     };
     let motor_position = motor.position();
     match motor.get("identified") {
@@ -215,7 +232,11 @@ fn edit(text: &str, entries: &[Entry], origin: &Origin<'_>) -> Result<String, Re
         }
     }
     let Some(Item::Table(ident)) = motor.get_mut("identified") else {
-        return Err(Refusal::at(&["motor", "identified"], "[motor.identified] is not a table", "a `[motor.identified]` section"));
+        return Err(Refusal::at(
+            &["motor", "identified"],
+            "[motor.identified] is not a table",
+            "a `[motor.identified]` section",
+        ));
     };
     let written = |k: &str| entries.iter().any(|e| e.key == k);
     // A single `inductance` becomes d/q when only one axis is identified now: the axis
@@ -297,7 +318,11 @@ fn splice(original: &str, old_lf: &str, new_lf: &str) -> String {
     let (orig, old, new) = (lines(original), lines(old_lf), lines(new_lf));
     debug_assert_eq!(orig.len(), old.len());
     let crlf = original.matches("\r\n").count();
-    let eol = if 2 * crlf > original.matches('\n').count() { "\r\n" } else { "\n" };
+    let eol = if 2 * crlf > original.matches('\n').count() {
+        "\r\n"
+    } else {
+        "\n"
+    };
     let mut out = String::with_capacity(new_lf.len() + new_lf.len() / 8);
     for op in capture_diff_slices(Algorithm::Myers, &old, &new) {
         let (tag, o, n) = op.as_tag_tuple();
@@ -436,7 +461,9 @@ mod tests {
         .unwrap();
         // The user's comment on the replaced value stays, above it, with the old value.
         assert!(
-            out.contains("[motor.identified]   # lab\n# was \"0.65 Ω\": old\nphase_resistance = \"0.6512 Ω\"  # identified: n\n"),
+            out.contains(
+                "[motor.identified]   # lab\n# was \"0.65 Ω\": old\nphase_resistance = \"0.6512 Ω\"  # identified: n\n"
+            ),
             "{out}"
         );
         assert!(out.contains("d_inductance = \"5 mH\"\n"), "{out}");
@@ -504,7 +531,9 @@ mod tests {
         }];
         let again = apply(&out, &d, &origin(&files, "step d")).unwrap();
         assert!(
-            again.contains("# LCR meter, 1 kHz\n# was \"5 mH\": both axes\nd_inductance = \"5.1 mH\"  # identified: m\n"),
+            again.contains(
+                "# LCR meter, 1 kHz\n# was \"5 mH\": both axes\nd_inductance = \"5.1 mH\"  # identified: m\n"
+            ),
             "{again}"
         );
         assert_eq!(again.matches("both axes").count(), 1, "{again}");

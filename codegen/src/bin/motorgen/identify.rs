@@ -152,7 +152,8 @@ struct Loaded {
 fn load(spec: &Path, common: &Common) -> Result<Loaded, Failure> {
     let date = match &common.date {
         Some(d) => {
-            writeback::parse_date(d).map_err(|e| plain_error("--date", e, "a date YYYY-MM-DD, e.g. --date 2025-03-14"))?;
+            writeback::parse_date(d)
+                .map_err(|e| plain_error("--date", e, "a date YYYY-MM-DD, e.g. --date 2025-03-14"))?;
             d.clone()
         }
         None => today(),
@@ -160,6 +161,10 @@ fn load(spec: &Path, common: &Common) -> Result<Loaded, Failure> {
     let (lock, text) = if common.dry_run {
         (None, crate::read_spec(spec)?)
     } else {
+        if std::fs::metadata(spec).is_err() {
+            // A missing spec is reported as every command reports it.
+            crate::read_spec(spec)?;
+        }
         let mut lock = LockedSpec::open(spec)?;
         let text = crate::spec_text(spec, std::mem::take(&mut lock.bytes))?;
         (Some(lock), text)
@@ -271,7 +276,10 @@ fn blame_identified(e: Diagnostic, old: &str, new: &str, keys: &str) -> Diagnost
             ..e
         },
         None => Diagnostic {
-            problem: format!("{problem} (line {} of the updated spec, which identify would write)", e.line),
+            problem: format!(
+                "{problem} (line {} of the updated spec, which identify would write)",
+                e.line
+            ),
             accepted,
             ..e
         },
@@ -290,8 +298,13 @@ fn write_back(spec: &Path, loaded: Loaded, entries: &[Entry], origin: &Origin<'_
     let keys: Vec<&str> = entries.iter().map(|e| e.key).collect();
     let keys = keys.join(", ");
     // The updated spec must still design; otherwise nothing is written.
-    let design = codegen::design_source(&file, &new)
-        .map_err(|d| Diagnostics(d.0.into_iter().map(|e| blame_identified(e, text, &new, &keys)).collect()))?;
+    let design = codegen::design_source(&file, &new).map_err(|d| {
+        Diagnostics(
+            d.0.into_iter()
+                .map(|e| blame_identified(e, text, &new, &keys))
+                .collect(),
+        )
+    })?;
     let Some(lock) = loaded.lock else {
         outln!("--dry-run: {file} would change as follows (nothing written):");
         out!("{}", writeback::line_diff(text, &new));
@@ -369,7 +382,13 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
     );
     outln!(
         "  {:<20} {:>8} {:>10} {:>10} {:>10} {:>12} {:>12}",
-        "recording", "U [V]", "R [Ω]", "τ [ms]", "L [mH]", "t_5% [T_s]", "T_d [T_s]"
+        "recording",
+        "U [V]",
+        "R [Ω]",
+        "τ [ms]",
+        "L [mH]",
+        "t_5% [T_s]",
+        "T_d [T_s]"
     );
     for (r, e) in recs.iter().zip(&estimates) {
         outln!(
@@ -389,11 +408,7 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         collect(|e| e.inductance_h),
         collect(|e| e.delay_samples),
     ) else {
-        return Err(plain_error(
-            &spec.display().to_string(),
-            "no recordings".into(),
-            "--csv FILE…",
-        ).into());
+        return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
     outln!(
         "  mean: R = {:.5} Ω ± {:.2} %, L_{name} = {:.5} mH ± {:.2} %, transport delay {:.2} ± {:.2} samples (1σ)",
@@ -464,11 +479,7 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
         return Err(Diagnostics(errors).into());
     }
     let Some(s) = Spread::of(&values) else {
-        return Err(plain_error(
-            &spec.display().to_string(),
-            "no recordings".into(),
-            "--csv FILE…",
-        ).into());
+        return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
     outln!("  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
     let files = names(csv);
@@ -493,7 +504,8 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
             "motorgen identify resolver",
             "no recordings given".into(),
             "--offset FILE… (resolver_offset runs) and/or --ratio FILE… (pole_pair_ratio runs)",
-        ).into());
+        )
+        .into());
     }
     let loaded = load(spec, common)?;
     let (text, design) = (&loaded.text, &loaded.design);
@@ -524,10 +536,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         return Err(Diagnostics(errors).into());
     }
     let expected = f64::from(np) / f64::from(nr);
-    let src = Source {
-        file: &file,
-        text,
-    };
+    let src = Source { file: &file, text };
     let at = writeback::value_span(text, &["motor", "pole_pairs"]).unwrap_or(0..0);
     for (r, e) in ratio_recs.iter().zip(&ratios) {
         if !e.directions_agree {
