@@ -4,17 +4,12 @@
 #![cfg(unix)]
 
 mod common;
-use common::repo;
+use common::{EXIT_IO, SIGXFSZ, repo, temporaries, text_of};
 
 use std::fs::OpenOptions;
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output, Stdio};
-
-/// `motorgen`'s exit code for an I/O failure (EX_IOERR, see the CLI's `output` module).
-const EXIT_IO: i32 = 74;
-/// SIGXFSZ (Linux: 25): the default action of exceeding RLIMIT_FSIZE.
-const SIGXFSZ: i32 = 25;
+use std::process::{Command, Stdio};
 
 fn spec() -> String {
     repo().join("motors/fischer-ti085.toml").display().to_string()
@@ -24,15 +19,6 @@ fn motorgen() -> Command {
     let mut c = Command::new(env!("CARGO_BIN_EXE_motorgen"));
     c.current_dir(repo());
     c
-}
-
-fn text_of(o: &Output) -> String {
-    format!(
-        "status {:?}\nstdout:\n{}\nstderr:\n{}",
-        o.status,
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 /// The commands that print to stdout, with arguments, and a directory for `report`.
@@ -132,14 +118,6 @@ fn old_set(name: &str) -> (PathBuf, Vec<PathBuf>) {
 
 fn all_old(files: &[PathBuf]) -> bool {
     files.iter().all(|f| std::fs::read_to_string(f).unwrap() == "old\n")
-}
-
-fn temporaries(dir: &Path) -> Vec<String> {
-    std::fs::read_dir(dir)
-        .unwrap()
-        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-        .filter(|n| n.ends_with(".tmp"))
-        .collect()
 }
 
 /// `generate` under a 4 KiB file-size limit (`ulimit -f 4`; the Rust module is larger):

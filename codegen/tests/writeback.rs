@@ -8,17 +8,12 @@
 
 mod common;
 use common::recordings::step_recording;
-use common::repo;
+use common::{EXIT_IO, SIGXFSZ, repo, text_of};
 
 use std::os::unix::fs::{MetadataExt, PermissionsExt};
 use std::os::unix::process::ExitStatusExt;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
-
-/// `motorgen`'s exit code for an I/O failure (EX_IOERR, see the CLI's `output` module).
-const EXIT_IO: i32 = 74;
-/// SIGXFSZ (Linux: 25): the default action of exceeding RLIMIT_FSIZE.
-const SIGXFSZ: i32 = 25;
 
 fn fischer_text() -> String {
     std::fs::read_to_string(repo().join("motors/fischer-ti085.toml")).unwrap()
@@ -78,23 +73,10 @@ impl Bench {
         std::fs::read_to_string(&self.spec).unwrap()
     }
 
-    /// Names of files in the directory that look like temporary files.
+    /// Temporary files left in the directory.
     fn leftovers(&self) -> Vec<String> {
-        std::fs::read_dir(&self.dir)
-            .unwrap()
-            .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
-            .filter(|n| n.ends_with(".tmp"))
-            .collect()
+        common::temporaries(&self.dir)
     }
-}
-
-fn text_of(o: &Output) -> String {
-    format!(
-        "status {:?}\nstdout:\n{}\nstderr:\n{}",
-        o.status,
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
 }
 
 fn ok(o: &Output) {

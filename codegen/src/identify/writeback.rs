@@ -442,23 +442,7 @@ mod tests {
     fn updates_in_place() {
         let spec = "[motor]\npole_pairs = 4\n\n[motor.identified]   # lab\nphase_resistance = \"0.65 Ω\"   # old\ninductance = \"5 mH\"\nsource = \"flux: f.csv; step q: old.csv\"\n\n[resolver]\npole_pairs = 1\n";
         let files = vec!["new.csv".to_string()];
-        let out = apply(
-            spec,
-            &[
-                Entry {
-                    key: "phase_resistance",
-                    value: "0.6512 Ω".into(),
-                    note: "n".into(),
-                },
-                Entry {
-                    key: "q_inductance",
-                    value: "7.612 mH".into(),
-                    note: "n".into(),
-                },
-            ],
-            &origin(&files, "step q"),
-        )
-        .unwrap();
+        let out = apply(spec, &q_entries(), &origin(&files, "step q")).unwrap();
         // The user's comment on the replaced value stays, above it, with the old value.
         assert!(
             out.contains(
