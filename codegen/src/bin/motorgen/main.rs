@@ -1,12 +1,8 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
-#[path = "motorgen/firmware.rs"]
 mod firmware;
-#[path = "motorgen/identify.rs"]
 mod identify;
-#[path = "motorgen/report.rs"]
 mod report;
-#[path = "motorgen/verify.rs"]
 mod verify;
 
 use std::path::{Path, PathBuf};
