@@ -1,16 +1,10 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
-#[path = "motorgen/atomic.rs"]
 mod atomic;
-#[path = "motorgen/firmware.rs"]
 mod firmware;
-#[path = "motorgen/identify.rs"]
 mod identify;
-#[path = "motorgen/output.rs"]
 mod output;
-#[path = "motorgen/report.rs"]
 mod report;
-#[path = "motorgen/verify.rs"]
 mod verify;
 
 use std::path::{Path, PathBuf};
