@@ -107,15 +107,16 @@ const PLOTS: &[&str] = &[
     "dq-plane",
 ];
 
-/// The plots of the field-weakening and estimator scenarios (motors with ψ_M).
-const FLUX_PLOTS: &[&str] = &[
+/// The plots of the field-weakening scenario (motors with ψ_M).
+const FIELD_WEAKENING_PLOTS: &[&str] = &[
     "field-weakening-0",
     "field-weakening-1",
     "field-weakening-2",
-    "sensorless-0",
-    "sensorless-1",
-    "sensorless-2",
+    "field-weakening-3",
 ];
+
+/// The plots of the estimator scenario (motors with ψ_M and a `[sensorless]` section).
+const SENSORLESS_PLOTS: &[&str] = &["sensorless-0", "sensorless-1", "sensorless-2"];
 
 #[test]
 fn report_loads_in_headless_chromium_with_every_plot() {
@@ -147,10 +148,14 @@ fn report_loads_in_headless_chromium_with_every_plot() {
                 &rest[..rest.find('"').unwrap()]
             })
             .collect();
-        // Motors with ψ_M also get the field-weakening and sensorless scenarios' plots.
+        // Motors with ψ_M also get the field-weakening plots, and those with a
+        // `[sensorless]` section the estimator's.
         let mut want: Vec<&str> = PLOTS.to_vec();
         if html.contains("Field weakening, ramp") {
-            want.extend(FLUX_PLOTS);
+            want.extend(FIELD_WEAKENING_PLOTS);
+        }
+        if html.contains("Angle estimation error") {
+            want.extend(SENSORLESS_PLOTS);
         }
         assert_eq!(ids, want, "{stem}: plots in the loaded page");
         for id in &want {
@@ -198,8 +203,9 @@ fn verify_prints_the_table() {
         "dc_link_step:",
         "ato_lock: cycle slips",
         "ato_ramp:",
+        "ato_type2:",
         "field_weakening: peak |v| on the ramp",
-        "estimator_recovery: cycle slips with the resetting term",
+        "field_weakening: peak |i_dq − i_dq^ref|",
         "7 of 7 scenarios passed",
     ] {
         assert!(stdout.contains(word), "{word} missing:\n{stdout}");

@@ -164,13 +164,13 @@ mod tests {
     /// default acceleration, 20 000 rpm in 10 s = 209.44 rad/s² (`acceleration`, n_r = 1):
     /// sin Δ = 209.44/4900 = 0.042743 → Δ = 2.4497° of resolver angle = 9.799° electrical
     /// (n_p = 4), inside the 10° allowance; the ω_n that lags exactly 10° electrical
-    /// (2.5° resolver) is √(209.44/sin 2.5°) = √4801.9 = 69.296 rad/s.
+    /// (2.5° resolver) is √(209.44/sin 2.5°) = √(209.44/0.043619) = √4801.5 = 69.293 rad/s.
     #[test]
     fn type_2_lag_by_hand() {
         let lag = ramp_lag(209.44, 4900.0, ObserverError::TrigIdentity).unwrap();
         assert!((lag.to_degrees() - 2.4497).abs() < 1e-4, "{}", lag.to_degrees());
         let wn = min_natural_frequency(209.44, 2.5f64.to_radians(), ObserverError::TrigIdentity);
-        assert!((wn - 69.296).abs() < 1e-3, "{wn}");
+        assert!((wn - 69.293).abs() < 1e-3, "{wn}");
         assert_eq!(ramp_lag(4900.0, 4900.0, ObserverError::TrigIdentity), None);
         // atan2: linear in Δ, 209.44/4900 rad = 2.4490°.
         let lag = ramp_lag(209.44, 4900.0, ObserverError::Atan2).unwrap();

@@ -138,10 +138,11 @@ pub fn first_order_compensated(
 /// k_p = (P + S·p₃ − a)/b,   k_i·T_s = k_p − P·p₃/b,   c = k_i·T_s/k_p
 /// ```
 ///
-/// A k_p ≤ 0 (the discrete counterpart of ω_n·ζ < R/(2L), thesis A §5.4.1) is refused as
-/// a right-half-plane zero with the continuous rule's smallest bandwidth. Close to the
-/// sampling rate p₃ leaves the unit circle (and k_i may turn negative): such gains are
-/// returned and refused by the floors of [`super::sampled_loop`].
+/// A k_p ≤ 0 within twice the continuous rule's smallest bandwidth (the discrete
+/// counterpart of ω_n·ζ < R/(2L), thesis A §5.4.1) is refused as a right-half-plane zero
+/// with that bandwidth. Close to the sampling rate p₃ leaves the unit circle (and k_p or
+/// k_i may turn negative): such gains are returned and refused by the floors of
+/// [`super::sampled_loop`].
 pub fn pole_placement(axis: char, r: f64, l: f64, alpha: f64, zeta: f64, ts: f64) -> Result<Pi, CurrentLoopError> {
     // The continuous design: its RHP-zero rule, its designed poles.
     let cont = continuous(Method::PolePlacement, axis, r, l, alpha, zeta, ts)?;
@@ -158,12 +159,12 @@ pub fn pole_placement(axis: char, r: f64, l: f64, alpha: f64, zeta: f64, ts: f64
     let p3 = 1.0 + p.a - sum;
     let kp = (product + sum * p3 - p.a) / p.b;
     let ki_ts = kp - product * p3 / p.b;
-    if kp <= 0.0 {
-        let wn_min = r / (2.0 * l * zeta);
-        return Err(CurrentLoopError::RhpZero {
-            axis,
-            min_bandwidth_rad_s: wn_min * alpha / wn,
-        });
+    // k_p ≤ 0 near the continuous rule's limit is its right-half-plane zero; far above it
+    // (poles faster than one period of delay lets the loop place) the gains go to the
+    // floors, which refuse them and name the largest bandwidth that works.
+    let min_bandwidth_rad_s = r / (2.0 * l * zeta) * alpha / wn;
+    if kp <= 0.0 && alpha <= 2.0 * min_bandwidth_rad_s {
+        return Err(CurrentLoopError::RhpZero { axis, min_bandwidth_rad_s });
     }
     let c = ki_ts / kp;
     Ok(Pi {
@@ -303,16 +304,17 @@ mod tests {
     use super::*;
     use crate::design::current_loop::design_axis;
 
-    /// Ramp lag of the first-order loop α/(s + α) is 1/α; the sampled IMC loop adds the
-    /// 1.5·T_s of delay (one period of computation, half a period of ZOH) and the
-    /// forward-difference integrator's half period: about 1/α + 2·T_s. Fischer at α = 100
-    /// rad/s, 20 kHz: 10 ms + 0.1 ms, to the third digit.
+    /// Hand calculation: the ramp error of a type-1 sampled loop is 1/K_v with
+    /// K_v = lim_{z→1} (z − 1)·C(z)·G(z)/T_s. Near z = 1 the forward-difference PI is
+    /// k_i·T_s/(z − 1) and the ZOH plant (delays included) has DC gain 1/R, so
+    /// K_v = k_i/R = α·R/R = α: the delays shift the response but not the steady lag, which
+    /// is exactly 1/α. Fischer at α = 100 rad/s, 20 kHz: 10 ms.
     #[test]
-    fn ramp_lag_is_one_over_alpha_plus_the_delay() {
+    fn ramp_lag_is_one_over_alpha() {
         let (r, l, ts) = (0.126, 0.393e-3, 5e-5);
         let g = design_axis(Method::Imc, 'd', r, l, 100.0, 0.0, ts).unwrap();
         let lag = ramp_lag(&g.loop_gains(), r, l, ts, 100.0);
-        assert!((lag / (0.01 + 2.0 * ts) - 1.0).abs() < 2e-3, "{lag}");
+        assert!((lag / 0.01 - 1.0).abs() < 1e-3, "{lag}");
     }
 
     /// Far below the sampling rate the sampled IMC loop rises as the continuous design,

@@ -101,6 +101,14 @@ pub struct HotVariant {
     pub q: AxisGains,
 }
 
+/// `x` > 0 rounded down to three significant figures: the bandwidth an error names lies
+/// inside the floors, not on the bisected boundary (where the firmware's fixed-point step
+/// may land a hair past the overshoot floor).
+fn round_down_3(x: f64) -> f64 {
+    let unit = 10f64.powi(x.log10().floor() as i32 - 2);
+    (x / unit).floor() * unit
+}
+
 /// The current-loop section, or `None` with the broken rules in `cx.errors`.
 pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoopOut> {
     let spec = cx.spec;
@@ -130,7 +138,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             .find_map(|(a, g)| g.sampled.breach(&promise).map(|b| (*a, b)))
     {
         let req = request(spec, r, ts);
-        let best = discrete_loop::largest_bandwidth(&req, c.bandwidth.value);
+        let best = discrete_loop::largest_bandwidth(&req, c.bandwidth.value).map(round_down_3);
         let b = &c.bandwidth;
         cx.errors.push(cx.src.error(
             b.span.clone(),
@@ -288,5 +296,17 @@ fn loop_error(src: &Source<'_>, spec: &Spec, e: CurrentLoopError) -> Diagnostic 
             format!("α_c·L < R on the {axis} axis: the active damping R_a = α_c·L − R (thesis B 2.43) would be negative"),
             format!("a bandwidth above R/L = {:.1} rad/s, or method = \"imc\"", min_bandwidth_rad_s),
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::round_down_3;
+
+    #[test]
+    fn named_bandwidth_is_rounded_down() {
+        assert_eq!(round_down_3(13_694.6), 13_600.0);
+        assert_eq!(round_down_3(6280.3), 6280.0);
+        assert_eq!(round_down_3(999.99), 999.0);
     }
 }
