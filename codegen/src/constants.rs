@@ -257,7 +257,7 @@ pub fn constants(d: &Design) -> Vec<Group> {
                 phys(g.kp, "V/A"),
                 kp_f,
                 eq,
-                ins.clone(),
+                format!("{ins}; {}", g.sampled.describe()),
             )
             .at(j("kp")),
         );

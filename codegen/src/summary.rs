@@ -44,7 +44,7 @@ pub fn summary(d: &Design) -> String {
         )?;
         writeln!(
             s,
-            "current loop: {:?}, α = {:.3} rad/s (limit {:.0} rad/s)",
+            "current loop: {:?}, α = {:.3} rad/s (guideline of thesis A §5.4.1: below {:.0} rad/s)",
             c.method, c.bandwidth_rad_s, c.bandwidth_limit_rad_s
         )?;
         if let Some([td, tq]) = c.sampled_rise_time_s {
@@ -64,12 +64,21 @@ pub fn summary(d: &Design) -> String {
                 }
             )?;
         }
+        writeln!(
+            s,
+            "  delay compensation: {}; floors: phase margin ≥ {}°, gain margin ≥ {} dB, overshoot ≤ {:.1} %",
+            if c.compensate_delay { "on (default; compensate_delay = false turns it off)" } else { "off (compensate_delay = false)" },
+            c.floors.min_phase_margin_deg,
+            c.floors.min_gain_margin_db,
+            c.floors.max_overshoot_pct
+        )?;
         for (axis, g) in [("d", &c.d), ("q", &c.q)] {
             writeln!(
                 s,
                 "  {axis}: K_p = {:.6} V/A, K_i = {:.6} V/(A·s); K_a = {:.6}, K_b = {:.4} rad/s (5.7); R_a = {:.4} Ω",
                 g.kp, g.ki, g.ka, g.kb, g.active_damping_ohm
             )?;
+            writeln!(s, "     {}", g.sampled.describe())?;
         }
         if let Some(k) = c.feedforward.iq_per_nm {
             writeln!(s, "  torque → i_q: {k:.5} A/(N·m) (2.34)")?;
@@ -83,6 +92,15 @@ pub fn summary(d: &Design) -> String {
             s,
             "  K_p = {}, K_i = {} (4.15); Q1.31: K̃_p = {}, K̃_i = {} (4.22)",
             o.kp, o.ki, o.kp_q31, o.ki_q31
+        )?;
+        writeln!(
+            s,
+            "  drive's largest acceleration {:.1} rad/s² ({:.0} rpm/s; {}): type-2 lag {:.2}° electrical (allowed {}°)",
+            d.drive.max_acceleration_rad_s2,
+            d.drive.max_acceleration_rad_s2 * 30.0 / std::f64::consts::PI,
+            d.drive.max_acceleration_rule.describe(),
+            o.lag_at_max_acceleration_deg,
+            o.max_lag_deg
         )?;
         writeln!(
             s,

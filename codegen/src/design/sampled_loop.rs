@@ -205,6 +205,19 @@ impl std::fmt::Display for FloorBreach {
 }
 
 impl SampledLoop {
+    /// One line for the summary, the report and the constants' doc comments: margins,
+    /// overshoot and the largest closed-loop pole magnitude.
+    pub fn describe(&self) -> String {
+        let opt = |x: Option<f64>, unit: &str, none: &str| x.map_or(none.to_string(), |v| format!("{v:.1}{unit}"));
+        format!(
+            "sampled loop (1.5·T_s delay): phase margin {}, gain margin {}, step overshoot {}, poles |z| ≤ {:.3}",
+            opt(self.phase_margin_deg, "°", "∞"),
+            opt(self.gain_margin_db, " dB", "∞"),
+            opt(self.overshoot_pct, " %", "— (unstable)"),
+            self.spectral_radius
+        )
+    }
+
     /// The first floor this loop breaks, given what the method designs.
     pub fn breach(&self, promise: &Promise) -> Option<FloorBreach> {
         let designed_overshoot_pct = promise.overshoot_pct;

@@ -341,6 +341,19 @@ pub fn html(d: &Design, v: &Verification, plots: &[Plot]) -> String {
             continue;
         }
         let _ = writeln!(s, "<h2 id=\"{id}\">{}</h2>", escape(title));
+        if *id == "current-loop" {
+            let c = &d.current_loop;
+            let _ = writeln!(
+                s,
+                "<p>Sampled loop (T_s, 1.5·T_s delay; floors: phase margin ≥ {}°, gain margin ≥ {} dB, overshoot ≤ {:.1} %; delay compensation {}):</p>\n<ul>\n<li>d axis: {}</li>\n<li>q axis: {}</li>\n</ul>",
+                c.floors.min_phase_margin_deg,
+                c.floors.min_gain_margin_db,
+                c.floors.max_overshoot_pct,
+                if c.compensate_delay { "on" } else { "off" },
+                escape(&c.d.sampled.describe()),
+                escape(&c.q.sampled.describe())
+            );
+        }
         for p in here {
             let _ = writeln!(
                 s,
