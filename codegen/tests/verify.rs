@@ -344,3 +344,31 @@ fn controller_config_is_the_generated_constants() {
         );
     }
 }
+
+/// A too-slow angle observer in field weakening (Fischer, ω_n = 40 rad/s instead of 70):
+/// the controller's frame lags and the current vector turns off its reference. Hand
+/// calculation at the default acceleration 2000 rpm/s = 209.44 rad/s² (n_r = 1): K_i =
+/// 1600 rad/s², sin Δ = 209.44/1600 = 0.1309 → Δ = 7.52° resolver = 30.1° electrical
+/// (n_p = 4), beyond the 10° allowance; a 30° turn moves the current by 2·sin 15° = 0.52
+/// of |i^ref|, beyond the 2·sin 9.1° = 0.32 of the tracking bound. Both checks fail;
+/// the designed observer passes both.
+#[test]
+fn slow_observer_loses_current_tracking_in_field_weakening() {
+    use codegen::design::angle_observer::design as observer;
+    use codegen::verify::field_weakening::{field_weakening_config, run as fw_run};
+    let (s, mut d) = load(&motor("fischer-ti085"));
+    let good = fw_run(&Setup::new(&s, &d), field_weakening_config(&d));
+    let find = |r: &codegen::verify::ScenarioResult, q: &str| {
+        r.checks.iter().find(|c| c.quantity.starts_with(q)).cloned().unwrap()
+    };
+    assert!(find(&good, "peak |i_dq − i_dq^ref|").pass, "{:?}", good.checks);
+    assert!(find(&good, "peak electrical angle error").pass);
+    let g = observer(40.0, 1.0, 20e3, d.angle_observer.error).unwrap();
+    d.angle_observer.kp_q31 = g.kp_q31;
+    d.angle_observer.ki_q31 = g.ki_q31;
+    let r = fw_run(&Setup::new(&s, &d), field_weakening_config(&d));
+    let angle = find(&r, "peak electrical angle error");
+    assert!(!angle.pass && (angle.measured - 30.1).abs() < 3.0, "{angle:?}");
+    let track = find(&r, "peak |i_dq − i_dq^ref|");
+    assert!(!track.pass, "{track:?}");
+}
