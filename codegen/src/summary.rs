@@ -67,7 +67,11 @@ pub fn summary(d: &Design) -> String {
         writeln!(
             s,
             "  delay compensation: {}; floors: phase margin ≥ {}°, gain margin ≥ {} dB, overshoot ≤ {:.1} %",
-            if c.compensate_delay { "on (default; compensate_delay = false turns it off)" } else { "off (compensate_delay = false)" },
+            if c.compensate_delay {
+                "on (default; compensate_delay = false turns it off)"
+            } else {
+                "off (compensate_delay = false)"
+            },
             c.floors.min_phase_margin_deg,
             c.floors.min_gain_margin_db,
             c.floors.max_overshoot_pct

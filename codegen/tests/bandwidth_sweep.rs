@@ -43,7 +43,11 @@ fn with_loop(text: &str, body: &str) -> String {
 }
 
 fn body(method: &str, alpha: f64, compensate: bool) -> String {
-    let damping = if method == "pole_placement" { "\ndamping = 0.7071" } else { "" };
+    let damping = if method == "pole_placement" {
+        "\ndamping = 0.7071"
+    } else {
+        ""
+    };
     format!("method = \"{method}\"\nbandwidth = \"{alpha:.1} rad/s\"{damping}\ncompensate_delay = {compensate}")
 }
 
@@ -61,7 +65,11 @@ fn judge(file: &str, text: &str) -> Verdict {
     let s = spec::parse(src).unwrap_or_else(|e| panic!("{file}: {e:?}"));
     match design::design(&s, src) {
         Ok(d) => Verdict::Accepted(Box::new((s, d))),
-        Err(e) => match e.0.iter().find(|d| d.key == "current_loop.bandwidth" && d.problem.contains("sampled")) {
+        Err(e) => match e
+            .0
+            .iter()
+            .find(|d| d.key == "current_loop.bandwidth" && d.problem.contains("sampled"))
+        {
             Some(d) => {
                 let best = d
                     .accepted
@@ -70,7 +78,10 @@ fn judge(file: &str, text: &str) -> Verdict {
                     .and_then(|n| n.parse().ok());
                 Verdict::Refused(d.problem.clone(), best)
             }
-            None => Verdict::Other(format!("{:?}", e.0.iter().map(|d| (&d.key, &d.problem)).collect::<Vec<_>>())),
+            None => Verdict::Other(format!(
+                "{:?}",
+                e.0.iter().map(|d| (&d.key, &d.problem)).collect::<Vec<_>>()
+            )),
         },
     }
 }
@@ -93,7 +104,10 @@ fn check_verdict_matches_the_simulated_step() {
         let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
         let text = std::fs::read_to_string(&path).unwrap();
         let fs = {
-            let src = Source { file: &stem, text: &text };
+            let src = Source {
+                file: &stem,
+                text: &text,
+            };
             spec::parse(src).unwrap().drive.switching_frequency.value
         };
         let ws = 2.0 * std::f64::consts::PI * fs;
@@ -123,7 +137,8 @@ fn check_verdict_matches_the_simulated_step() {
                             continue;
                         }
                         // The named bandwidth is accepted and its step passes.
-                        let Verdict::Accepted(sd) = judge(&name, &with_loop(&text, &body(method, best, compensate))) else {
+                        let Verdict::Accepted(sd) = judge(&name, &with_loop(&text, &body(method, best, compensate)))
+                        else {
                             problems.push(format!("{name}: the named {best} rad/s is not accepted"));
                             continue;
                         };
@@ -134,7 +149,10 @@ fn check_verdict_matches_the_simulated_step() {
                         }
                         // The refused gains in that design fail the step (margin or
                         // overshoot breaches; a rise-time breach is not about stability).
-                        if problem.contains("rise time") && !problem.contains("margin") && !problem.contains("overshoot") {
+                        if problem.contains("rise time")
+                            && !problem.contains("margin")
+                            && !problem.contains("overshoot")
+                        {
                             continue;
                         }
                         let m = &s.motor;
@@ -142,8 +160,26 @@ fn check_verdict_matches_the_simulated_step() {
                         let ts = 1.0 / fs;
                         let r = m.phase_resistance.value;
                         let (Ok(gd), Ok(gq)) = (
-                            discrete_loop::axis(s.current_loop.method, 'd', r, m.d_inductance.value, alpha, zeta, ts, compensate),
-                            discrete_loop::axis(s.current_loop.method, 'q', r, m.q_inductance.value, alpha, zeta, ts, compensate),
+                            discrete_loop::axis(
+                                s.current_loop.method,
+                                'd',
+                                r,
+                                m.d_inductance.value,
+                                alpha,
+                                zeta,
+                                ts,
+                                compensate,
+                            ),
+                            discrete_loop::axis(
+                                s.current_loop.method,
+                                'q',
+                                r,
+                                m.q_inductance.value,
+                                alpha,
+                                zeta,
+                                ts,
+                                compensate,
+                            ),
                         ) else {
                             continue;
                         };

@@ -321,7 +321,12 @@ fn design_rules_are_located_errors() {
         &t,
         line,
         "current_loop.bandwidth",
-        &["phase margin", "< 45°", "delay-compensated", "accepted: a bandwidth up to"],
+        &[
+            "phase margin",
+            "< 45°",
+            "delay-compensated",
+            "accepted: a bandwidth up to",
+        ],
     );
     // f_s ≥ 12·1333 Hz = 16 kHz.
     let (t, line) = mutate("switching_frequency = \"20 kHz\"", "switching_frequency = \"15 kHz\"");
@@ -553,7 +558,12 @@ fn sampled_loop_refusal_names_the_hand_figures() {
     let err = String::from_utf8_lossy(&out.stderr);
     let number_after = |tag: &str| -> f64 {
         let at = err.find(tag).unwrap_or_else(|| panic!("{tag} missing:\n{err}")) + tag.len();
-        err[at..].split(|c: char| !(c.is_ascii_digit() || c == '.')).next().unwrap().parse().unwrap()
+        err[at..]
+            .split(|c: char| !(c.is_ascii_digit() || c == '.'))
+            .next()
+            .unwrap()
+            .parse()
+            .unwrap()
     };
     assert!(err.contains("`current_loop.bandwidth`"), "{err}");
     let pm = number_after("is phase margin ");

@@ -59,5 +59,4 @@ mod tests {
         let peak = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         assert!((peak - 1.0 - (-std::f64::consts::PI).exp()).abs() < 1e-5, "{peak}");
     }
-
 }

@@ -164,7 +164,10 @@ pub fn pole_placement(axis: char, r: f64, l: f64, alpha: f64, zeta: f64, ts: f64
     // floors, which refuse them and name the largest bandwidth that works.
     let min_bandwidth_rad_s = r / (2.0 * l * zeta) * alpha / wn;
     if kp <= 0.0 && alpha <= 2.0 * min_bandwidth_rad_s {
-        return Err(CurrentLoopError::RhpZero { axis, min_bandwidth_rad_s });
+        return Err(CurrentLoopError::RhpZero {
+            axis,
+            min_bandwidth_rad_s,
+        });
     }
     let c = ki_ts / kp;
     Ok(Pi {
@@ -410,13 +413,19 @@ mod tests {
         let (r, l, ts) = (0.65, 7.6e-3, 5e-5);
         let z = std::f64::consts::FRAC_1_SQRT_2;
         let g = pole_placement('q', r, l, 1.0 / ts, z, ts).unwrap().finish(r, l, ts);
-        assert!((g.sampled.spectral_radius - 1.246).abs() < 1e-3, "{}", g.sampled.spectral_radius);
-        assert!(g.sampled
-            .breach(&crate::design::sampled_loop::Promise {
-                overshoot_pct: 4.32,
-                rise_time_s: None
-            })
-            .is_some());
+        assert!(
+            (g.sampled.spectral_radius - 1.246).abs() < 1e-3,
+            "{}",
+            g.sampled.spectral_radius
+        );
+        assert!(
+            g.sampled
+                .breach(&crate::design::sampled_loop::Promise {
+                    overshoot_pct: 4.32,
+                    rise_time_s: None
+                })
+                .is_some()
+        );
         assert!(g.sampled.spectral_radius > 1.0, "{}", g.sampled.spectral_radius);
     }
 }

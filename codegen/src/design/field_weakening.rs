@@ -69,7 +69,15 @@ pub fn onset_speed(m: &LossModel, v_prime: f64) -> f64 {
 /// (`discrete_loop::ramp_lag`): δ = ψ_s·ω̇_e·(1/α + τ_v). The onset is where δ is largest
 /// and α smallest (deeper in field weakening v_q/|v| → 1 and s → ω·L_d), so the estimate
 /// is on the safe side.
-pub fn voltage_overshoot(m: &LossModel, v_prime: f64, onset: f64, base_speed: f64, acceleration: f64, alpha_fw: f64, lag: f64) -> f64 {
+pub fn voltage_overshoot(
+    m: &LossModel,
+    v_prime: f64,
+    onset: f64,
+    base_speed: f64,
+    acceleration: f64,
+    alpha_fw: f64,
+    lag: f64,
+) -> f64 {
     let alpha = alpha_fw * voltage_sensitivity(m, onset) / (base_speed.max(onset) * m.ld);
     v_prime / onset * acceleration * (1.0 / alpha + lag)
 }

@@ -316,7 +316,11 @@ pub fn margins(g: &LoopGains, p: &SampledPlant) -> (Option<(f64, f64)>, Option<(
     let mut phase = Vec::with_capacity(w.len());
     for (k, v) in l.iter().enumerate() {
         let arg = v.arg();
-        phase.push(if k == 0 { arg } else { phase[k - 1] + wrap(arg - l[k - 1].arg()) });
+        phase.push(if k == 0 {
+            arg
+        } else {
+            phase[k - 1] + wrap(arg - l[k - 1].arg())
+        });
     }
     let mut gm: Option<(f64, f64)> = None;
     let mut pm: Option<(f64, f64)> = None;
@@ -331,7 +335,10 @@ pub fn margins(g: &LoopGains, p: &SampledPlant) -> (Option<(f64, f64)>, Option<(
             }
         }
         // Phase crossovers: the unwrapped phase passes −π − 2πj.
-        let (j0, j1) = (((phase[k] + PI) / (2.0 * PI)).floor(), ((phase[k + 1] + PI) / (2.0 * PI)).floor());
+        let (j0, j1) = (
+            ((phase[k] + PI) / (2.0 * PI)).floor(),
+            ((phase[k + 1] + PI) / (2.0 * PI)).floor(),
+        );
         if j0 != j1 {
             let target = -PI + 2.0 * PI * j0.max(j1);
             let unwrapped = |x: f64| phase[k] + wrap(open_loop(g, p, x).arg() - l[k].arg()) - target;
@@ -428,8 +435,16 @@ mod tests {
             let s = analyse(&g, r, l, ts);
             let gm = -20.0 * f64::log10(k);
             let pm = 90.0 - 3.0 * (k / 2.0).asin().to_degrees();
-            assert!((s.gain_margin_db.unwrap() - gm).abs() < 1e-6, "K = {k}: {:?} vs {gm}", s.gain_margin_db);
-            assert!((s.phase_margin_deg.unwrap() - pm).abs() < 1e-6, "K = {k}: {:?} vs {pm}", s.phase_margin_deg);
+            assert!(
+                (s.gain_margin_db.unwrap() - gm).abs() < 1e-6,
+                "K = {k}: {:?} vs {gm}",
+                s.gain_margin_db
+            );
+            assert!(
+                (s.phase_margin_deg.unwrap() - pm).abs() < 1e-6,
+                "K = {k}: {:?} vs {pm}",
+                s.phase_margin_deg
+            );
             let wp = PI / 3.0 / ts;
             assert!((s.phase_crossover_rad_s.unwrap() / wp - 1.0).abs() < 1e-9);
             let wc = 2.0 * (k / 2.0).asin() / ts;
@@ -455,7 +470,11 @@ mod tests {
     fn stability_boundary_at_k_equal_one() {
         let (r, l, ts) = (0.126, 0.393e-3, 5e-5);
         let s = analyse(&cancelling(r, l, ts, 0.999), r, l, ts);
-        assert!(s.spectral_radius < 1.0 && s.spectral_radius > 0.999, "{}", s.spectral_radius);
+        assert!(
+            s.spectral_radius < 1.0 && s.spectral_radius > 0.999,
+            "{}",
+            s.spectral_radius
+        );
         assert!(s.gain_margin_db.unwrap() > 0.0);
         let s = analyse(&cancelling(r, l, ts, 1.05), r, l, ts);
         assert!(s.spectral_radius > 1.0);

@@ -221,7 +221,8 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
     let (mut peak_v, mut peak_i) = (0.0f64, 0.0f64);
     // Tracking: ripple in the hold before the ramp, then the peak error, the reference
     // magnitude and rate during and after it, and the peak angle error.
-    let (mut ripple, mut peak_err, mut peak_ref, mut peak_rate, mut peak_angle) = (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
+    let (mut ripple, mut peak_err, mut peak_ref, mut peak_rate, mut peak_angle) =
+        (0.0f64, 0.0f64, 0.0f64, 0.0f64, 0.0f64);
     let mut prev_ref: Option<(f64, f64)> = None;
     for _ in 0..n {
         b.plant.speed = segment(b.plant.t);

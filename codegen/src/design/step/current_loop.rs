@@ -162,7 +162,9 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             },
         ));
     }
-    let sampled_rise = gains.as_ref().and_then(|(gd, gq)| Some([gd.sampled.rise_time_s?, gq.sampled.rise_time_s?]));
+    let sampled_rise = gains
+        .as_ref()
+        .and_then(|(gd, gq)| Some([gd.sampled.rise_time_s?, gq.sampled.rise_time_s?]));
     if let (Some(t), true) = (sampled_rise, c.method != Method::PolePlacement) {
         let want = 9f64.ln() / c.bandwidth.value;
         let worst = t[0].min(t[1]);
@@ -200,7 +202,8 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         bandwidth_limit_rad_s: limit,
         rise_time_s: Some(crate::design::designed_response::designed_rise_time(
             c.bandwidth.value,
-            (c.method == Method::PolePlacement).then(|| (current_loop::natural_frequency(c.bandwidth.value, zeta), zeta)),
+            (c.method == Method::PolePlacement)
+                .then(|| (current_loop::natural_frequency(c.bandwidth.value, zeta), zeta)),
         )),
         sampled_rise_time_s: sampled_rise,
         compensate_delay: c.compensate_delay,
@@ -257,11 +260,11 @@ fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
                 }
             }
             Some(HotVariant {
-            temperature_c: t.max_winding_temperature.value,
-            phase_resistance_ohm: r_hot,
-            d,
-            q,
-        })
+                temperature_c: t.max_winding_temperature.value,
+                phase_resistance_ohm: r_hot,
+                d,
+                q,
+            })
         }
         Err(_) => {
             cx.warnings.push(format!(

@@ -114,7 +114,11 @@ pub(in crate::design) fn field_weakening(
         );
         let a_max = acc * allowed / delta;
         let (span, key, how) = match (rule, &f.speed_loop_bandwidth, mech) {
-            (BandwidthRule::SpeedLoop, Some(p), _) => (p.span.clone(), p.key.clone(), "a speed-loop bandwidth α_s = α_fw/10 of at least"),
+            (BandwidthRule::SpeedLoop, Some(p), _) => (
+                p.span.clone(),
+                p.key.clone(),
+                "a speed-loop bandwidth α_s = α_fw/10 of at least",
+            ),
             (_, _, Some((_, j))) => (j.span.clone(), j.key.clone(), "b/J = α_fw/10 of at least"),
             _ => (
                 spec.current_loop.bandwidth.span.clone(),
@@ -125,7 +129,11 @@ pub(in crate::design) fn field_weakening(
         let fix = match need {
             Some(n) if n <= ceiling => format!(
                 "{how} {:.1} (α_fw ≥ {n:.0} rad/s), a smaller field_weakening.voltage_fraction (more margin), or a drive.max_acceleration of at most {:.0} rpm/s",
-                if rule == BandwidthRule::DefaultSpeedLoop { 10.0 * n } else { n / 10.0 },
+                if rule == BandwidthRule::DefaultSpeedLoop {
+                    10.0 * n
+                } else {
+                    n / 10.0
+                },
                 a_max * 30.0 / PI
             ),
             _ => format!(

@@ -103,7 +103,10 @@ pub(in crate::design) fn sensorless(
             (Some(p), _) => (
                 p.span.clone(),
                 p.key.clone(),
-                format!("a bandwidth of at least {rho_needed:.1} rad/s (and at most α_c/10 = {:.1} rad/s)", out.rho_max_rad_s),
+                format!(
+                    "a bandwidth of at least {rho_needed:.1} rad/s (and at most α_c/10 = {:.1} rad/s)",
+                    out.rho_max_rad_s
+                ),
             ),
             (None, Some(p)) => (
                 p.span.clone(),
