@@ -156,7 +156,7 @@ fn check_verdict_matches_the_simulated_step() {
                             continue;
                         }
                         let m = &s.motor;
-                        let zeta = if method == "pole_placement" { 0.7071 } else { 0.0 };
+                        let zeta = s.current_loop.damping.as_ref().map_or(0.0, |z| z.value);
                         let ts = 1.0 / fs;
                         let r = m.phase_resistance.value;
                         let (Ok(gd), Ok(gq)) = (

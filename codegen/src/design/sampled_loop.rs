@@ -307,9 +307,12 @@ fn bisect(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
     0.5 * (lo + hi)
 }
 
+/// A margin and the frequency it is read at: (margin, ω [rad/s]).
+pub type Margin = Option<(f64, f64)>;
+
 /// The margins of the module documentation: (gain margin [dB], phase-crossover ω),
 /// (phase margin [°], gain-crossover ω).
-pub fn margins(g: &LoopGains, p: &SampledPlant) -> (Option<(f64, f64)>, Option<(f64, f64)>) {
+pub fn margins(g: &LoopGains, p: &SampledPlant) -> (Margin, Margin) {
     let w = grid(p.ts);
     let l: Vec<Complex<f64>> = w.iter().map(|&w| open_loop(g, p, w)).collect();
     // Unwrapped phase along the grid.
