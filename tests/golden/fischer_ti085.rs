@@ -8,54 +8,54 @@
 
 /// Current loop: PI gains per axis, feed-forward, torque → i_q.
 pub mod current_loop {
-    /// 0.0393 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
+    /// 0.0389382 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
-    pub const D_KP: f32 = 0.0393;
-    /// 12.6 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
+    pub const D_KP: f32 = 0.03893817;
+    /// 12.484 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
-    pub const D_KI: f32 = 12.6;
-    /// 0.00063 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    pub const D_KI: f32 = 12.483993;
+    /// 0.0006242 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec).
-    pub const D_KI_TS: f32 = 0.00063;
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    pub const D_KI_TS: f32 = 0.00062419963;
     /// 320.611 rad/s: `K_b = K_i/K_p (series-form zero)`, thesis A (5.7).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const D_KB: f32 = 320.6107;
     /// 0 Ω: `R_a = α_c·L − R (0 unless imc_active_damping)`, thesis B (2.43).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const D_ACTIVE_DAMPING: f32 = 0.0;
-    /// 25.4453 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
+    /// 25.6817 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
-    pub const D_ANTI_WINDUP: f32 = 25.445293;
-    /// 0.0393 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    pub const D_ANTI_WINDUP: f32 = 25.681744;
+    /// 0.0389382 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
-    pub const Q_KP: f32 = 0.0393;
-    /// 12.6 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
+    pub const Q_KP: f32 = 0.03893817;
+    /// 12.484 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
-    pub const Q_KI: f32 = 12.6;
-    /// 0.00063 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    pub const Q_KI: f32 = 12.483993;
+    /// 0.0006242 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec).
-    pub const Q_KI_TS: f32 = 0.00063;
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    pub const Q_KI_TS: f32 = 0.00062419963;
     /// 320.611 rad/s: `K_b = K_i/K_p (series-form zero)`, thesis A (5.7).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const Q_KB: f32 = 320.6107;
     /// 0 Ω: `R_a = α_c·L − R (0 unless imc_active_damping)`, thesis B (2.43).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const Q_ACTIVE_DAMPING: f32 = 0.0;
-    /// 25.4453 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
+    /// 25.6817 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
-    pub const Q_ANTI_WINDUP: f32 = 25.445293;
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    pub const Q_ANTI_WINDUP: f32 = 25.681744;
     /// 0.000393 H: `L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)`, thesis A (5.3).
     ///
     /// Inputs: L_d = 0.000393 H (datasheet).
@@ -269,54 +269,54 @@ pub mod field_weakening {
 
 /// Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4).
 pub mod sensorless {
-    /// 10 rad/s: `ρ: estimator bandwidth, ρ ≤ α_c/10`, thesis B (4.74), Table 4.1.
+    /// 0 rad/s: `ρ: estimator bandwidth, ρ ≤ α_c/10`, thesis B (4.74), Table 4.1.
     ///
-    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
-    pub const RHO: f32 = 10.0;
-    /// 100 1/s²: `γ1 = ρ²`, thesis B (4.7).
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    pub const RHO: f32 = 0.0;
+    /// 0 1/s²: `γ1 = ρ²`, thesis B (4.7).
     ///
-    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
-    pub const GAMMA1: f32 = 100.0;
-    /// 20 1/s: `γ2 = 2ρ`, thesis B (4.7).
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    pub const GAMMA1: f32 = 0.0;
+    /// 0 1/s: `γ2 = 2ρ`, thesis B (4.7).
     ///
-    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
-    pub const GAMMA2: f32 = 20.0;
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    pub const GAMMA2: f32 = 0.0;
     /// 0 rad/s: `ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10)`, thesis B (4.34).
     ///
-    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const INJECTION_FREQUENCY: f32 = 0.0;
     /// 0 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
     ///
-    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const INJECTION_VOLTAGE: f32 = 0.0;
     /// 0 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q)`, thesis B (4.19).
     ///
-    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const INJECTION_GAIN: f32 = 0.0;
     /// 0 rad/s: `ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base)`, thesis B §4.3, Table 4.1.
     ///
-    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const HIGHPASS: f32 = 0.0;
     /// 0 rad/s: `ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ)`, thesis B Table 4.1.
     ///
-    /// Inputs: L_q ≤ L_d: no saliency, no signal injection → 0.
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const LOWPASS: f32 = 0.0;
     /// 0 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
     ///
-    /// Inputs: ω_min1 = 0 rad/s, ω_min2 = 0 rad/s (θ̃ = 10.0°), I_max = 86.267 A.
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const LOW_SPEED: f32 = 0.0;
     /// 0 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
     ///
-    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const HIGH_SPEED: f32 = 0.0;
-    /// 10 rad/s: `Δω1 = ρ: γ0 = 0 below`, thesis B (4.83), §4.6.
+    /// 0 rad/s: `Δω1 = ρ: γ0 = 0 below`, thesis B (4.83), §4.6.
     ///
-    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
-    pub const RESET_LOWER: f32 = 10.0;
-    /// 20 rad/s: `Δω2 = 2ρ: γ0 = ρ above`, thesis B (4.83), §4.6.
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    pub const RESET_LOWER: f32 = 0.0;
+    /// 0 rad/s: `Δω2 = 2ρ: γ0 = ρ above`, thesis B (4.83), §4.6.
     ///
-    /// Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
-    pub const RESET_UPPER: f32 = 20.0;
+    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    pub const RESET_UPPER: f32 = 0.0;
     /// 0 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
     ///
     /// Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb, ω_max = 8377.58 rad/s.
