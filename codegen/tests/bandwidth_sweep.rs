@@ -16,23 +16,12 @@
 //! estimator rules that depend on α_c) are not current-loop feasibility verdicts and are
 //! skipped; the test requires enough accepted and refused points to mean something.
 
-use std::path::{Path, PathBuf};
+mod common;
 
 use codegen::design::Design;
 use codegen::design::discrete_loop;
 use codegen::verify::{Setup, scenarios::current_step};
 use codegen::{Source, design, spec};
-
-fn motors() -> Vec<PathBuf> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../motors");
-    let mut v: Vec<PathBuf> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .collect();
-    v.sort();
-    v
-}
 
 /// `text` with its `[current_loop]` section replaced by `body`.
 fn with_loop(text: &str, body: &str) -> String {
@@ -100,9 +89,8 @@ fn step_failures(s: &spec::Spec, d: &Design) -> Vec<String> {
 fn check_verdict_matches_the_simulated_step() {
     let (mut accepted, mut refused, mut unstable_seen) = (0, 0, 0);
     let mut problems = Vec::new();
-    for path in motors() {
-        let stem = path.file_stem().unwrap().to_string_lossy().into_owned();
-        let text = std::fs::read_to_string(&path).unwrap();
+    for stem in common::motor_stems() {
+        let text = std::fs::read_to_string(common::repo().join(format!("motors/{stem}.toml"))).unwrap();
         let fs = {
             let src = Source {
                 file: &stem,

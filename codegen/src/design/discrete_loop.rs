@@ -206,7 +206,7 @@ pub fn axis(
     if compensate {
         delay_compensated(method, axis, r, l, alpha, zeta, ts)
     } else {
-        continuous(method, axis, r, l, alpha, zeta, ts).map(|pi| pi.finish(r, l, ts))
+        super::current_loop::design_axis(method, axis, r, l, alpha, zeta, ts)
     }
 }
 
