@@ -87,9 +87,11 @@ fn fischer_reproduces_thesis_a() {
     }
     assert_eq!(v["motor"]["provenance"]["flux_linkage"]["source"], "derived");
     assert_eq!(v["motor"]["provenance"]["phase_resistance"]["source"], "datasheet");
-    // IMC at 100 rad/s (5.9): K_p = L·α = 0.0393 V/A, K_i = R·α = 12.6 V/(A·s).
-    assert!(close(f(&v, "current_loop.d.kp"), 0.0393, 1e-12));
-    assert!(close(f(&v, "current_loop.d.ki"), 12.6, 1e-12));
+    // IMC at 100 rad/s (5.9), the continuous design (compensate_delay = false):
+    // K_p = L·α = 0.0393 V/A, K_i = R·α = 12.6 V/(A·s).
+    let c = plain_json("fischer-ti085");
+    assert!(close(f(&c, "current_loop.d.kp"), 0.0393, 1e-12));
+    assert!(close(f(&c, "current_loop.d.ki"), 12.6, 1e-12));
     // ATO (4.15), (4.22): K_p = 140, K_i = 4900; Q1.31 4 784 957 and 8 374 (hand calculation in angle_observer.rs).
     assert_eq!(f(&v, "angle_observer.kp"), 140.0);
     assert_eq!(f(&v, "angle_observer.ki"), 4900.0);
@@ -114,7 +116,9 @@ fn unimotor_uses_identified_values() {
     assert!(close(f(&v, "motor.q_inductance_h"), 7.6e-3, 1e-12));
     assert_eq!(v["motor"]["provenance"]["q_inductance"]["source"], "identified");
     assert!(v["motor"]["flux_linkage_wb"].is_null());
-    // Pole placement with ζ = 0.7071 ≈ 1/√2 at 100 rad/s (5.14): K_i ≈ L·α², K_p ≈ 2ζα·L − R.
+    // Pole placement with ζ = 0.7071 ≈ 1/√2 at 100 rad/s (5.14), the continuous design
+    // (compensate_delay = false): K_i ≈ L·α², K_p ≈ 2ζα·L − R.
+    let v = plain_json("unimotor-142umd300");
     assert!(close(f(&v, "current_loop.q.ki"), 7.6e-3 * 100.0 * 100.0, 1e-3));
     assert!(close(
         f(&v, "current_loop.q.kp"),
@@ -134,8 +138,7 @@ fn chalmers_reproduces_thesis_b() {
     // from the same file with that one key switched off.
     let rel = "motors/chalmers-hev50.toml";
     let text = std::fs::read_to_string(motor_tests::repo().join(rel)).unwrap();
-    let plain_text = text.replace("compensate_delay = true", "compensate_delay = false");
-    assert_ne!(plain_text, text, "the seed file no longer sets compensate_delay");
+    let plain_text = plain(&text);
     let plain = codegen::design_source(rel, &plain_text).unwrap();
     let v = serde_json::to_value(&plain).unwrap();
     let pu = |name: &str, digits: i32| {
@@ -185,4 +188,21 @@ fn chalmers_reproduces_thesis_b() {
         let rise = rise.as_f64().unwrap();
         assert!((rise - 1.5e-3).abs() < 0.01e-3, "sampled rise {rise}");
     }
+}
+
+/// `text` with `compensate_delay = false` after its current-loop bandwidth: the
+/// continuous design the theses print (the default compensates the 1.5·T_s delay).
+fn plain(text: &str) -> String {
+    let at = text.find("\n[current_loop]").unwrap();
+    let line = at + text[at..].find("\nbandwidth = ").unwrap() + 1;
+    let end = line + text[line..].find('\n').unwrap();
+    format!("{}\ncompensate_delay = false{}", &text[..end], &text[end..])
+}
+
+/// The design of `stem` without delay compensation, as JSON.
+fn plain_json(stem: &str) -> serde_json::Value {
+    let rel = format!("motors/{stem}.toml");
+    let text = std::fs::read_to_string(motor_tests::repo().join(&rel)).unwrap();
+    let d = codegen::design_source(&rel, &plain(&text)).unwrap_or_else(|e| panic!("{e}"));
+    serde_json::to_value(&d).unwrap()
 }
