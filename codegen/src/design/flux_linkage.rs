@@ -7,7 +7,7 @@
 
 use crate::spec::{Amplitude, Between, SpeedAxis};
 
-/// ψ_M [Wb] from K_t [N·m/A] quoted per `current` ampere (rms or peak), (2.34).
+/// ψ_M \[Wb\] from K_t [N·m/A] quoted per `current` ampere (rms or peak), (2.34).
 pub fn from_torque_constant(kt: f64, current: Amplitude, pole_pairs: u32) -> f64 {
     let kt_peak = match current {
         Amplitude::Rms => kt / std::f64::consts::SQRT_2,
@@ -16,7 +16,7 @@ pub fn from_torque_constant(kt: f64, current: Amplitude, pole_pairs: u32) -> f64
     kt_peak / (1.5 * f64::from(pole_pairs))
 }
 
-/// ψ_M [Wb] from K_e [V·s/rad] quoted in the given conventions, (6.11).
+/// ψ_M \[Wb\] from K_e [V·s/rad] quoted in the given conventions, (6.11).
 pub fn from_back_emf_constant(
     ke: f64,
     voltage: Amplitude,

@@ -9,27 +9,27 @@ use serde::Serialize;
 /// The base values.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Bases {
-    /// V_base = V_dc/√3 [V].
+    /// V_base = V_dc/√3 \[V\].
     pub voltage_v: f64,
-    /// I_base = √2·I_n [A].
+    /// I_base = √2·I_n \[A\].
     pub current_a: f64,
-    /// Z_base [Ω].
+    /// Z_base \[Ω\].
     pub impedance_ohm: f64,
     /// ω_base = 2π·f_n [rad/s].
     pub angular_frequency_rad_s: f64,
-    /// ψ_base [Wb].
+    /// ψ_base \[Wb\].
     pub flux_wb: f64,
-    /// L_base = Z_base/ω_base [H].
+    /// L_base = Z_base/ω_base \[H\].
     pub inductance_h: f64,
     /// J_base [kg·m²] as Table A.1 defines it.
     pub inertia: f64,
-    /// P_base = P_n [W], if given.
+    /// P_base = P_n \[W\], if given.
     pub power_w: Option<f64>,
     /// T_base = T_n [N·m], if given.
     pub torque_nm: Option<f64>,
 }
 
-/// Bases from the DC link [V], rated rms current [A] and rated electrical frequency [Hz].
+/// Bases from the DC link \[V\], rated rms current \[A\] and rated electrical frequency \[Hz\].
 pub fn bases(v_dc: f64, i_n_rms: f64, f_n: f64, p_n: Option<f64>, t_n: Option<f64>) -> Bases {
     let v = v_dc / 3f64.sqrt();
     let i = std::f64::consts::SQRT_2 * i_n_rms;

@@ -12,17 +12,17 @@ use serde::Serialize;
 /// Everything the rules need, in SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Inputs {
-    /// R̂_s [Ω].
+    /// R̂_s \[Ω\].
     pub resistance: f64,
-    /// L̂_d [H].
+    /// L̂_d \[H\].
     pub ld: f64,
-    /// L̂_q [H].
+    /// L̂_q \[H\].
     pub lq: f64,
-    /// ψ̂_m [Wb].
+    /// ψ̂_m \[Wb\].
     pub psi: f64,
-    /// I_max, the peak phase current [A].
+    /// I_max, the peak phase current \[A\].
     pub current_max: f64,
-    /// I_base of (4.35) [A]: the per-unit base √2·I_n (thesis B App. A), else I_max.
+    /// I_base of (4.35) \[A\]: the per-unit base √2·I_n (thesis B App. A), else I_max.
     pub current_base: f64,
     /// ω_max, the largest electrical speed [rad/s] (4.92).
     pub speed_max: f64,
@@ -30,7 +30,7 @@ pub struct Inputs {
     pub current_bandwidth: f64,
     /// ω_sw = 2π·f_sw [rad/s].
     pub switching: f64,
-    /// V_max = U_dc/√3, the largest phase-voltage amplitude [V].
+    /// V_max = U_dc/√3, the largest phase-voltage amplitude \[V\].
     pub voltage_max: f64,
     /// ω_base of the per-unit system [rad/s], if the spec defines one.
     pub speed_base: Option<f64>,
@@ -47,11 +47,11 @@ pub struct Choices {
     pub bandwidth: Option<f64>,
     /// Largest shaft acceleration [rad/s², mechanical].
     pub max_acceleration: Option<f64>,
-    /// θ̃_max [rad].
+    /// θ̃_max \[rad\].
     pub angle_error: f64,
     /// ω_e [rad/s].
     pub injection_frequency: Option<f64>,
-    /// V_e [V].
+    /// V_e \[V\].
     pub injection_voltage: Option<f64>,
     /// ω_hp [rad/s].
     pub highpass: Option<f64>,
@@ -84,11 +84,11 @@ pub struct InjectionOut {
     pub frequency_min_rad_s: f64,
     /// Upper end of (4.34): ω_sw/10 [rad/s].
     pub frequency_max_rad_s: f64,
-    /// V_e [V].
+    /// V_e \[V\].
     pub voltage_v: f64,
-    /// Smallest V_e of (4.35) [V].
+    /// Smallest V_e of (4.35) \[V\].
     pub voltage_min_v: f64,
-    /// K_e = V_e·ΔL/(4·ω_e·L_d·L_q) (4.19) [A].
+    /// K_e = V_e·ΔL/(4·ω_e·L_d·L_q) (4.19) \[A\].
     pub gain_ke_a: f64,
     /// ω_hp [rad/s].
     pub highpass_rad_s: f64,
@@ -113,7 +113,7 @@ pub struct SensorlessOut {
     pub gamma1: f64,
     /// γ2 = 2ρ (4.7) [1/s].
     pub gamma2: f64,
-    /// θ̃_max [rad].
+    /// θ̃_max \[rad\].
     pub angle_error_rad: f64,
     /// Electrical acceleration tracked within θ̃_max: ρ²·sin θ̃max (4.74) [rad/s²].
     pub acceleration_tracked_rad_s2: f64,
@@ -131,9 +131,9 @@ pub struct SensorlessOut {
     pub resetting_lower_rad_s: f64,
     /// Δω2 = 2ρ (§4.6) [rad/s].
     pub resetting_upper_rad_s: f64,
-    /// |i_q^ref| limit while the resetting term acts (4.92) with γ0 = ρ [A] (salient).
+    /// |i_q^ref| limit while the resetting term acts (4.92) with γ0 = ρ \[A\] (salient).
     pub iq_limit_resetting_a: Option<f64>,
-    /// |i_q| ≤ ψ_m/ΔL, no bifurcation (4.66) [A] (salient).
+    /// |i_q| ≤ ψ_m/ΔL, no bifurcation (4.66) \[A\] (salient).
     pub iq_limit_bifurcation_a: Option<f64>,
 }
 

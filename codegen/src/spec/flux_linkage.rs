@@ -13,9 +13,9 @@ use crate::units::Kind;
 /// ψ_M derived from both K_t and K_e, and how far apart they are.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FluxCrossCheck {
-    /// ψ_M from the torque constant, (2.34): K_t,peak / (3/2·n_p) [Wb].
+    /// ψ_M from the torque constant, (2.34): K_t,peak / (3/2·n_p) \[Wb\].
     pub from_torque_constant_wb: f64,
-    /// ψ_M from the back-EMF constant, (6.11): phase-peak volts per electrical rad/s [Wb].
+    /// ψ_M from the back-EMF constant, (6.11): phase-peak volts per electrical rad/s \[Wb\].
     pub from_back_emf_constant_wb: f64,
     /// |a − b| / mean, in percent.
     pub disagreement_percent: f64,

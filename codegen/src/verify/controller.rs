@@ -16,7 +16,7 @@ use crate::design::Design;
 use crate::design::current_loop::AxisGains;
 use crate::spec::ObserverError;
 
-/// TIM1 kernel clock [Hz]: the STM32G474's maximum SYSCLK (170 MHz, STM32G474 datasheet),
+/// TIM1 kernel clock \[Hz\]: the STM32G474's maximum SYSCLK (170 MHz, STM32G474 datasheet),
 /// as the firmware bench assumes; with centre-aligned PWM the auto-reload is
 /// `TIMER_CLOCK_HZ/(2·f_s)` (4250 at 20 kHz). Only the telemetry compare values use it;
 /// the simulated inverter applies the duties.
