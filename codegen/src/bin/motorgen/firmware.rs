@@ -17,12 +17,15 @@
 //! else the repository `motorgen` was built from.
 
 use std::fmt::Write as _;
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode, Stdio};
+use std::process::{Command, Stdio};
 
 use object::elf;
 use object::read::elf::{ElfFile32, FileHeader, ProgramHeader, SectionHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol};
+
+use crate::exit::{Exit, Failure};
 
 /// The firmware's target triple.
 const TARGET: &str = "thumbv7em-none-eabihf";
@@ -224,9 +227,12 @@ fn stems(dir: &Path) -> Result<Vec<String>, String> {
     Ok(v)
 }
 
-/// Runs cargo for `stem`; returns the built ELF's path (from cargo's JSON messages).
-fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String> {
+/// Runs cargo for `stem`, relaying its progress (stderr) line by line as it comes;
+/// returns the built ELF's path (from cargo's JSON messages on stdout).
+fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, Failure> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let command = format!("MOTOR={stem} cargo build --release --target {TARGET} -p {PACKAGE}");
+    eprintln!("{stem}: {command} (in firmware/; a first build takes minutes)");
     let child = Command::new(&cargo)
         .args(["build", "--release", "--target", TARGET, "-p", PACKAGE])
         .args(["--message-format=json-render-diagnostics"])
@@ -236,30 +242,53 @@ fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn();
-    let output = match child.and_then(|c| c.wait_with_output()) {
-        Ok(o) => o,
+    let io = |what: String| Failure::new(Exit::Io, what);
+    let mut child = match child {
+        Ok(c) => c,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(format!(
-                "`{}` was not found: install Rust with rustup (https://rustup.rs), then \
+            return Err(io(format!(
+                "error: `{}` was not found: install Rust with rustup (https://rustup.rs), then \
                  `rustup target add {TARGET}`",
                 cargo.to_string_lossy()
-            ));
+            )));
         }
-        Err(e) => return Err(format!("cannot run {}: {e}", cargo.to_string_lossy())),
+        Err(e) => return Err(io(format!("error: cannot run {}: {e}", cargo.to_string_lossy()))),
     };
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if !output.status.success() {
+    let (Some(out), Some(err)) = (child.stdout.take(), child.stderr.take()) else {
+        return Err(io(format!(
+            "error: cannot read the output of {}",
+            cargo.to_string_lossy()
+        )));
+    };
+    // Progress and rendered diagnostics go to our stderr as they come; a copy is kept
+    // for the hint below. The JSON messages on stdout are read meanwhile.
+    let relay = std::thread::spawn(move || {
+        let mut seen = String::new();
+        for line in BufReader::new(err).lines().map_while(Result::ok) {
+            eprintln!("{line}");
+            seen.push_str(&line);
+            seen.push('\n');
+        }
+        seen
+    });
+    let mut stdout = String::new();
+    let read = BufReader::new(out).read_to_string(&mut stdout);
+    let status = child.wait();
+    let stderr = relay.join().unwrap_or_default();
+    let status = status
+        .and_then(|s| read.map(|_| s))
+        .map_err(|e| io(format!("error: {command}: {e}")))?;
+    if !status.success() {
         let hint = if stderr.contains("target may not be installed") || stderr.contains("can't find crate for `core`") {
             format!("\n  the {TARGET} target is missing: install it with `rustup target add {TARGET}`")
         } else {
             String::new()
         };
-        return Err(format!(
-            "MOTOR={stem} cargo build --release --target {TARGET} -p {PACKAGE} failed ({}):\n{stderr}{hint}",
-            output.status
+        return Err(Failure::new(
+            Exit::BuildFailed,
+            format!("error: {command} failed ({status}; its messages are above){hint}"),
         ));
     }
-    let stdout = String::from_utf8_lossy(&output.stdout);
     stdout
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
@@ -267,29 +296,39 @@ fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String
             m["reason"] == "compiler-artifact" && m["target"]["name"] == PACKAGE && m["target"]["kind"][0] == "bin"
         })
         .find_map(|m| m["executable"].as_str().map(PathBuf::from))
-        .ok_or_else(|| format!("cargo built no `{PACKAGE}` executable (is firmware/app a binary crate?)"))
+        .ok_or_else(|| {
+            Failure::new(
+                Exit::BuildFailed,
+                format!("error: cargo built no `{PACKAGE}` executable (is firmware/app a binary crate?)"),
+            )
+        })
 }
 
 /// Builds, checks and writes one motor's image (its spec designs); returns its report.
-fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
+fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, Failure> {
     let elf_path = cargo_build(root, motors, stem)?;
-    let bytes = std::fs::read(&elf_path).map_err(|e| format!("cannot read {}: {e}", elf_path.display()))?;
-    let image = image(&bytes).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+    let io = |what: String| Failure::new(Exit::Io, what);
+    let bytes = std::fs::read(&elf_path).map_err(|e| io(format!("error: cannot read {}: {e}", elf_path.display())))?;
+    let image =
+        image(&bytes).map_err(|e| Failure::new(Exit::BuildFailed, format!("error: {}: {e}", elf_path.display())))?;
     let mut report = report(stem, &image.usage);
     if image.usage.flash > FLASH_LIMIT {
-        return Err(format!(
-            "{report}{stem}: the image needs {} bytes of flash, more than the 64 KiB ({FLASH_LIMIT} bytes) \
-             allowed; nothing written (the ELF is {})",
-            image.usage.flash,
-            elf_path.display()
+        return Err(Failure::new(
+            Exit::VerificationFailed,
+            format!(
+                "{report}error: {stem}: the image needs {} bytes of flash, more than the 64 KiB ({FLASH_LIMIT} \
+                 bytes) budget; nothing written (the ELF is {})",
+                image.usage.flash,
+                elf_path.display()
+            ),
         ));
     }
     let out = root.join("target").join("firmware");
-    std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
+    std::fs::create_dir_all(&out).map_err(|e| io(format!("error: cannot create {}: {e}", out.display())))?;
     let elf_out = out.join(format!("{stem}.elf"));
     let bin_out = out.join(format!("{stem}.bin"));
-    std::fs::write(&elf_out, &bytes).map_err(|e| format!("cannot write {}: {e}", elf_out.display()))?;
-    std::fs::write(&bin_out, &image.bin).map_err(|e| format!("cannot write {}: {e}", bin_out.display()))?;
+    std::fs::write(&elf_out, &bytes).map_err(|e| io(format!("error: cannot write {}: {e}", elf_out.display())))?;
+    std::fs::write(&bin_out, &image.bin).map_err(|e| io(format!("error: cannot write {}: {e}", bin_out.display())))?;
     let _ = writeln!(
         report,
         "{stem}: wrote {} and {} (load address {:#010x})",
@@ -300,73 +339,73 @@ fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
     Ok(report)
 }
 
-/// The `firmware` subcommand.
-pub fn run(which: Which, motors: &Path) -> ExitCode {
-    let known = match stems(motors) {
-        Ok(k) => k,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+/// The `firmware` subcommand. Every selected spec must design before cargo runs; every
+/// motor is built even if one fails, and the exit code is the gravest failure's.
+pub fn run(which: Which, motors: &Path) -> Result<(), Failure> {
+    let known = stems(motors).map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
     let selected = match which {
         Which::All if known.is_empty() => {
-            eprintln!(
-                "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
-                motors.display()
-            );
-            return ExitCode::FAILURE;
+            return Err(Failure::new(
+                Exit::BadInput,
+                format!(
+                    "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
+                    motors.display()
+                ),
+            ));
         }
         Which::All => known,
         Which::One(stem) if known.contains(&stem) => vec![stem],
         Which::One(stem) => {
-            eprintln!(
-                "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
-                motors.display(),
-                if known.is_empty() {
-                    "none: the folder holds no *.toml".to_string()
-                } else {
-                    known.join(", ")
-                }
-            );
-            return ExitCode::FAILURE;
+            return Err(Failure::new(
+                Exit::BadInput,
+                format!(
+                    "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
+                    motors.display(),
+                    if known.is_empty() {
+                        "none: the folder holds no *.toml".to_string()
+                    } else {
+                        known.join(", ")
+                    }
+                ),
+            ));
         }
     };
-    let root = match repo_root(motors) {
-        Ok(r) => r,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+    let root = repo_root(motors).map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
     let motors = motors.canonicalize().unwrap_or_else(|_| motors.to_path_buf());
+    let gravest = |failed: &[Exit]| failed.iter().copied().max_by_key(|e| *e as u8);
     // Every selected spec must design before cargo runs (located diagnostics).
     let mut designs = Vec::new();
+    let mut failed = Vec::new();
     for stem in &selected {
         match super::design(&motors.join(format!("{stem}.toml"))) {
             Ok(d) => designs.push(d),
-            Err(d) => eprint!("{d}"),
+            Err(f) => {
+                failed.push(f.exit);
+                f.report();
+            }
         }
     }
-    if designs.len() != selected.len() {
-        return ExitCode::FAILURE;
+    if let Some(exit) = gravest(&failed) {
+        return Err(Failure::new(exit, "firmware: nothing built (a spec has problems)"));
     }
     // One motor: the constants the image is built from, as `motorgen design` prints them.
     if let [d] = designs.as_slice() {
         print!("{}", codegen::summary::summary(d));
     }
-    let mut ok = true;
     for stem in &selected {
         match build_one(&root, &motors, stem) {
             Ok(report) => print!("{report}"),
-            Err(e) => {
-                ok = false;
-                eprint!("error: {e}");
-                if !e.ends_with('\n') {
-                    eprintln!();
-                }
+            Err(f) => {
+                failed.push(f.exit);
+                f.report();
             }
         }
     }
-    if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+    match gravest(&failed) {
+        None => Ok(()),
+        Some(exit) => Err(Failure::new(
+            exit,
+            format!("firmware: {} of {} images not built", failed.len(), selected.len()),
+        )),
+    }
 }

@@ -7,7 +7,6 @@
 //! written). `--dry-run` prints the change instead.
 
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 use clap::{Args, Subcommand, ValueEnum};
 use codegen::identify::recording::{self, Recording, RecordingKind};
@@ -18,6 +17,8 @@ use codegen::identify::{Spread, flux};
 use codegen::units::{self, Kind};
 use codegen::{Design, Diagnostic, Diagnostics, Source};
 use motor_control::commissioning::Axis;
+
+use crate::exit::{Exit, Failure};
 
 /// What to identify.
 #[derive(Subcommand)]
@@ -88,17 +89,6 @@ pub enum AxisArg {
     Q,
 }
 
-/// Runs one identification; prints results or located errors.
-pub fn run(what: What) -> ExitCode {
-    match run_inner(what) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprint!("{e}");
-            ExitCode::FAILURE
-        }
-    }
-}
-
 fn plain_error(file: &str, problem: String, accepted: &str) -> Diagnostics {
     Diagnostics(vec![Diagnostic {
         file: file.to_string(),
@@ -112,16 +102,18 @@ fn plain_error(file: &str, problem: String, accepted: &str) -> Diagnostics {
 }
 
 /// The spec's text and design.
-fn load(spec: &Path) -> Result<(String, Design), Diagnostics> {
+fn load(spec: &Path) -> Result<(String, Design), Failure> {
     let text = crate::read_spec(spec)?;
     let design = codegen::design_source(&spec.display().to_string(), &text)?;
     Ok((text, design))
 }
 
 /// Reads and parses every recording; all problems are reported together.
-fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Recording>, Diagnostics> {
+/// An unreadable recording makes it an I/O failure, otherwise bad input.
+fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Recording>, Failure> {
     let mut out = Vec::new();
     let mut errors = Vec::new();
+    let mut unreadable = false;
     for f in files {
         let name = f.display().to_string();
         match std::fs::read_to_string(f) {
@@ -129,32 +121,36 @@ fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Rec
                 Ok(r) => out.push(r),
                 Err(e) => errors.extend(e.0),
             },
-            Err(e) => errors.extend(
-                plain_error(
-                    &name,
-                    format!("cannot read the recording: {e}"),
-                    "a readable UTF-8 CSV recording",
+            Err(e) => {
+                unreadable = true;
+                errors.extend(
+                    plain_error(
+                        &name,
+                        format!("cannot read the recording: {e}"),
+                        "a readable UTF-8 CSV recording",
+                    )
+                    .0,
                 )
-                .0,
-            ),
+            }
         }
     }
     if errors.is_empty() {
         Ok(out)
     } else {
-        Err(Diagnostics(errors))
+        let exit = if unreadable { Exit::Io } else { Exit::BadInput };
+        Err(Failure::new(exit, Diagnostics(errors).to_string()))
     }
 }
 
-fn sample_period(common: &Common, design: &Design) -> Result<f64, Diagnostics> {
+fn sample_period(common: &Common, design: &Design) -> Result<f64, Failure> {
     match &common.sample_period {
         None => Ok(design.drive.sample_period_s),
         Some(s) => units::parse(Kind::Time, s).ok().filter(|t| *t > 0.0).ok_or_else(|| {
-            plain_error(
+            Failure::from(plain_error(
                 "--sample-period",
                 format!("`{s}` is not a positive time"),
                 Kind::Time.accepted(),
-            )
+            ))
         }),
     }
 }
@@ -197,13 +193,7 @@ fn spread_note(label: &str, s: &Spread) -> String {
 }
 
 /// Writes `entries` into the spec (or prints the change), after checking the new spec.
-fn write_back(
-    spec: &Path,
-    text: &str,
-    entries: &[Entry],
-    origin: &Origin<'_>,
-    dry_run: bool,
-) -> Result<(), Diagnostics> {
+fn write_back(spec: &Path, text: &str, entries: &[Entry], origin: &Origin<'_>, dry_run: bool) -> Result<(), Failure> {
     let file = spec.display().to_string();
     let new = writeback::apply(text, entries, origin)
         .map_err(|e| plain_error(&file, e, "a spec that `motorgen check` accepts"))?;
@@ -225,11 +215,12 @@ fn write_back(
     let result = std::fs::write(&tmp, new.as_bytes()).and_then(|()| std::fs::rename(&tmp, spec));
     if let Err(e) = result {
         let _ = std::fs::remove_file(&tmp);
-        return Err(plain_error(
+        let d = plain_error(
             &file,
             format!("cannot write the updated spec: {e}"),
             "a writable spec file and directory",
-        ));
+        );
+        return Err(Failure::new(Exit::Io, d.to_string()));
     }
     let keys: Vec<&str> = entries.iter().map(|e| e.key).collect();
     println!("wrote [motor.identified] {} to {file}", keys.join(", "));
@@ -243,7 +234,8 @@ fn write_back(
     Ok(())
 }
 
-fn run_inner(what: What) -> Result<(), Diagnostics> {
+/// Runs one identification; prints results, or fails with located errors.
+pub fn run(what: What) -> Result<(), Failure> {
     match what {
         What::Step {
             spec,
@@ -261,7 +253,7 @@ fn run_inner(what: What) -> Result<(), Diagnostics> {
     }
 }
 
-fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
+fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<(), Failure> {
     let (text, design) = load(spec)?;
     let ts = sample_period(common, &design)?;
     let recs = recordings(csv, RecordingKind::Step, ts)?;
@@ -285,7 +277,7 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     println!(
         "{name} axis, {} recording(s), FIR order {} (group delay {} samples), T_s = {:.1} µs",
@@ -316,11 +308,7 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         collect(|e| e.inductance_h),
         collect(|e| e.delay_samples),
     ) else {
-        return Err(plain_error(
-            &spec.display().to_string(),
-            "no recordings".into(),
-            "--csv FILE…",
-        ));
+        return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
     println!(
         "  mean: R = {:.5} Ω ± {:.2} %, L_{name} = {:.5} mH ± {:.2} %, transport delay {:.2} ± {:.2} samples (1σ)",
@@ -358,7 +346,7 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
     write_back(spec, &text, &entries, &origin, common.dry_run)
 }
 
-fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
+fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure> {
     let (text, design) = load(spec)?;
     let ts = sample_period(common, &design)?;
     let recs = recordings(csv, RecordingKind::Flux, ts)?;
@@ -387,14 +375,10 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnos
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     let Some(s) = Spread::of(&values) else {
-        return Err(plain_error(
-            &spec.display().to_string(),
-            "no recordings".into(),
-            "--csv FILE…",
-        ));
+        return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
     println!("  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
     let files = names(csv);
@@ -412,14 +396,15 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnos
     write_back(spec, &text, &entries, &origin, common.dry_run)
 }
 
-fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
+fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Common) -> Result<(), Failure> {
     let file = spec.display().to_string();
     if offset.is_empty() && ratio.is_empty() {
         return Err(plain_error(
             "motorgen identify resolver",
             "no recordings given".into(),
             "--offset FILE… (resolver_offset runs) and/or --ratio FILE… (pole_pair_ratio runs)",
-        ));
+        )
+        .into());
     }
     let (text, design) = load(spec)?;
     let ts = sample_period(common, &design)?;
@@ -446,7 +431,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     let expected = f64::from(np) / f64::from(nr);
     let src = Source {
@@ -482,7 +467,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     if !ratios.is_empty() {
         println!("  pole-pair ratio agrees with the spec ({np}/{nr}); directions agree");
@@ -508,10 +493,10 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     let Some((mean, dev)) = resolver::combine_offsets(&offsets, np, nr) else {
-        return Err(plain_error(&file, "no recordings".into(), "--offset FILE…"));
+        return Err(plain_error(&file, "no recordings".into(), "--offset FILE…").into());
     };
     println!(
         "  mean: θ_off = {mean:.5} rad (mod 2π·n_r/n_p), runs within ±{:.3}° electrical",

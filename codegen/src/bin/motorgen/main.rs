@@ -1,5 +1,6 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
+mod exit;
 mod firmware;
 mod identify;
 mod report;
@@ -10,11 +11,11 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use codegen::render::{Output, render_with};
-use codegen::{Diagnostic, Diagnostics};
+use exit::{Exit, Failure};
 
 /// Motor description (TOML) → tuned motor-controller constants.
 #[derive(Parser)]
-#[command(name = "motorgen", version, about)]
+#[command(name = "motorgen", version, about, after_help = exit::HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -25,66 +26,73 @@ enum Command {
     /// Print the whole design of one motor.
     Design {
         /// The motor spec, e.g. motors/fischer-ti085.toml.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
         /// Output format.
         #[arg(long, value_enum, default_value_t = Format::Summary)]
         format: Format,
         /// Directory with replacement templates (for rust, c, markdown).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
     },
     /// Write the Rust module, C header and Markdown summary of one motor into a directory
     /// (files are only rewritten when their bytes change).
     Generate {
         /// The motor spec.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
         /// Output directory (created if missing).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         out: PathBuf,
         /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
     },
-    /// Validate specs; exit non-zero if any has a problem.
+    /// Validate specs; warnings go to stderr; exit 1 if any spec has a problem.
     Check {
         /// One or more motor specs.
-        #[arg(required = true)]
+        #[arg(required = true, value_name = "SPEC")]
         specs: Vec<PathBuf>,
     },
-    /// Write a commented starting spec to motors/<stem>.toml (never overwrites).
+    /// Write a commented starting spec to DIR/STEM.toml, DIR defaulting to motors/
+    /// (never overwrites).
     New {
         /// File stem: lowercase letters, digits and '-'.
+        #[arg(value_name = "STEM")]
         stem: String,
         /// Directory of motor specs.
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
-    /// Build the STM32G474 image of one motor (or --all) into target/firmware/<stem>.elf
-    /// and .bin and print its flash and RAM use (fails above 64 KiB of flash).
+    /// Build the STM32G474 image of one motor (or --all) into target/firmware/STEM.elf
+    /// and .bin and print its flash and RAM use (fails above the 64 KiB flash budget);
+    /// cargo's build progress is shown on stderr.
     Firmware {
         /// Motor file stem in the motors folder, e.g. fischer-ti085.
-        #[arg(required_unless_present = "all", conflicts_with = "all")]
+        #[arg(required_unless_present = "all", conflicts_with = "all", value_name = "STEM")]
         stem: Option<String>,
         /// Every motor in the motors folder.
         #[arg(long)]
         all: bool,
         /// Directory of motor specs (default: motors/).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
     /// Simulate the firmware's current loop and observer with the motor and print a
-    /// pass/fail table of measured vs designed figures (non-zero exit on a failure).
+    /// pass/fail table of measured vs designed figures (exit 3 on a failure).
     Verify {
         /// The motor spec.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
     },
     /// Write a self-contained HTML report (verification table, SVG plots, every constant
-    /// with formula and provenance) to DIR/<stem>.html.
+    /// with formula and provenance) to DIR/STEM.html (exit 3 if a figure fails).
     Report {
         /// The motor spec.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
         /// Output directory (created if missing).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
     /// Identify R, L, ψ_M or the resolver offset from recorded commissioning runs
@@ -96,7 +104,7 @@ enum Command {
     /// List the motors in a directory (default: motors/).
     List {
         /// Directory of motor specs.
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
 }
@@ -127,31 +135,25 @@ impl Format {
 }
 
 /// Renders `out` with the template from `dir` if given, else the built-in one.
-fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String, String> {
+fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String, Failure> {
+    let bad_template = |e: codegen::render::RenderError| Failure::new(Exit::BadInput, e.to_string());
     match dir {
         Some(dir) => {
             let path = dir.join(out.template());
             let source = std::fs::read_to_string(&path)
-                .map_err(|e| format!("error: cannot read template {}: {e}", path.display()))?;
-            render_with(d, &path.display().to_string(), &source).map_err(|e| e.to_string())
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read template {}: {e}", path.display())))?;
+            render_with(d, &path.display().to_string(), &source).map_err(bad_template)
         }
-        None => codegen::render::render(d, out).map_err(|e| e.to_string()),
+        None => codegen::render::render(d, out).map_err(bad_template),
     }
 }
 
-/// Writes `bytes` to `path` unless it already holds exactly them; returns whether it wrote.
-fn write_if_changed(path: &Path, bytes: &[u8]) -> std::io::Result<bool> {
-    if std::fs::read(path).is_ok_and(|old| old == bytes) {
-        return Ok(false);
-    }
-    std::fs::write(path, bytes).map(|()| true)
-}
-
-/// Reads a spec as UTF-8 text, or a diagnostic naming the file.
-fn read_spec(path: &Path) -> Result<String, Diagnostics> {
+/// Reads a spec as UTF-8 text: an unreadable file is an I/O failure, invalid UTF-8 bad
+/// input; both name the file.
+fn read_spec(path: &Path) -> Result<String, Failure> {
     let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| {
-        Diagnostics(vec![Diagnostic {
+        let d = codegen::Diagnostic {
             file: file.clone(),
             line: 1,
             column: 1,
@@ -159,12 +161,13 @@ fn read_spec(path: &Path) -> Result<String, Diagnostics> {
             problem: format!("cannot read the file: {e}"),
             accepted: "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)".into(),
             excerpt: String::new(),
-        }])
+        };
+        Failure::new(Exit::Io, codegen::Diagnostics(vec![d]).to_string())
     })?;
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(e.as_bytes());
-        codegen::Source {
+        let d = codegen::Source {
             file: &file,
             text: &text,
         }
@@ -173,14 +176,14 @@ fn read_spec(path: &Path) -> Result<String, Diagnostics> {
             "",
             format!("the file is not valid UTF-8 (byte {at})"),
             "a UTF-8 text file; save the spec as UTF-8",
-        )
-        .into()
+        );
+        Failure::from(codegen::Diagnostics::from(d))
     })
 }
 
-fn design(path: &Path) -> Result<codegen::Design, Diagnostics> {
+fn design(path: &Path) -> Result<codegen::Design, Failure> {
     let text = read_spec(path)?;
-    codegen::design_source(&path.display().to_string(), &text)
+    Ok(codegen::design_source(&path.display().to_string(), &text)?)
 }
 
 /// `motors/` in the working directory, else the one in this repository.
@@ -196,52 +199,32 @@ fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
-    match cli.command {
+    match run(Cli::parse().command) {
+        Ok(()) => Exit::Success.into(),
+        Err(f) => f.report(),
+    }
+}
+
+fn run(command: Command) -> Result<(), Failure> {
+    match command {
         Command::Design {
             spec,
             format,
             templates,
-        } => match design(&spec) {
-            Ok(d) => {
-                let out = match format {
-                    Format::Rust | Format::C | Format::Markdown => {
-                        let Some(o) = format.output() else {
-                            return ExitCode::FAILURE;
-                        };
-                        match render(&d, o, templates.as_deref()) {
-                            Ok(s) => s,
-                            Err(e) => {
-                                eprintln!("{e}");
-                                return ExitCode::FAILURE;
-                            }
-                        }
-                    }
-                    Format::Summary => codegen::summary::summary(&d),
-                    Format::Json => match serde_json::to_string_pretty(&d) {
-                        Ok(s) => s + "\n",
-                        Err(e) => {
-                            eprintln!("error: cannot serialise the design: {e}");
-                            return ExitCode::FAILURE;
-                        }
-                    },
-                };
-                print!("{out}");
-                ExitCode::SUCCESS
-            }
-            Err(e) => {
-                eprint!("{e}");
-                ExitCode::FAILURE
-            }
-        },
-        Command::Generate { spec, out, templates } => {
-            let d = match design(&spec) {
-                Ok(d) => d,
-                Err(e) => {
-                    eprint!("{e}");
-                    return ExitCode::FAILURE;
-                }
+        } => {
+            let d = design(&spec)?;
+            let out = match format.output() {
+                Some(o) => render(&d, o, templates.as_deref())?,
+                None if matches!(format, Format::Json) => serde_json::to_string_pretty(&d)
+                    .map(|s| s + "\n")
+                    .map_err(|e| Failure::new(Exit::Io, format!("error: cannot serialise the design: {e}")))?,
+                None => codegen::summary::summary(&d),
             };
+            print!("{out}");
+            Ok(())
+        }
+        Command::Generate { spec, out, templates } => {
+            let d = design(&spec)?;
             let stem = spec
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -249,47 +232,43 @@ fn main() -> ExitCode {
             // Render everything first: nothing is written unless every output renders.
             let mut files = Vec::new();
             for o in Output::ALL {
-                match render(&d, o, templates.as_deref()) {
-                    Ok(text) => files.push((out.join(o.file_name(&stem)), text)),
-                    Err(e) => {
-                        eprintln!("{e}");
-                        return ExitCode::FAILURE;
-                    }
-                }
+                files.push((out.join(o.file_name(&stem)), render(&d, o, templates.as_deref())?));
             }
-            if let Err(e) = std::fs::create_dir_all(&out) {
-                eprintln!("error: cannot create {}: {e}", out.display());
-                return ExitCode::FAILURE;
-            }
+            let io = |what: String| Failure::new(Exit::Io, what);
+            std::fs::create_dir_all(&out).map_err(|e| io(format!("error: cannot create {}: {e}", out.display())))?;
             for (path, text) in files {
-                match write_if_changed(&path, text.as_bytes()) {
+                match codegen::files::write_if_changed(&path, text.as_bytes()) {
                     Ok(true) => println!("wrote {}", path.display()),
                     Ok(false) => println!("unchanged {}", path.display()),
-                    Err(e) => {
-                        eprintln!("error: cannot write {}: {e}", path.display());
-                        return ExitCode::FAILURE;
-                    }
+                    Err(e) => return Err(io(format!("error: cannot write {}: {e}", path.display()))),
                 }
             }
-            ExitCode::SUCCESS
+            Ok(())
         }
         Command::Check { specs } => {
-            let mut ok = true;
+            // Every spec is checked; the exit code is the gravest failure's (I/O over bad input).
+            let mut failed = Vec::new();
             for path in &specs {
                 match design(path) {
                     Ok(d) => {
                         println!("ok: {} ({})", path.display(), d.name);
                         for w in &d.warnings {
-                            println!("  warning: {w}");
+                            eprintln!("warning: {}: {w}", path.display());
                         }
                     }
-                    Err(e) => {
-                        ok = false;
-                        eprint!("{e}");
+                    Err(f) => {
+                        failed.push(f.exit);
+                        f.report();
                     }
                 }
             }
-            if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+            match failed.iter().max_by_key(|e| **e as u8) {
+                None => Ok(()),
+                Some(&exit) => Err(Failure::new(
+                    exit,
+                    format!("check: {} of {} specs failed", failed.len(), specs.len()),
+                )),
+            }
         }
         Command::New { stem, dir } => {
             if stem.is_empty()
@@ -298,41 +277,34 @@ fn main() -> ExitCode {
                     .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
                 || stem.starts_with('-')
             {
-                eprintln!(
-                    "error: `{stem}` is not a valid motor stem\n  accepted: lowercase letters, digits and '-', e.g. my-motor-80kw"
-                );
-                return ExitCode::FAILURE;
+                return Err(Failure::new(
+                    Exit::BadInput,
+                    format!(
+                        "error: `{stem}` is not a valid motor stem\n  accepted: lowercase letters, digits and '-', e.g. my-motor-80kw"
+                    ),
+                ));
             }
             let dir = motors_dir(dir);
             let path = dir.join(format!("{stem}.toml"));
             if path.exists() {
-                eprintln!(
-                    "error: {} already exists\n  accepted: a new stem, or edit the existing file",
-                    path.display()
-                );
-                return ExitCode::FAILURE;
-            }
-            let text = match codegen::render::new_spec(&stem) {
-                Ok(t) => t,
-                Err(e) => {
-                    eprintln!("{e}");
-                    return ExitCode::FAILURE;
-                }
-            };
-            match std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, text)) {
-                Ok(()) => {
-                    println!(
-                        "wrote {}; edit it, then run `motorgen check {}`",
-                        path.display(),
+                return Err(Failure::new(
+                    Exit::BadInput,
+                    format!(
+                        "error: {} already exists\n  accepted: a new stem, or edit the existing file",
                         path.display()
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    eprintln!("error: cannot write {}: {e}", path.display());
-                    ExitCode::FAILURE
-                }
+                    ),
+                ));
             }
+            let text = codegen::render::new_spec(&stem).map_err(|e| Failure::new(Exit::BadInput, e.to_string()))?;
+            std::fs::create_dir_all(&dir)
+                .and_then(|()| std::fs::write(&path, text))
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot write {}: {e}", path.display())))?;
+            println!(
+                "wrote {}; edit it, then run `motorgen check {}`",
+                path.display(),
+                path.display()
+            );
+            Ok(())
         }
         Command::Firmware { stem, all, dir } => {
             let which = match stem {
@@ -346,16 +318,11 @@ fn main() -> ExitCode {
         Command::Identify { what } => identify::run(what),
         Command::List { dir } => {
             let dir = motors_dir(dir);
-            let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {
-                Ok(rd) => rd
-                    .filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-                    .collect(),
-                Err(e) => {
-                    eprintln!("error: cannot read {}: {e}", dir.display());
-                    return ExitCode::FAILURE;
-                }
-            };
+            let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read {}: {e}", dir.display())))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect();
             entries.sort();
             for path in entries {
                 let stem = path
@@ -364,14 +331,10 @@ fn main() -> ExitCode {
                     .unwrap_or_default();
                 match design(&path) {
                     Ok(d) => println!("{stem:<24} {}", d.name),
-                    Err(e) => println!(
-                        "{stem:<24} INVALID ({} problem{})",
-                        e.0.len(),
-                        if e.0.len() == 1 { "" } else { "s" }
-                    ),
+                    Err(_) => println!("{stem:<24} INVALID (`motorgen check {}` says why)", path.display()),
                 }
             }
-            ExitCode::SUCCESS
+            Ok(())
         }
     }
 }

@@ -2,59 +2,39 @@
 //! self-contained HTML report `DIR/<stem>.html`.
 
 use std::path::Path;
-use std::process::ExitCode;
 
-/// Writes the report; non-zero exit (and no file) on a bad spec or a write error. A
-/// failing verification is reported in the page and on stderr, and the exit is non-zero.
-pub fn run(spec: &Path, out: &Path) -> ExitCode {
-    let text = match crate::read_spec(spec) {
-        Ok(t) => t,
-        Err(e) => {
-            eprint!("{e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    let (design, verification) = match codegen::verify::verify_source(&spec.display().to_string(), &text) {
-        Ok(x) => x,
-        Err(e) => {
-            eprint!("{e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    let page = match codegen::report::report(&design, &verification) {
-        Ok(p) => p,
-        Err(e) => {
-            eprintln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+use crate::exit::{Exit, Failure};
+
+/// Writes the report; no file on a bad spec or a write error. A failing verification
+/// is reported in the page and on stderr, with the verification-failed exit code.
+pub fn run(spec: &Path, out: &Path) -> Result<(), Failure> {
+    let text = crate::read_spec(spec)?;
+    let (design, verification) = codegen::verify::verify_source(&spec.display().to_string(), &text)?;
+    let page = codegen::report::report(&design, &verification)
+        .map_err(|e| Failure::new(Exit::Io, format!("error: cannot draw the report: {e}")))?;
     let stem = spec
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "motor".into());
-    if let Err(e) = std::fs::create_dir_all(out) {
-        eprintln!("error: cannot create {}: {e}", out.display());
-        return ExitCode::FAILURE;
-    }
+    let io = |what: String| Failure::new(Exit::Io, what);
+    std::fs::create_dir_all(out).map_err(|e| io(format!("error: cannot create {}: {e}", out.display())))?;
     let path = out.join(format!("{stem}.html"));
     // Written whole into a temporary file, then renamed: never a partial page.
     let tmp = out.join(format!(".{stem}.html.tmp"));
     if let Err(e) = std::fs::write(&tmp, page).and_then(|()| std::fs::rename(&tmp, &path)) {
         let _ = std::fs::remove_file(&tmp);
-        eprintln!("error: cannot write {}: {e}", path.display());
-        return ExitCode::FAILURE;
+        return Err(io(format!("error: cannot write {}: {e}", path.display())));
     }
     println!("wrote {}", path.display());
     if verification.passed() {
-        ExitCode::SUCCESS
+        Ok(())
     } else {
-        let failed: Vec<&str> = verification
-            .scenarios
-            .iter()
-            .filter(|s| !s.passed())
-            .map(|s| s.id)
-            .collect();
-        eprintln!("verification failed: {} (see the report's table)", failed.join(", "));
-        ExitCode::FAILURE
+        Err(Failure::new(
+            Exit::VerificationFailed,
+            format!(
+                "{} (see the report's table)",
+                crate::verify::failed_message(&verification)
+            ),
+        ))
     }
 }

@@ -1,0 +1,98 @@
+//! The exit codes of `motorgen`, one per kind of failure, so that scripts and CI can
+//! tell a bad spec from a failed verification or a full disk. Documented in `--help`
+//! ([`HELP`]) and in the README.
+
+use std::process::ExitCode;
+
+use codegen::Diagnostics;
+
+/// Why `motorgen` stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exit {
+    /// 0: done.
+    Success = 0,
+    /// 1: the input is wrong — a spec, recording, template or motor name; the message
+    /// names the file, line:column and key, and what would be accepted.
+    BadInput = 1,
+    /// 2: the command line is wrong (clap's own exit code for usage errors).
+    Usage = 2,
+    /// 3: the design was made but does not hold up: `verify`/`report` measured a
+    /// failing figure, or the `firmware` image exceeds its flash budget.
+    VerificationFailed = 3,
+    /// 4: a file or directory could not be read or written, or cargo could not be run.
+    Io = 4,
+    /// 5: the firmware build (cargo) failed.
+    BuildFailed = 5,
+}
+
+impl From<Exit> for ExitCode {
+    fn from(e: Exit) -> Self {
+        ExitCode::from(e as u8)
+    }
+}
+
+/// The exit-code table shown at the end of `motorgen --help`.
+pub const HELP: &str = "\
+Exit codes:
+  0  success
+  1  bad input: a spec, recording, template or motor name is wrong (located message on stderr)
+  2  usage: the command line is wrong
+  3  verification failed: a simulated figure failed, or the image exceeds its flash budget
+  4  I/O: a file or directory could not be read or written, or cargo could not be run
+  5  the firmware build (cargo) failed";
+
+/// A failed command: the message for stderr and the exit code.
+#[derive(Debug)]
+pub struct Failure {
+    /// Exit code.
+    pub exit: Exit,
+    /// Printed on stderr (a trailing newline is added if missing).
+    pub message: String,
+}
+
+impl Failure {
+    /// A failure of kind `exit` with `message`.
+    pub fn new(exit: Exit, message: impl Into<String>) -> Self {
+        Self {
+            exit,
+            message: message.into(),
+        }
+    }
+
+    /// Prints the message on stderr and returns the exit code.
+    pub fn report(self) -> ExitCode {
+        if self.message.ends_with('\n') {
+            eprint!("{}", self.message);
+        } else {
+            eprintln!("{}", self.message);
+        }
+        self.exit.into()
+    }
+}
+
+/// Located diagnostics are bad input.
+impl From<Diagnostics> for Failure {
+    fn from(d: Diagnostics) -> Self {
+        Failure::new(Exit::BadInput, d.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table in `--help` lists every code with its number.
+    #[test]
+    fn help_lists_every_code() {
+        for e in [
+            Exit::Success,
+            Exit::BadInput,
+            Exit::Usage,
+            Exit::VerificationFailed,
+            Exit::Io,
+            Exit::BuildFailed,
+        ] {
+            assert!(HELP.contains(&format!("\n  {}  ", e as u8)), "{e:?}");
+        }
+    }
+}
