@@ -32,13 +32,13 @@ pub struct Bench {
 /// One recorded period.
 #[derive(Clone, Copy, Debug)]
 pub struct Sample {
-    /// Time of the sample t_n [s].
+    /// Time of the sample t_n \[s\].
     pub t: f64,
-    /// True i_d, i_q at t_n [A].
+    /// True i_d, i_q at t_n \[A\].
     pub i: [f64; 2],
     /// The controller's output at t_n.
     pub out: StepOutput,
-    /// True resolver angle θ_r(t_n) [rad].
+    /// True resolver angle θ_r(t_n) \[rad\].
     pub theta_r: f64,
     /// True mechanical speed [rad/s].
     pub omega_m: f64,
@@ -108,7 +108,7 @@ impl Bench {
     }
 }
 
-/// π-scaled Q1.31 stored integer → angle [rad].
+/// π-scaled Q1.31 stored integer → angle \[rad\].
 pub fn q31_angle(bits: i32) -> f64 {
     f64::from(bits) * PI / Q31
 }

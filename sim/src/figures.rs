@@ -3,7 +3,7 @@
 /// Step-response figures of a sampled signal.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepFigures {
-    /// 10–90 % rise time [s] (linear interpolation between samples); NaN if never reached.
+    /// 10–90 % rise time \[s\] (linear interpolation between samples); NaN if never reached.
     pub rise_time: f64,
     /// Peak beyond the target, as a fraction of the step height (≥ 0).
     pub overshoot: f64,
@@ -11,7 +11,7 @@ pub struct StepFigures {
     pub final_error: f64,
 }
 
-/// Time [s] at which `samples` (spaced `dt`) first crosses `initial + level·(target − initial)`.
+/// Time \[s\] at which `samples` (spaced `dt`) first crosses `initial + level·(target − initial)`.
 pub fn crossing(samples: &[f64], dt: f64, initial: f64, target: f64, level: f64) -> f64 {
     let height = target - initial;
     let y = initial + level * height;
@@ -38,7 +38,7 @@ pub fn step_figures(samples: &[f64], dt: f64, initial: f64, target: f64) -> Step
     }
 }
 
-/// Time [s] after which `|x|` stays below `threshold`; `None` if the last sample is not.
+/// Time \[s\] after which `|x|` stays below `threshold`; `None` if the last sample is not.
 pub fn settling_time(x: &[f64], dt: f64, threshold: f64) -> Option<f64> {
     match x.iter().rposition(|v| v.abs() >= threshold) {
         None => Some(0.0),

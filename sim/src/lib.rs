@@ -6,7 +6,7 @@
 //! * [`plant`]: a PMSM in rotor (dq) coordinates with optional harmonics and L_q
 //!   saturation, an ideal inverter, the ADCs and the resolver; the shaft either follows a
 //!   speed profile or turns freely with its inertia.
-//! * [`bench`]: the firmware's [`ControllerConfig::process`] and the plant, stepped with
+//! * [`mod@bench`]: the firmware's [`ControllerConfig::process`] and the plant, stepped with
 //!   the sampling timing of thesis A §4.6.
 //! * [`figures`]: step-response figures (rise time, overshoot, settling) of sampled
 //!   signals.

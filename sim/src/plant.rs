@@ -32,26 +32,26 @@ pub const SUBSTEPS: usize = 4;
 pub struct MotorModel {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub resistance: f64,
-    /// L_d [H].
+    /// L_d \[H\].
     pub ld: f64,
-    /// L_q [H] (unsaturated).
+    /// L_q \[H\] (unsaturated).
     pub lq: f64,
-    /// ψ_M [Wb] (0 when the spec does not know it).
+    /// ψ_M \[Wb\] (0 when the spec does not know it).
     pub psi: f64,
-    /// L_6 [H] (2.16c).
+    /// L_6 \[H\] (2.16c).
     pub l6: f64,
-    /// ψ_d,6, ψ_d,12 [Wb] (2.16e).
+    /// ψ_d,6, ψ_d,12 \[Wb\] (2.16e).
     pub psi_d: [f64; 2],
-    /// ψ_q,6, ψ_q,12 [Wb] (2.16f).
+    /// ψ_q,6, ψ_q,12 \[Wb\] (2.16f).
     pub psi_q: [f64; 2],
-    /// L_q(|i_q|) points ([A], [H]), sorted by current; empty = constant L_q.
+    /// L_q(|i_q|) points (\[A\], \[H\]), sorted by current; empty = constant L_q.
     pub q_saturation: Vec<(f64, f64)>,
 }
 
 impl MotorModel {
-    /// L_q at `iq` [A]: the saturation curve (2.25), constant beyond its ends.
+    /// L_q at `iq` \[A\]: the saturation curve (2.25), constant beyond its ends.
     pub fn lq_at(&self, iq: f64) -> f64 {
         let pts = &self.q_saturation;
         let x = iq.abs();
@@ -109,7 +109,7 @@ pub struct SpeedProfile {
     pub from: f64,
     /// Speed after the ramp [rad/s].
     pub to: f64,
-    /// Ramp start [s].
+    /// Ramp start \[s\].
     pub start: f64,
     /// |acceleration| [rad/s²] (ignored when `from == to`).
     pub acceleration: f64,
@@ -143,11 +143,11 @@ impl SpeedProfile {
 /// What the ADCs and the resolver demodulator deliver (before quantisation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Measured {
-    /// Phase currents u, v, w [A].
+    /// Phase currents u, v, w \[A\].
     pub phase_currents: [f64; 3],
-    /// Resolver angle θ_r [rad].
+    /// Resolver angle θ_r \[rad\].
     pub theta_r: f64,
-    /// DC-link voltage [V].
+    /// DC-link voltage \[V\].
     pub dc_link: f64,
 }
 
@@ -178,17 +178,17 @@ pub struct Plant {
     pub resolver_pole_pairs: u32,
     /// Resolver mounted the other way round: θ_r = −n_r·θ_m + θ_off.
     pub resolver_reversed: bool,
-    /// Resolver offset θ_off [rad] (4.5): θ_r = n_r·θ_m + θ_off.
+    /// Resolver offset θ_off \[rad\] (4.5): θ_r = n_r·θ_m + θ_off.
     pub resolver_offset: f64,
-    /// PWM period T_s [s].
+    /// PWM period T_s \[s\].
     pub ts: f64,
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
-    /// i_d, i_q [A].
+    /// i_d, i_q \[A\].
     pub i: [f64; 2],
-    /// Mechanical angle θ_m [rad], unwrapped.
+    /// Mechanical angle θ_m \[rad\], unwrapped.
     pub theta_m: f64,
-    /// Actual DC-link voltage [V] (a scenario may change it between periods).
+    /// Actual DC-link voltage \[V\] (a scenario may change it between periods).
     pub dc_link: f64,
     /// Duties loaded for the next period (computed at the previous sample); `None` = gates off.
     pub pending: Option<[f32; 3]>,
@@ -213,7 +213,7 @@ impl Plant {
         }
     }
 
-    /// Electrical angle θ_e = n_p·θ_m (thesis A (2.19)) [rad].
+    /// Electrical angle θ_e = n_p·θ_m (thesis A (2.19)) \[rad\].
     pub fn theta_e(&self) -> f64 {
         f64::from(self.motor.pole_pairs) * self.theta_m
     }
@@ -224,7 +224,7 @@ impl Plant {
         if self.resolver_reversed { -nr } else { nr }
     }
 
-    /// Resolver angle θ_r = ±n_r·θ_m + θ_off [rad] (4.4), (4.5).
+    /// Resolver angle θ_r = ±n_r·θ_m + θ_off \[rad\] (4.4), (4.5).
     pub fn theta_r(&self) -> f64 {
         self.resolver_ratio() * self.theta_m + self.resolver_offset
     }

@@ -18,7 +18,7 @@ pub fn run(spec: &Path) -> Result<(), Failure> {
     }
 }
 
-/// "verification failed: <scenario ids>".
+/// `verification failed: <scenario ids>`.
 pub fn failed_message(v: &codegen::verify::Verification) -> String {
     let failed: Vec<&str> = v.scenarios.iter().filter(|s| !s.passed()).map(|s| s.id).collect();
     format!("verification failed: {}", failed.join(", "))

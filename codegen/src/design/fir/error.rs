@@ -7,7 +7,7 @@ use super::{FMAC_MAX_TAPS, FMAC_MEMORY_WORDS, MIN_ORDER};
 
 /// Why no filter was designed; [`FirError::key`] names the spec key to point at.
 ///
-/// Every `Display` message has the form "<what is wrong>; accepted: <what is accepted>".
+/// Every `Display` message has the form "`<what is wrong>; accepted: <what is accepted>`".
 #[derive(Debug, Clone, PartialEq)]
 pub enum FirError {
     /// An input is NaN, infinite, zero or negative.
