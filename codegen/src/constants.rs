@@ -333,19 +333,20 @@ pub fn constants(d: &Design) -> Vec<Group> {
             )
             .at(j("anti_windup_gain")),
         );
-        if let Some(p) = &g.prefilter {
-            current.push(
-                c(
-                    format!("{axis}_PREFILTER"),
-                    f32v(p.discrete_coefficient),
-                    phys(p.discrete_coefficient, ""),
-                    "a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y)",
-                    "thesis A (5.16)",
-                    format!("{ins}, {fs_in}"),
-                )
-                .at(j("prefilter/discrete_coefficient")),
-            );
-        }
+        current.push(
+            c(
+                format!("{axis}_PREFILTER"),
+                f32v(g.reference_filter),
+                phys(g.reference_filter, ""),
+                match g.prefilter {
+                    Some(_) => "a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y)",
+                    None => "y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel",
+                },
+                "thesis A (5.16)",
+                format!("{ins}, {fs_in}"),
+            )
+            .at(j("reference_filter")),
+        );
     }
     let ff = &cl.feedforward;
     current.push(

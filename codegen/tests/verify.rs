@@ -294,16 +294,11 @@ fn controller_config_is_the_generated_constants() {
                 f("current_loop", &format!("{axis}_ACTIVE_DAMPING")),
                 "{name} {axis}"
             );
-            let has_prefilter = g
-                .iter()
-                .flat_map(|g| &g.constants)
-                .any(|c| c.name == format!("{axis}_PREFILTER"));
-            let want = if has_prefilter {
-                f("current_loop", &format!("{axis}_PREFILTER"))
-            } else {
-                1.0
-            };
-            assert_eq!(pi.reference_filter, want, "{name} {axis}");
+            assert_eq!(
+                pi.reference_filter,
+                f("current_loop", &format!("{axis}_PREFILTER")),
+                "{name} {axis}"
+            );
         }
         assert_eq!(cfg.feed_forward.ld, f("current_loop", "FF_LD"), "{name}");
         assert_eq!(cfg.feed_forward.lq, f("current_loop", "FF_LQ"), "{name}");

@@ -76,15 +76,14 @@ fn main() {
         Ok(c) => c,
         Err(e) => return fail(&e.to_string()),
     };
-    write_if_changed(&out_dir.join("motor.rs"), &code);
-    write_if_changed(&out_dir.join("design_extra.rs"), &design_extra(&design));
+    write(&out_dir.join("motor.rs"), &code);
+    write(&out_dir.join("design_extra.rs"), &design_extra(&design));
 }
 
-/// Writes only when the bytes change, so an unchanged design causes no rebuild.
-fn write_if_changed(out: &Path, code: &str) {
-    if std::fs::read(out).ok().as_deref() != Some(code.as_bytes())
-        && let Err(e) = std::fs::write(out, code)
-    {
+/// Writes through codegen's [`codegen::files::write_if_changed`] (an unchanged design
+/// causes no rebuild); a failure fails the build with the path.
+fn write(out: &Path, code: &str) {
+    if let Err(e) = codegen::files::write_if_changed(out, code.as_bytes()) {
         fail(&format!("cannot write {}: {e}", out.display()));
     }
 }
@@ -99,12 +98,9 @@ fn design_extra(d: &codegen::design::Design) -> String {
         ObserverError::TrigIdentity => "TrigIdentity",
         ObserverError::Atan2 => "Atan2",
     };
-    // θ_off [rad] → π-scaled Q1.31 (4.20), wrapped into one turn.
-    let offset = d.angle_observer.resolver_offset_rad.map_or(0, |rad| {
-        let turns = rad / std::f64::consts::TAU;
-        let frac = turns - turns.round();
-        (frac * 4_294_967_296.0).round() as i64 as i32
-    });
+    // θ_off [rad] → π-scaled Q1.31 (4.20), wrapped into one turn: the design's value
+    // (motor_control::angle::from_radians_f64), 0 when the spec gives none.
+    let offset = d.angle_observer.resolver_offset_q31.unwrap_or(0);
     let opt = |v: Option<String>| v.map_or_else(|| "None".to_string(), |v| format!("Some({v})"));
     let offset_doc = d.angle_observer.resolver_offset_rad.map_or_else(
         || "not in the spec: 0".to_string(),

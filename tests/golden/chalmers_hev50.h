@@ -39,6 +39,10 @@ static const float CHALMERS_HEV50_CURRENT_LOOP_D_ACTIVE_DAMPING = 0.2677192f;
  *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_ANTI_WINDUP = 3.628194f;
 
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_PREFILTER = 1.0f;
+
 /** 0.671673 V/A: k_p = α_c·L, thesis B (2.38), (2.39).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KP = 0.6716734f;
@@ -62,6 +66,10 @@ static const float CHALMERS_HEV50_CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.6637734f;
 /** 1.48882 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_ANTI_WINDUP = 1.4888188f;
+
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_PREFILTER = 1.0f;
 
 /** 0.00023 H: L_d in u_q,ff = ω_e(L_d·i_d + ψ_M), thesis A (5.3).
  *  Inputs: L_d = 0.00023 H (datasheet). */

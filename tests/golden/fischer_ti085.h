@@ -39,6 +39,10 @@ static const float FISCHER_TI085_CURRENT_LOOP_D_ACTIVE_DAMPING = 0.0f;
  *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
 static const float FISCHER_TI085_CURRENT_LOOP_D_ANTI_WINDUP = 25.445293f;
 
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec). */
+static const float FISCHER_TI085_CURRENT_LOOP_D_PREFILTER = 1.0f;
+
 /** 0.0393 V/A: K_p = K_a = L·α, thesis A (5.9), (5.7).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
 static const float FISCHER_TI085_CURRENT_LOOP_Q_KP = 0.0393f;
@@ -62,6 +66,10 @@ static const float FISCHER_TI085_CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.0f;
 /** 25.4453 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
 static const float FISCHER_TI085_CURRENT_LOOP_Q_ANTI_WINDUP = 25.445293f;
+
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec). */
+static const float FISCHER_TI085_CURRENT_LOOP_Q_PREFILTER = 1.0f;
 
 /** 0.000393 H: L_d in u_q,ff = ω_e(L_d·i_d + ψ_M), thesis A (5.3).
  *  Inputs: L_d = 0.000393 H (datasheet). */

@@ -47,6 +47,9 @@ pub struct AxisGains {
     pub ki_ts: f64,
     /// Reference prefilter (pole placement only).
     pub prefilter: Option<Prefilter>,
+    /// Coefficient a of the reference filter y += a·(x − y) the controller runs: the
+    /// prefilter's (5.16), or 1 (the reference passes unfiltered) without one.
+    pub reference_filter: f64,
     /// Designed closed-loop poles, real and imaginary parts [rad/s].
     pub designed_poles: Vec<[f64; 2]>,
     /// The bandwidth α these gains were designed for [rad/s]: the spec's, or the lower
@@ -160,6 +163,7 @@ pub fn design_axis(
         active_damping_ohm: ra,
         anti_windup_gain: 1.0 / kp,
         ki_ts: ki * ts,
+        reference_filter: prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient),
         prefilter,
         designed_poles: poles,
         bandwidth_rad_s: alpha,

@@ -31,7 +31,7 @@ fn axis(g: &AxisGains) -> PiConfig {
         ki: g.ki as f32,
         anti_windup: g.anti_windup_gain as f32,
         active_damping: g.active_damping_ohm as f32,
-        reference_filter: g.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient as f32),
+        reference_filter: g.reference_filter as f32,
     }
 }
 

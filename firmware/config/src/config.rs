@@ -29,10 +29,11 @@ pub const PWM_PERIOD: u16 = match timing::centre_aligned_arr(hw::TIMER_CLOCK_HZ,
 /// Mid-scale of the 16-bit left-aligned ADC code: a bipolar current sensor's 0 A.
 pub const BIPOLAR_OFFSET: i32 = 1 << 15;
 
-/// One axis' PI configuration from the generated gains.
-const fn axis(kp: f32, ki: f32, anti_windup: f32, active_damping: f32) -> PiConfig {
+/// One axis' PI configuration from the generated gains and reference prefilter (5.16).
+const fn axis(kp: f32, ki: f32, anti_windup: f32, active_damping: f32, reference_filter: f32) -> PiConfig {
     let mut c = PiConfig::new(kp, ki, anti_windup);
     c.active_damping = active_damping;
+    c.reference_filter = reference_filter;
     c
 }
 
@@ -66,8 +67,8 @@ pub const CONTROLLER: ControllerConfig = ControllerConfig {
     },
     angle_lead: observer::LEAD_Q16,
     current_loop: CurrentPiConfig {
-        d: axis(cl::D_KP, cl::D_KI, cl::D_ANTI_WINDUP, cl::D_ACTIVE_DAMPING),
-        q: axis(cl::Q_KP, cl::Q_KI, cl::Q_ANTI_WINDUP, cl::Q_ACTIVE_DAMPING),
+        d: axis(cl::D_KP, cl::D_KI, cl::D_ANTI_WINDUP, cl::D_ACTIVE_DAMPING, cl::D_PREFILTER),
+        q: axis(cl::Q_KP, cl::Q_KI, cl::Q_ANTI_WINDUP, cl::Q_ACTIVE_DAMPING, cl::Q_PREFILTER),
         limit: VoltageLimit::Proportional,
     },
     feed_forward: FeedForwardConfig {
@@ -238,6 +239,9 @@ mod tests {
         assert!(close(c.current_loop.q.ki, 12.6, 1e-6));
         assert!(close(c.current_loop.d.anti_windup, 1.0 / 0.0393, 1e-5));
         assert_eq!(c.current_loop.d.active_damping, 0.0);
+        // IMC: the closed loop α/(s + α) has no zero, so no prefilter (a = 1).
+        assert_eq!(c.current_loop.d.reference_filter, 1.0);
+        assert_eq!(c.current_loop.q.reference_filter, 1.0);
         assert!(close(
             c.feed_forward.psi_m,
             0.296 * 2f32.sqrt() / (3f32.sqrt() * 4.0),
@@ -327,7 +331,8 @@ mod tests {
     }
 
     /// Every motor: the configuration is consistent with its own constants (the
-    /// compare range is the timer period; the chalmers motor's active damping is used).
+    /// compare range is the timer period; the chalmers motor's active damping and the
+    /// unimotor's pole-placement prefilter (5.16) are used).
     #[test]
     fn every_motor_uses_its_constants() {
         assert_eq!(CONTROLLER.pwm_period, PWM_PERIOD);
@@ -340,5 +345,13 @@ mod tests {
             motor::current_loop::Q_ACTIVE_DAMPING
         );
         assert_eq!(CONTROLLER.observer.kp, motor::observer::KP);
+        assert_eq!(
+            CONTROLLER.current_loop.d.reference_filter,
+            motor::current_loop::D_PREFILTER
+        );
+        assert_eq!(
+            CONTROLLER.current_loop.q.reference_filter,
+            motor::current_loop::Q_PREFILTER
+        );
     }
 }
