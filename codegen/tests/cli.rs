@@ -1,11 +1,11 @@
 //! The `motorgen` CLI as a user runs it: the exit codes (0 success, 1 bad input,
-//! 2 usage, 3 verification failed, 4 I/O, 5 firmware build failed — documented in
+//! 2 usage, 3 verification failed, 5 firmware build failed, 74 I/O — documented in
 //! `--help` and the README), what goes to stdout and what to stderr, and file I/O. The
 //! diagnostics themselves are tested at the library level (`tests/spec.rs`); here they
 //! only have to reach stderr.
 
 mod common;
-use common::{motorgen, repo};
+use common::{EXIT_IO, motorgen, repo};
 
 use std::path::{Path, PathBuf};
 
@@ -102,8 +102,8 @@ fn help_documents_exit_codes_and_value_names() {
         "  1  bad input",
         "  2  usage",
         "  3  verification failed",
-        "  4  I/O",
         "  5  the firmware build",
+        "  74 I/O",
     ] {
         assert!(help.contains(code), "{code:?} not in\n{help}");
     }
@@ -172,14 +172,14 @@ fn invalid_utf8_is_bad_input() {
     assert!(stderr.contains("not valid UTF-8"), "{stderr}");
 }
 
-/// An unreadable spec is an I/O failure (exit 4), located at the file.
+/// An unreadable spec is an I/O failure (exit 74), located at the file.
 #[test]
 fn missing_file_is_an_io_error() {
     let out = motorgen(&["check", "motors/no-such-motor.toml"]);
-    assert_eq!(out.status.code(), Some(4));
+    assert_eq!(out.status.code(), Some(EXIT_IO));
     assert!(String::from_utf8_lossy(&out.stderr).contains("motors/no-such-motor.toml:1:1"));
     let out = motorgen(&["design", "motors/no-such-motor.toml"]);
-    assert_eq!(out.status.code(), Some(4));
+    assert_eq!(out.status.code(), Some(EXIT_IO));
     assert!(out.stdout.is_empty());
 }
 
@@ -228,7 +228,7 @@ fn generate_writes_only_changed_files_and_templates_errors_name_the_file() {
     assert_eq!(bad.status.code(), Some(1));
     assert!(stderr.contains("motor.rs.j2:2"), "{stderr}");
     assert!(bad.stdout.is_empty());
-    // An output directory that cannot be created (a file is in the way): I/O, exit 4.
+    // An output directory that cannot be created (a file is in the way): I/O, exit 74.
     let blocked = out_dir.join("fischer_ti085.rs");
     let under = blocked.join("sub");
     let out = motorgen(&[
@@ -237,6 +237,11 @@ fn generate_writes_only_changed_files_and_templates_errors_name_the_file() {
         "--out",
         under.to_str().unwrap(),
     ]);
-    assert_eq!(out.status.code(), Some(4), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        out.status.code(),
+        Some(EXIT_IO),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     assert!(String::from_utf8_lossy(&out.stderr).contains("cannot create"));
 }

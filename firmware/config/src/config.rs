@@ -67,8 +67,20 @@ pub const CONTROLLER: ControllerConfig = ControllerConfig {
     },
     angle_lead: observer::LEAD_Q16,
     current_loop: CurrentPiConfig {
-        d: axis(cl::D_KP, cl::D_KI, cl::D_ANTI_WINDUP, cl::D_ACTIVE_DAMPING, cl::D_PREFILTER),
-        q: axis(cl::Q_KP, cl::Q_KI, cl::Q_ANTI_WINDUP, cl::Q_ACTIVE_DAMPING, cl::Q_PREFILTER),
+        d: axis(
+            cl::D_KP,
+            cl::D_KI,
+            cl::D_ANTI_WINDUP,
+            cl::D_ACTIVE_DAMPING,
+            cl::D_PREFILTER,
+        ),
+        q: axis(
+            cl::Q_KP,
+            cl::Q_KI,
+            cl::Q_ANTI_WINDUP,
+            cl::Q_ACTIVE_DAMPING,
+            cl::Q_PREFILTER,
+        ),
         limit: VoltageLimit::Proportional,
     },
     feed_forward: FeedForwardConfig {

@@ -6,6 +6,9 @@ use std::process::ExitCode;
 
 use codegen::Diagnostics;
 
+use crate::atomic::IoFailure;
+use crate::output::{err, errln};
+
 /// Why `motorgen` stopped.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Exit {
@@ -19,8 +22,9 @@ pub enum Exit {
     /// 3: the design was made but does not hold up: `verify`/`report` measured a
     /// failing figure, or the `firmware` image exceeds its flash budget.
     VerificationFailed = 3,
-    /// 4: a file or directory could not be read or written, or cargo could not be run.
-    Io = 4,
+    /// 74 (sysexits' EX_IOERR, [`crate::output::EXIT_IO`]): a file or directory could
+    /// not be read or written (standard output included), or cargo could not be run.
+    Io = crate::output::EXIT_IO as isize,
     /// 5: the firmware build (cargo) failed.
     BuildFailed = 5,
 }
@@ -38,8 +42,8 @@ Exit codes:
   1  bad input: a spec, recording, template or motor name is wrong (located message on stderr)
   2  usage: the command line is wrong
   3  verification failed: a simulated figure failed, or the image exceeds its flash budget
-  4  I/O: a file or directory could not be read or written, or cargo could not be run
-  5  the firmware build (cargo) failed";
+  5  the firmware build (cargo) failed
+  74 I/O: a file, directory or standard output could not be read or written, or cargo could not be run";
 
 /// A failed command: the message for stderr and the exit code.
 #[derive(Debug)]
@@ -62,11 +66,18 @@ impl Failure {
     /// Prints the message on stderr and returns the exit code.
     pub fn report(self) -> ExitCode {
         if self.message.ends_with('\n') {
-            eprint!("{}", self.message);
+            err!("{}", self.message);
         } else {
-            eprintln!("{}", self.message);
+            errln!("{}", self.message);
         }
         self.exit.into()
+    }
+}
+
+/// A file that could not be written is an I/O failure.
+impl From<IoFailure> for Failure {
+    fn from(e: IoFailure) -> Self {
+        Failure::new(Exit::Io, format!("error: {e}"))
     }
 }
 
@@ -92,7 +103,13 @@ mod tests {
             Exit::Io,
             Exit::BuildFailed,
         ] {
-            assert!(HELP.contains(&format!("\n  {}  ", e as u8)), "{e:?}");
+            let code = e as u8;
+            let row = if code < 10 {
+                format!("\n  {code}  ")
+            } else {
+                format!("\n  {code} ")
+            };
+            assert!(HELP.contains(&row), "{e:?}");
         }
     }
 }

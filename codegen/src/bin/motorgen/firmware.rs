@@ -26,6 +26,7 @@ use object::read::elf::{ElfFile32, FileHeader, ProgramHeader, SectionHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol};
 
 use crate::exit::{Exit, Failure};
+use crate::output::{errln, out};
 
 /// The firmware's target triple.
 const TARGET: &str = "thumbv7em-none-eabihf";
@@ -232,7 +233,7 @@ fn stems(dir: &Path) -> Result<Vec<String>, String> {
 fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, Failure> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let command = format!("MOTOR={stem} cargo build --release --target {TARGET} -p {PACKAGE}");
-    eprintln!("{stem}: {command} (in firmware/; a first build takes minutes)");
+    errln!("{stem}: {command} (in firmware/; a first build takes minutes)");
     let child = Command::new(&cargo)
         .args(["build", "--release", "--target", TARGET, "-p", PACKAGE])
         .args(["--message-format=json-render-diagnostics"])
@@ -265,7 +266,7 @@ fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, Failur
     let relay = std::thread::spawn(move || {
         let mut seen = String::new();
         for line in BufReader::new(err).lines().map_while(Result::ok) {
-            eprintln!("{line}");
+            errln!("{line}");
             seen.push_str(&line);
             seen.push('\n');
         }
@@ -324,11 +325,10 @@ fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, Failure> 
         ));
     }
     let out = root.join("target").join("firmware");
-    std::fs::create_dir_all(&out).map_err(|e| io(format!("error: cannot create {}: {e}", out.display())))?;
     let elf_out = out.join(format!("{stem}.elf"));
     let bin_out = out.join(format!("{stem}.bin"));
-    std::fs::write(&elf_out, &bytes).map_err(|e| io(format!("error: cannot write {}: {e}", elf_out.display())))?;
-    std::fs::write(&bin_out, &image.bin).map_err(|e| io(format!("error: cannot write {}: {e}", bin_out.display())))?;
+    // The pair is replaced together or not at all.
+    crate::atomic::write_set(&out, &[(elf_out.clone(), bytes), (bin_out.clone(), image.bin.clone())])?;
     let _ = writeln!(
         report,
         "{stem}: wrote {} and {} (load address {:#010x})",
@@ -390,11 +390,11 @@ pub fn run(which: Which, motors: &Path) -> Result<(), Failure> {
     }
     // One motor: the constants the image is built from, as `motorgen design` prints them.
     if let [d] = designs.as_slice() {
-        print!("{}", codegen::summary::summary(d));
+        out!("{}", codegen::summary::summary(d));
     }
     for stem in &selected {
         match build_one(&root, &motors, stem) {
-            Ok(report) => print!("{report}"),
+            Ok(report) => out!("{report}"),
             Err(f) => {
                 failed.push(f.exit);
                 f.report();

@@ -1,8 +1,10 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
+mod atomic;
 mod exit;
 mod firmware;
 mod identify;
+mod output;
 mod report;
 mod verify;
 
@@ -12,6 +14,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 use codegen::render::{Output, render_with};
 use exit::{Exit, Failure};
+use output::{out, outln};
 
 /// Motor description (TOML) → tuned motor-controller constants.
 #[derive(Parser)]
@@ -164,6 +167,12 @@ fn read_spec(path: &Path) -> Result<String, Failure> {
         };
         Failure::new(Exit::Io, codegen::Diagnostics(vec![d]).to_string())
     })?;
+    spec_text(path, bytes)
+}
+
+/// A spec's bytes as UTF-8 text, or bad input located at the first invalid byte.
+fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, Failure> {
+    let file = path.display().to_string();
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(e.as_bytes());
@@ -199,10 +208,12 @@ fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
 }
 
 fn main() -> ExitCode {
-    match run(Cli::parse().command) {
+    let code = match run(Cli::parse().command) {
         Ok(()) => Exit::Success.into(),
         Err(f) => f.report(),
-    }
+    };
+    output::flush();
+    code
 }
 
 fn run(command: Command) -> Result<(), Failure> {
@@ -220,10 +231,11 @@ fn run(command: Command) -> Result<(), Failure> {
                     .map_err(|e| Failure::new(Exit::Io, format!("error: cannot serialise the design: {e}")))?,
                 None => codegen::summary::summary(&d),
             };
-            print!("{out}");
+            out!("{out}");
             Ok(())
         }
         Command::Generate { spec, out, templates } => {
+            atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
             let d = design(&spec)?;
             let stem = spec
                 .file_stem()
@@ -232,16 +244,13 @@ fn run(command: Command) -> Result<(), Failure> {
             // Render everything first: nothing is written unless every output renders.
             let mut files = Vec::new();
             for o in Output::ALL {
-                files.push((out.join(o.file_name(&stem)), render(&d, o, templates.as_deref())?));
+                let text = render(&d, o, templates.as_deref())?;
+                files.push((out.join(o.file_name(&stem)), text.into_bytes()));
             }
-            let io = |what: String| Failure::new(Exit::Io, what);
-            std::fs::create_dir_all(&out).map_err(|e| io(format!("error: cannot create {}: {e}", out.display())))?;
-            for (path, text) in files {
-                match codegen::files::write_if_changed(&path, text.as_bytes()) {
-                    Ok(true) => println!("wrote {}", path.display()),
-                    Ok(false) => println!("unchanged {}", path.display()),
-                    Err(e) => return Err(io(format!("error: cannot write {}: {e}", path.display()))),
-                }
+            // All or nothing, each file rewritten only when its bytes change.
+            let written = atomic::write_set(&out, &files)?;
+            for ((path, _), w) in files.iter().zip(written) {
+                outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
             }
             Ok(())
         }
@@ -251,9 +260,9 @@ fn run(command: Command) -> Result<(), Failure> {
             for path in &specs {
                 match design(path) {
                     Ok(d) => {
-                        println!("ok: {} ({})", path.display(), d.name);
+                        outln!("ok: {} ({})", path.display(), d.name);
                         for w in &d.warnings {
-                            eprintln!("warning: {}: {w}", path.display());
+                            output::warn(format_args!("{}: {w}", path.display()));
                         }
                     }
                     Err(f) => {
@@ -296,10 +305,8 @@ fn run(command: Command) -> Result<(), Failure> {
                 ));
             }
             let text = codegen::render::new_spec(&stem).map_err(|e| Failure::new(Exit::BadInput, e.to_string()))?;
-            std::fs::create_dir_all(&dir)
-                .and_then(|()| std::fs::write(&path, text))
-                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot write {}: {e}", path.display())))?;
-            println!(
+            atomic::create_new(&path, text.as_bytes())?;
+            outln!(
                 "wrote {}; edit it, then run `motorgen check {}`",
                 path.display(),
                 path.display()
@@ -330,8 +337,8 @@ fn run(command: Command) -> Result<(), Failure> {
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_default();
                 match design(&path) {
-                    Ok(d) => println!("{stem:<24} {}", d.name),
-                    Err(_) => println!("{stem:<24} INVALID (`motorgen check {}` says why)", path.display()),
+                    Ok(d) => outln!("{stem:<24} {}", d.name),
+                    Err(_) => outln!("{stem:<24} INVALID (`motorgen check {}` says why)", path.display()),
                 }
             }
             Ok(())

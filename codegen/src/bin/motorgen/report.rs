@@ -4,10 +4,12 @@
 use std::path::Path;
 
 use crate::exit::{Exit, Failure};
+use crate::output::outln;
 
 /// Writes the report; no file on a bad spec or a write error. A failing verification
 /// is reported in the page and on stderr, with the verification-failed exit code.
 pub fn run(spec: &Path, out: &Path) -> Result<(), Failure> {
+    crate::atomic::check_out_dir(out).map_err(|e| Failure::new(Exit::BadInput, e))?;
     let text = crate::read_spec(spec)?;
     let (design, verification) = codegen::verify::verify_source(&spec.display().to_string(), &text)?;
     let page = codegen::report::report(&design, &verification)
@@ -16,16 +18,10 @@ pub fn run(spec: &Path, out: &Path) -> Result<(), Failure> {
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "motor".into());
-    let io = |what: String| Failure::new(Exit::Io, what);
-    std::fs::create_dir_all(out).map_err(|e| io(format!("error: cannot create {}: {e}", out.display())))?;
     let path = out.join(format!("{stem}.html"));
     // Written whole into a temporary file, then renamed: never a partial page.
-    let tmp = out.join(format!(".{stem}.html.tmp"));
-    if let Err(e) = std::fs::write(&tmp, page).and_then(|()| std::fs::rename(&tmp, &path)) {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(io(format!("error: cannot write {}: {e}", path.display())));
-    }
-    println!("wrote {}", path.display());
+    crate::atomic::write_set(out, &[(path.clone(), page.into_bytes())])?;
+    outln!("wrote {}", path.display());
     if verification.passed() {
         Ok(())
     } else {

@@ -4,13 +4,14 @@
 use std::path::Path;
 
 use crate::exit::{Exit, Failure};
+use crate::output::out;
 
 /// Reads, designs and verifies `spec`; prints the table. A bad spec is bad input (with
 /// the located message), a failing scenario a failed verification.
 pub fn run(spec: &Path) -> Result<(), Failure> {
     let text = crate::read_spec(spec)?;
     let (_, v) = codegen::verify::verify_source(&spec.display().to_string(), &text)?;
-    print!("{}", v.table());
+    out!("{}", v.table());
     if v.passed() {
         Ok(())
     } else {
