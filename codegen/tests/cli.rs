@@ -119,14 +119,20 @@ fn help_documents_exit_codes_and_value_names() {
     );
 }
 
+/// The Chalmers HEV50 spec with `compensate_delay = false`, written as `name`: its
+/// sampled current loop is slower than designed (a warning, and a failing rise time).
+fn chalmers_without_delay_compensation(name: &str) -> PathBuf {
+    let text = std::fs::read_to_string(repo().join("motors/chalmers-hev50.toml"))
+        .unwrap()
+        .replace("compensate_delay = true", "compensate_delay = false");
+    write(name, text.as_bytes())
+}
+
 /// `check`: the verdict on stdout, warnings on stderr (Chalmers without delay
 /// compensation warns that its sampled loop is slow).
 #[test]
 fn check_prints_warnings_on_stderr() {
-    let text = std::fs::read_to_string(repo().join("motors/chalmers-hev50.toml"))
-        .unwrap()
-        .replace("compensate_delay = true", "compensate_delay = false");
-    let path = write("chalmers-plain.toml", text.as_bytes());
+    let path = chalmers_without_delay_compensation("chalmers-plain.toml");
     let out = motorgen(&["check", path.to_str().unwrap()]);
     let (stdout, stderr) = (
         String::from_utf8_lossy(&out.stdout),
@@ -144,10 +150,7 @@ fn check_prints_warnings_on_stderr() {
 /// designed rise time, see tests/verify.rs), the table still on stdout.
 #[test]
 fn failed_verification_exits_3() {
-    let text = std::fs::read_to_string(repo().join("motors/chalmers-hev50.toml"))
-        .unwrap()
-        .replace("compensate_delay = true", "compensate_delay = false");
-    let path = write("chalmers-unverified.toml", text.as_bytes());
+    let path = chalmers_without_delay_compensation("chalmers-unverified.toml");
     let out = motorgen(&["verify", path.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(3), "{stderr}");

@@ -348,22 +348,12 @@ mod tests {
     #[test]
     fn every_motor_uses_its_constants() {
         assert_eq!(CONTROLLER.pwm_period, PWM_PERIOD);
-        assert_eq!(
-            CONTROLLER.current_loop.d.active_damping,
-            motor::current_loop::D_ACTIVE_DAMPING
-        );
-        assert_eq!(
-            CONTROLLER.current_loop.q.active_damping,
-            motor::current_loop::Q_ACTIVE_DAMPING
-        );
         assert_eq!(CONTROLLER.observer.kp, motor::observer::KP);
-        assert_eq!(
-            CONTROLLER.current_loop.d.reference_filter,
-            motor::current_loop::D_PREFILTER
-        );
-        assert_eq!(
-            CONTROLLER.current_loop.q.reference_filter,
-            motor::current_loop::Q_PREFILTER
-        );
+        for (pi, damping, prefilter) in [
+            (CONTROLLER.current_loop.d, cl::D_ACTIVE_DAMPING, cl::D_PREFILTER),
+            (CONTROLLER.current_loop.q, cl::Q_ACTIVE_DAMPING, cl::Q_PREFILTER),
+        ] {
+            assert_eq!((pi.active_damping, pi.reference_filter), (damping, prefilter));
+        }
     }
 }
