@@ -85,7 +85,7 @@ pub fn group(d: &Design) -> Group {
             phys(fw.speed_loop_bandwidth_rad_s.unwrap_or(0.0), "rad/s")
         ),
     };
-    let base_in = match &d.per_unit {
+    let base_in = match d.per_unit.bases.angular_frequency_rad_s {
         Some(_) => "ω_base = 2π·f_n (per-unit base, thesis B App. A)".to_string(),
         None => "no f_n: ω_base = the speed where the full-current MTPA point reaches V'_max (2.53)".to_string(),
     };

@@ -67,6 +67,8 @@ pub struct Motor {
     pub connection: Option<Connection>,
     /// When and from what the identified values were obtained (`date`, `source`).
     pub identification: Option<String>,
+    /// Byte span of the `[motor]` table: where a missing motor key is reported.
+    pub span: Range<usize>,
 }
 
 /// "identified on <date> from <source>", from `[motor.identified]`'s `date` and `source`.
@@ -163,6 +165,7 @@ impl Resolver_<'_> {
         let harmonics = m.harmonics.as_ref().map(|h| self.harmonics(h.get_ref()));
         let q_saturation = self.saturation(m);
         Some(Motor {
+            span: motor_span,
             connection: m.connection.as_ref().map(|c| *c.get_ref()),
             identification: identification(m),
             pole_pairs: pole_pairs?,

@@ -78,5 +78,20 @@ pub(in crate::design) fn field_weakening(cx: &mut Context<'_>) -> Option<FieldWe
         ));
         return None;
     }
-    Some(field_weakening::design(&inp))
+    let out = field_weakening::design(&inp);
+    if out.is_none() {
+        let p = &spec.drive.dc_link_voltage;
+        cx.errors.push(cx.src.error(
+            p.span.clone(),
+            &p.key,
+            format!(
+                "R_s·I_max = {:.2} V reaches V'_max = {:.2} V: the peak current cannot be driven at any speed, so \
+                 there is no corner speed for ω_base (2.60) (no motor.datasheet.rated_frequency given)",
+                inp.model.rs * inp.model.i_max,
+                inp.voltage_fraction * inp.voltage_max
+            ),
+            "a DC link with U_dc/√3·field_weakening.voltage_fraction above R_s·√2·I_peak, a lower peak_current, or the motor's rated_frequency",
+        ));
+    }
+    out
 }
