@@ -427,7 +427,7 @@ pub fn constants(d: &Design) -> Vec<Group> {
             o.resolver_pole_pairs.to_string(),
             "n_r",
             "thesis A (4.5)",
-            "n_r (datasheet)".into(),
+            "n_r (spec [resolver])".into(),
         )
         .at("/angle_observer/resolver_pole_pairs"),
         c(
@@ -436,7 +436,10 @@ pub fn constants(d: &Design) -> Vec<Group> {
             phys(o.lead_samples, "samples"),
             "k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16",
             "thesis A (4.19), (4.23)",
-            format!("k = {} samples (spec)", o.lead_samples),
+            match o.lead_samples_source {
+                Provenance::Default => format!("k = {} samples (default: 1.5·T_s delay, thesis A §4.6)", o.lead_samples),
+                _ => format!("k = {} samples (spec angle_observer.lead_samples)", o.lead_samples),
+            },
         )
         .at("/angle_observer/lead_q16"),
     ];

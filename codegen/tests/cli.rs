@@ -94,7 +94,9 @@ fn summary_shows_field_weakening_and_sensorless() {
     for needle in [
         "field weakening: V'_max = 0.9 V_max",
         "ρ = 147.0 rad/s",
-        "γ1 = ρ² = 21609.0, γ2 = 2ρ = 294.0 (4.7)",
+        "γ1 = ρ² = 21609.0 1/s², γ2 = 2ρ = 294.0 1/s (4.7)",
+        "K_p = 2ζω_n = 140 1/s, K_i = ω_n² = 4900 1/s² (4.15)",
+        "ω_min2 = 65.9 (4.69, i_d = -99.56 A at I_base)",
         "17-point MTPA table",
     ] {
         assert!(s.contains(needle), "{needle:?} not in\n{s}");

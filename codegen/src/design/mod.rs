@@ -7,6 +7,7 @@
 pub mod adc;
 pub mod angle_observer;
 pub mod current_loop;
+pub mod dead_time;
 pub mod discrete_loop;
 
 pub mod field_weakening;
