@@ -30,11 +30,17 @@ pub fn summary(d: &Design) -> String {
             )?,
             None => writeln!(s, "  ψ_M unknown")?,
         }
-        if let Some(x) = &m.flux_cross_check {
+        for x in &m.cross_checks {
             writeln!(
                 s,
-                "  ψ_M cross-check: K_t → {:.5} Wb, K_e → {:.5} Wb, disagreement {:.2} %",
-                x.from_torque_constant_wb, x.from_back_emf_constant_wb, x.disagreement_percent
+                "  cross-check {}: {:.5} vs {:.5}, {:.2} % apart{} ({} vs {})",
+                x.quantity,
+                x.a,
+                x.b,
+                x.disagreement_percent,
+                if x.fails() { " — above 5 %" } else { "" },
+                x.a_from,
+                x.b_from
             )?;
         }
         writeln!(

@@ -6,6 +6,7 @@
 
 pub mod adc;
 pub mod angle_observer;
+pub mod cross_check;
 pub mod current_loop;
 pub mod dead_time;
 pub mod discrete_loop;
