@@ -217,7 +217,14 @@ impl Constant {
 /// All constants of `d`, grouped: current loop, observer, scalings, filter, limits.
 pub fn constants(d: &Design) -> Vec<Group> {
     let m = &d.motor;
-    let pv = |k: &str| prov(m.provenance.get(k));
+    // The provenance label, with the conversion from the datasheet's form where there was one.
+    let pv = |k: &str| {
+        let o = m.provenance.get(k);
+        match o.and_then(|o| o.note.as_deref()).filter(|n| n.starts_with("converted")) {
+            Some(n) => format!("{}, {n}", prov(o)),
+            None => prov(o).to_string(),
+        }
+    };
     let r_in = format!(
         "R_s = {} ({})",
         phys(m.phase_resistance_ohm, "Ω"),

@@ -123,6 +123,20 @@ fn provenance(cx: &Context<'_>) -> BTreeMap<&'static str, Origin> {
     if let Some(p) = &cx.spec.resolver.offset {
         provenance.insert("resolver_offset", Origin::from(p));
     }
+    for (name, p) in [
+        ("nominal_current", &m.nominal_current),
+        ("nominal_torque", &m.nominal_torque),
+        ("peak_torque", &m.peak_torque),
+        ("rated_frequency", &m.rated_frequency),
+        ("nominal_speed", &m.nominal_speed),
+        ("rated_power", &m.rated_power),
+        ("inertia", &m.inertia),
+        ("viscous_friction", &m.viscous_friction),
+    ] {
+        if let Some(p) = p {
+            provenance.insert(name, Origin::from(p));
+        }
+    }
     if let Some(note) = &m.identification {
         for o in provenance.values_mut().filter(|o| o.source == Provenance::Identified) {
             o.note = Some(note.clone());
