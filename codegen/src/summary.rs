@@ -204,7 +204,7 @@ pub fn summary(d: &Design) -> String {
                 )?;
             }
             if let Some(why) = &se.no_injection {
-                writeln!(s, "  no injection: {why}")?;
+                writeln!(s, "  no signal injection — {why}")?;
             }
             writeln!(
                 s,
