@@ -82,13 +82,20 @@ fn no_rated_current_no_silent_fallback() {
 /// estimator's (4.66) and (4.92) limits exist; the thesis's 500 Hz carrier would need
 /// V_e = I_base·ω_e·L_d·L_q/(10·|ΔL|) = 226.27·3141.6·0.70e-3·0.56e-3/1.4e-3 = 199.0 V
 /// > V_max = 184.75 V — an error at the key that set the carrier; at 100 Hz K_e (4.19)
-/// is −I_base/40 = −5.657 A.
+/// is −I_base/40 = −5.657 A. `motorgen verify` passes this variant at 6500 rpm (all 7
+/// scenarios, field weakening and estimator recovery included).
 #[test]
 fn inverse_saliency_variant() {
     let text = chalmers().replace("d_inductance = \"0.23 mH\"", "d_inductance = \"0.70 mH\"");
     let err = codegen::design_source("inv.toml", &text).unwrap_err().to_string();
     assert!(err.contains("`sensorless.injection_frequency`") && err.contains("199.0 V"), "{err}");
     let text = text.replace("injection_frequency = \"500 Hz\"", "injection_frequency = \"100 Hz\"");
+    // ψ_m = 0.104 Wb < L_d·I_max = 0.2217 Wb: above 6741 rpm no current-circle point meets
+    // V'_max (hand value in design::field_weakening::tests::circle_speed_limit_by_hand), so
+    // the seed's 12000 rpm is refused at max_speed; 6500 rpm designs.
+    let err = codegen::design_source("inv.toml", &text).unwrap_err().to_string();
+    assert!(err.contains("`motor.datasheet.max_speed`") && err.contains("above 6741 rpm"), "{err}");
+    let text = text.replace("max_speed = \"12000 rpm\"", "max_speed = \"6500 rpm\"");
     let d = design("inv.toml", &text);
     let fw = d.field_weakening.as_ref().unwrap();
     assert!((fw.id_mtpa_at_current_max_a - 105.26).abs() < 0.01);

@@ -177,6 +177,25 @@ pub fn full_current_corner_speed(inp: &Inputs) -> Option<f64> {
     corner_speed(m, id, iq, inp.voltage_fraction * inp.voltage_max)
 }
 
+/// The highest electrical speed [rad/s] at which some point of the current circle
+/// |i| = I_max (i_d ≤ 0) still meets V'_max, R_s included: the largest
+/// [`corner_speed`] over the circle, scanned in 1000 steps of i_d from −I_max to 0 (the
+/// flux |ψ_s| on the circle has at most one minimum there). The field weakening of
+/// (2.55)–(2.57) holds the current on that circle (Mode B) down to i_d = −I_max; above this
+/// speed no reference it can give keeps |v| ≤ V'_max and the current loop saturates. When
+/// ψ_m < L_d·I_max the voltage-feasible currents at such speeds lie inside the circle
+/// (maximum torque per volt), which (2.57) does not reach. `None` if no point is feasible.
+pub fn circle_speed_limit(inp: &Inputs) -> Option<f64> {
+    let m = &inp.model;
+    let v = inp.voltage_fraction * inp.voltage_max;
+    (0..=1000)
+        .filter_map(|k| {
+            let id = -m.i_max * f64::from(1000 - k) / 1000.0;
+            corner_speed(m, id, mode_b_iq(m.i_max, id), v)
+        })
+        .fold(None, |best: Option<f64>, w| Some(best.map_or(w, |b| b.max(w))))
+}
+
 /// ω_base of (2.60): the per-unit base 2π·f_n (thesis B App. A) when known, else the
 /// corner speed of the full-current MTPA point at V'_max, R_s included
 /// ([`full_current_corner_speed`]); `None` when neither exists.
@@ -433,6 +452,22 @@ mod tests {
             }
         }
         assert!(lt.id_a[n - 1] > 100.0, "{}", lt.id_a[n - 1]);
+    }
+
+    /// The speed above which no current-circle point meets V'_max, by hand at i_d = −I_max,
+    /// i_q = 0 (the smallest flux on the circle for both motors below): the thesis B motor,
+    /// |ψ_s| = ψ − L_d·I_max = 0.104 − 0.23e-3·316.784 = 0.031140 Wb, ω = √((V'² −
+    /// R²I²)/|ψ_s|²) = √(27641.74)/0.031140 = 5339.0 rad/s (above its 2513 rad/s top speed);
+    /// the inverse-saliency variant (L_d = 0.70 mH), |ψ_s| = |0.104 − 0.221749| = 0.117749 Wb,
+    /// ω = 166.258/0.117749 = 1411.97 rad/s = 6741 rpm, below its 12000 rpm.
+    #[test]
+    fn circle_speed_limit_by_hand() {
+        let mut inp = chalmers();
+        let w = circle_speed_limit(&inp).unwrap();
+        assert!((w - 5339.0).abs() < 0.5, "{w}");
+        inp.model.ld = 0.70e-3;
+        let w = circle_speed_limit(&inp).unwrap();
+        assert!((w - 1411.97).abs() < 0.05, "{w}");
     }
 
     /// MTPA table properties: monotone non-increasing, i_d ≤ 0, |i| ≤ I_max at every grid
