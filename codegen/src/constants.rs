@@ -444,7 +444,9 @@ pub fn constants(d: &Design) -> Vec<Group> {
             "k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16",
             "thesis A (4.19), (4.23)",
             match o.lead_samples_source {
-                Provenance::Default => format!("k = {} samples (default: 1.5·T_s delay, thesis A §4.6)", o.lead_samples),
+                Provenance::Default => {
+                    format!("k = {} samples (default: 1.5·T_s delay, thesis A §4.6)", o.lead_samples)
+                }
                 _ => format!("k = {} samples (spec angle_observer.lead_samples)", o.lead_samples),
             },
         )

@@ -15,8 +15,16 @@ fn chalmers() -> String {
 
 /// `text` with the first line starting with `key` removed (which must exist).
 fn without(text: &str, key: &str) -> String {
-    let at = text.lines().position(|l| l.starts_with(key)).unwrap_or_else(|| panic!("{key} not in spec"));
-    let out: Vec<&str> = text.lines().enumerate().filter(|&(i, _)| i != at).map(|(_, l)| l).collect();
+    let at = text
+        .lines()
+        .position(|l| l.starts_with(key))
+        .unwrap_or_else(|| panic!("{key} not in spec"));
+    let out: Vec<&str> = text
+        .lines()
+        .enumerate()
+        .filter(|&(i, _)| i != at)
+        .map(|(_, l)| l)
+        .collect();
     out.join("\n")
 }
 
@@ -61,7 +69,10 @@ fn estimator_constants_do_not_depend_on_rated_frequency() {
 fn no_rated_current_no_silent_fallback() {
     let text = without(&chalmers(), "nominal_current");
     let err = codegen::design_source("x.toml", &text).unwrap_err().to_string();
-    assert!(err.contains("`motor.datasheet.nominal_current`") && err.contains("I_base = √2·I_n"), "{err}");
+    assert!(
+        err.contains("`motor.datasheet.nominal_current`") && err.contains("I_base = √2·I_n"),
+        "{err}"
+    );
     let at = text.find("[sensorless]").unwrap();
     let d = design("y.toml", &text[..at]);
     assert!(d.sensorless.is_none());
@@ -86,22 +97,37 @@ fn no_rated_current_no_silent_fallback() {
 /// scenarios, field weakening and estimator recovery included).
 #[test]
 fn inverse_saliency_variant() {
-    let text = chalmers().replace("d_inductance = \"0.23 mH\"", "d_inductance = \"0.70 mH\"");
-    let err = codegen::design_source("inv.toml", &text).unwrap_err().to_string();
-    assert!(err.contains("`sensorless.injection_frequency`") && err.contains("199.0 V"), "{err}");
-    let text = text.replace("injection_frequency = \"500 Hz\"", "injection_frequency = \"100 Hz\"");
-    // ψ_m = 0.104 Wb < L_d·I_max = 0.2217 Wb: above 6741 rpm no current-circle point meets
-    // V'_max (hand value in design::field_weakening::tests::circle_speed_limit_by_hand), so
-    // the seed's 12000 rpm is refused at max_speed; 6500 rpm designs.
-    let err = codegen::design_source("inv.toml", &text).unwrap_err().to_string();
-    assert!(err.contains("`motor.datasheet.max_speed`") && err.contains("above 6741 rpm"), "{err}");
-    let text = text.replace("max_speed = \"12000 rpm\"", "max_speed = \"6500 rpm\"");
+    let inv = chalmers().replace("d_inductance = \"0.23 mH\"", "d_inductance = \"0.70 mH\"");
+    let slow = inv.replace("max_speed = \"12000 rpm\"", "max_speed = \"6500 rpm\"");
+    let err = codegen::design_source("inv.toml", &slow).unwrap_err().to_string();
+    assert!(
+        err.contains("`sensorless.injection_frequency`") && err.contains("199.0 V"),
+        "{err}"
+    );
+    // ψ_m = 0.104 Wb < L_d·I_max = 0.2217 Wb: above 1411.97 rad/s = 6741.6 rpm no
+    // current-circle point meets V'_max (hand value in
+    // design::field_weakening::tests::circle_speed_limit_by_hand), so the seed's 12000 rpm is
+    // refused at max_speed; 6500 rpm designs.
+    let carrier = |t: &str| t.replace("injection_frequency = \"500 Hz\"", "injection_frequency = \"100 Hz\"");
+    let err = codegen::design_source("inv.toml", &carrier(&inv))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("`motor.datasheet.max_speed`")
+            && err.contains("above 6742 rpm")
+            && err.contains("at most 6741 rpm"),
+        "{err}"
+    );
+    let text = carrier(&slow);
     let d = design("inv.toml", &text);
     let fw = d.field_weakening.as_ref().unwrap();
     assert!((fw.id_mtpa_at_current_max_a - 105.26).abs() < 0.01);
     assert!(fw.mtpa.id_a.iter().all(|&i| i >= 0.0));
     let lt = &fw.loss_minimisation.as_ref().unwrap().table;
-    assert_eq!(lt.id_a[..lt.iq_a.len()].iter().filter(|&&i| i > 0.0).count(), lt.iq_a.len() - 1);
+    assert_eq!(
+        lt.id_a[..lt.iq_a.len()].iter().filter(|&&i| i > 0.0).count(),
+        lt.iq_a.len() - 1
+    );
     let s = d.sensorless.as_ref().unwrap();
     assert!((s.injection.as_ref().unwrap().gain_ke_a + 226.274_17 / 40.0).abs() < 1e-3);
     assert!((s.iq_limit_bifurcation_a.unwrap() - 742.857).abs() < 1e-3);
@@ -125,16 +151,32 @@ fn maxon_as_printed_equals_hand_converted() {
         assert_eq!(ga.constants.len(), gb.constants.len(), "{}", ga.name);
         for (x, y) in ga.constants.iter().zip(&gb.constants) {
             assert_eq!(x.name, y.name);
-            assert!(same_numbers(&x.value.number, &y.value.number), "{}::{}: {} vs {}", ga.name, x.name, x.value.number, y.value.number);
+            assert!(
+                same_numbers(&x.value.number, &y.value.number),
+                "{}::{}: {} vs {}",
+                ga.name,
+                x.name,
+                x.value.number,
+                y.value.number
+            );
         }
     }
     let p = &printed.motor.provenance;
-    assert!(p["phase_resistance"].note.as_deref().unwrap().contains("line-to-line \"0.573 Ω\""));
+    assert!(
+        p["phase_resistance"]
+            .note
+            .as_deref()
+            .unwrap()
+            .contains("line-to-line \"0.573 Ω\"")
+    );
     assert!(p["inertia"].note.as_deref().unwrap().contains("181 g·cm²"));
     assert!(p["flux_linkage"].note.as_deref().unwrap().contains("236 rpm/V"));
     // k_M and k_n of block commutation agree (0.16 %), within the 5 % tolerance.
     let c = &printed.motor.cross_checks[0];
-    assert!(c.quantity.starts_with("ψ_M") && (c.disagreement_percent - 0.156).abs() < 0.01, "{c}");
+    assert!(
+        c.quantity.starts_with("ψ_M") && (c.disagreement_percent - 0.156).abs() < 0.01,
+        "{c}"
+    );
     assert!((printed.drive.dead_time_voltage_error_v.unwrap() - 0.24).abs() < 1e-12);
 }
 
@@ -159,10 +201,16 @@ fn same_numbers(a: &serde_json::Value, b: &serde_json::Value) -> bool {
 fn disagreeing_constants_are_warned_with_both_values() {
     let text = read("../motors/fischer-ti085.toml")
         .replace("\"0.492 N·m/A\"", "\"0.689 N·m/A\"")
-        .replace("inductance = \"0.393 mH\"", "inductance = \"0.393 mH\"\nflux_linkage = \"60.42 mWb\"");
+        .replace(
+            "inductance = \"0.393 mH\"",
+            "inductance = \"0.393 mH\"\nflux_linkage = \"60.42 mWb\"",
+        );
     let d = design("f.toml", &text);
     let w: Vec<&String> = d.warnings.iter().filter(|w| w.contains("ψ_M [Wb]")).collect();
-    assert!(w.iter().any(|w| w.contains("0.06042") && w.contains("0.08120")), "{w:?}");
+    assert!(
+        w.iter().any(|w| w.contains("0.06042") && w.contains("0.08120")),
+        "{w:?}"
+    );
 }
 
 /// Terminal values in a delta winding and a winding value: R_LL = 2R_Δ/3 is 2 star
@@ -185,8 +233,14 @@ fn star_delta_and_winding_forms() {
         assert!((r - 0.126).abs() < 1e-12, "{form} {conn}: {r}");
     }
     let text = fischer
-        .replace("phase_resistance = \"0.126 Ω\"", "phase_resistance = { value = \"0.378 Ω\", measured = \"winding\" }")
+        .replace(
+            "phase_resistance = \"0.126 Ω\"",
+            "phase_resistance = { value = \"0.378 Ω\", measured = \"winding\" }",
+        )
         .replace("connection = \"star\"     # Table 1.2\n", "");
     let err = codegen::design_source("w.toml", &text).unwrap_err().to_string();
-    assert!(err.contains("`motor.datasheet.phase_resistance.measured`") && err.contains("connection"), "{err}");
+    assert!(
+        err.contains("`motor.datasheet.phase_resistance.measured`") && err.contains("connection"),
+        "{err}"
+    );
 }

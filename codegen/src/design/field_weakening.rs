@@ -433,7 +433,10 @@ mod tests {
         inp.model.rc = Some(24.5);
         let out = design(&inp).unwrap();
         let (id_top, iq_top) = loss_minimisation::mtpa_corner(0.104, -0.14e-3, inp.model.i_max);
-        assert!((id_top - 105.260).abs() < 1e-3 && id_top == out.id_mtpa_at_current_max_a, "{id_top}");
+        assert!(
+            (id_top - 105.260).abs() < 1e-3 && id_top == out.id_mtpa_at_current_max_a,
+            "{id_top}"
+        );
         assert_eq!(out.iq_mode_b_at_mtpa_a, iq_top);
         assert_eq!(out.id_min_a, -inp.model.i_max);
         let t = &out.mtpa;
@@ -445,7 +448,12 @@ mod tests {
         let lt = &out.loss_minimisation.as_ref().unwrap().table;
         let n = lt.iq_a.len();
         for j in 0..n {
-            assert!((lt.id_a[j] - t.id_a[j]).abs() <= 1e-4, "{j}: {} vs {}", lt.id_a[j], t.id_a[j]);
+            assert!(
+                (lt.id_a[j] - t.id_a[j]).abs() <= 1e-4,
+                "{j}: {} vs {}",
+                lt.id_a[j],
+                t.id_a[j]
+            );
             for k in 1..LOSS_SPEED_POINTS {
                 let id = lt.id_a[k * n + j];
                 assert!(id <= lt.id_a[(k - 1) * n + j] + 1e-6 && id.hypot(lt.iq_a[j]) <= out.current_max_a + 1e-6);

@@ -40,7 +40,13 @@ pub fn from_torque_constant(kt: f64, current: Amplitude, pole_pairs: u32) -> f64
 /// ψ_M [Wb] from K_e [V per rad/s of `speed`] quoted in the given conventions (6.11):
 /// rms or peak, line to line or phase; or the induced DC voltage of block commutation
 /// (line to line by construction).
-pub fn from_back_emf_constant(ke: f64, voltage: Amplitude, line_to_line: bool, speed: SpeedAxis, pole_pairs: u32) -> f64 {
+pub fn from_back_emf_constant(
+    ke: f64,
+    voltage: Amplitude,
+    line_to_line: bool,
+    speed: SpeedAxis,
+    pole_pairs: u32,
+) -> f64 {
     let electrical = match voltage {
         Amplitude::BlockCommutation => ke / BLOCK_COMMUTATION_FACTOR,
         Amplitude::Rms | Amplitude::Peak => {

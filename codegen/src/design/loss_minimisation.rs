@@ -418,7 +418,10 @@ mod tests {
                 m.torque(x, (316.8f64 * 316.8 - x * x).max(0.0).sqrt())
             })
             .fold(f64::MIN, f64::max);
-        assert!(best <= m.torque(id, iq) + 1e-9 && best > m.torque(id, iq) - 1e-3, "{best}");
+        assert!(
+            best <= m.torque(id, iq) + 1e-9 && best > m.torque(id, iq) - 1e-3,
+            "{best}"
+        );
     }
 
     /// The loss-minimising search for inverse saliency: at ω = 0 (and without R_c) it
@@ -451,7 +454,10 @@ mod tests {
             for k in 0..=4000 {
                 let x = -m.i_max + 2.0 * m.i_max * f64::from(k) / 4000.0;
                 let y = t / (1.5 * 2.0 * (m.psi - (m.lq - m.ld) * x));
-                assert!(m.loss(w, x, y) >= best - 1e-9 * best, "ω = {w}: i_d0 = {x} beats the optimum");
+                assert!(
+                    m.loss(w, x, y) >= best - 1e-9 * best,
+                    "ω = {w}: i_d0 = {x} beats the optimum"
+                );
             }
         }
     }

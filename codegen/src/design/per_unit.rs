@@ -61,9 +61,7 @@ pub fn missing(b: &Bases) -> Vec<String> {
         out.push("I_base = √2·I_n, Z_base: need motor.datasheet.nominal_current".to_string());
     }
     if b.angular_frequency_rad_s.is_none() {
-        out.push(
-            "ω_base = 2π·f_n, ψ_base: need motor.datasheet.rated_frequency or nominal_speed".to_string(),
-        );
+        out.push("ω_base = 2π·f_n, ψ_base: need motor.datasheet.rated_frequency or nominal_speed".to_string());
     }
     if b.inductance_h.is_none() {
         out.push("L_base, J_base: need both".to_string());
@@ -119,7 +117,10 @@ mod tests {
         assert_eq!(pu(7.9e-3, no_f.impedance_ohm, 3), 0.010);
         assert!(no_f.angular_frequency_rad_s.is_none() && no_f.inductance_h.is_none() && no_f.flux_wb.is_none());
         let no_i = bases(320.0, None, Some(200.0), None, None);
-        assert_eq!((no_i.angular_frequency_rad_s, no_i.flux_wb), (all.angular_frequency_rad_s, all.flux_wb));
+        assert_eq!(
+            (no_i.angular_frequency_rad_s, no_i.flux_wb),
+            (all.angular_frequency_rad_s, all.flux_wb)
+        );
         assert_eq!(pu(104e-3, no_i.flux_wb, 2), 0.71);
         assert!(no_i.current_a.is_none() && no_i.inductance_h.is_none() && no_i.inertia.is_none());
         assert!(missing(&all).is_empty());

@@ -629,8 +629,16 @@ mod tests {
         assert!((inj.voltage_v - 39.808).abs() < 1e-3, "{}", inj.voltage_v);
         assert!((inj.gain_ke_a + i_base() / 40.0).abs() < 1e-9, "{}", inj.gain_ke_a);
         assert!((out.iq_limit_bifurcation_a.unwrap() - 742.857).abs() < 1e-3);
-        assert!((out.omega_min1_rad_s - 104.478).abs() < 1e-3, "{}", out.omega_min1_rad_s);
-        assert!((out.id_at_base_current_a - 59.418).abs() < 1e-3, "{}", out.id_at_base_current_a);
+        assert!(
+            (out.omega_min1_rad_s - 104.478).abs() < 1e-3,
+            "{}",
+            out.omega_min1_rad_s
+        );
+        assert!(
+            (out.id_at_base_current_a - 59.418).abs() < 1e-3,
+            "{}",
+            out.id_at_base_current_a
+        );
         assert!((out.omega_min2_rad_s - 47.890).abs() < 1e-3, "{}", out.omega_min2_rad_s);
         assert!((out.iq_limit_resetting_a.unwrap() - 43.449).abs() < 1e-3);
         // ψ/|ΔL| = 742.9 A lies outside I_max = 316.8 A: (4.51) is not singular in the circle.

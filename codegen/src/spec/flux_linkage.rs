@@ -31,7 +31,11 @@ struct Found<'a, T> {
     raw: &'a T,
 }
 
-fn find<'a, T>(m: &'a RawMotor, name: &str, pick: fn(&'a RawParams) -> Option<&'a serde_spanned::Spanned<T>>) -> Option<Found<'a, T>> {
+fn find<'a, T>(
+    m: &'a RawMotor,
+    name: &str,
+    pick: fn(&'a RawParams) -> Option<&'a serde_spanned::Spanned<T>>,
+) -> Option<Found<'a, T>> {
     [
         (&m.identified, Provenance::Identified, "identified"),
         (&m.datasheet, Provenance::Datasheet, "datasheet"),
@@ -78,7 +82,12 @@ impl Resolver_<'_> {
             });
         }
         let mut derived: Vec<(Param, usize)> = Vec::new();
-        let mut add = |sources: &mut Vec<FluxSource>, (key, span): (&str, &Range<usize>), written: String, psi: f64, eq: &str, rank: usize| {
+        let mut add = |sources: &mut Vec<FluxSource>,
+                       (key, span): (&str, &Range<usize>),
+                       written: String,
+                       psi: f64,
+                       eq: &str,
+                       rank: usize| {
             sources.push(FluxSource {
                 key: key.to_string(),
                 written: written.clone(),
@@ -98,7 +107,13 @@ impl Resolver_<'_> {
         if let Some(f) = find(m, "back_emf_constant", |p| p.back_emf_constant.as_ref()) {
             let k = f.raw;
             if let (Some(v), Some(ll)) = (
-                self.quantity(&format!("{}.value", f.key), &k.value, Kind::BackEmfConstant, f.prov, true),
+                self.quantity(
+                    &format!("{}.value", f.key),
+                    &k.value,
+                    Kind::BackEmfConstant,
+                    f.prov,
+                    true,
+                ),
                 self.line_to_line(&f.key, *k.voltage.get_ref(), k.measured.as_ref(), connection, &f.span),
             ) {
                 let psi = crate::design::flux_linkage::from_back_emf_constant(
@@ -112,10 +127,23 @@ impl Resolver_<'_> {
                     "K_e = {} {}{} per {} rad/s",
                     text(&k.value),
                     amplitude_name(*k.voltage.get_ref()),
-                    if *k.voltage.get_ref() == Amplitude::BlockCommutation { "" } else if ll { " line-to-line" } else { " phase" },
+                    if *k.voltage.get_ref() == Amplitude::BlockCommutation {
+                        ""
+                    } else if ll {
+                        " line-to-line"
+                    } else {
+                        " phase"
+                    },
                     speed_name(*k.speed.get_ref())
                 );
-                add(&mut sources, (&f.key, &f.span), written, psi, "ψ_M = K_e in phase-peak volts per electrical rad/s (6.11)", 1);
+                add(
+                    &mut sources,
+                    (&f.key, &f.span),
+                    written,
+                    psi,
+                    "ψ_M = K_e in phase-peak volts per electrical rad/s (6.11)",
+                    1,
+                );
             }
         }
         if let Some(f) = find(m, "speed_constant", |p| p.speed_constant.as_ref()) {
@@ -125,21 +153,50 @@ impl Resolver_<'_> {
                 self.quantity(&format!("{}.value", f.key), &k.value, Kind::SpeedConstant, f.prov, true),
                 self.line_to_line(&f.key, *k.voltage.get_ref(), k.measured.as_ref(), connection, &f.span),
             ) {
-                let psi = crate::design::flux_linkage::from_back_emf_constant(1.0 / v.value, *k.voltage.get_ref(), ll, speed, np);
+                let psi = crate::design::flux_linkage::from_back_emf_constant(
+                    1.0 / v.value,
+                    *k.voltage.get_ref(),
+                    ll,
+                    speed,
+                    np,
+                );
                 let written = format!(
                     "k_n = {} per {}{} volt, K_e = 1/k_n",
                     text(&k.value),
                     amplitude_name(*k.voltage.get_ref()),
-                    if *k.voltage.get_ref() == Amplitude::BlockCommutation { "" } else if ll { " line-to-line" } else { " phase" },
+                    if *k.voltage.get_ref() == Amplitude::BlockCommutation {
+                        ""
+                    } else if ll {
+                        " line-to-line"
+                    } else {
+                        " phase"
+                    },
                 );
-                add(&mut sources, (&f.key, &f.span), written, psi, "ψ_M = (1/k_n) in phase-peak volts per electrical rad/s (6.11)", 2);
+                add(
+                    &mut sources,
+                    (&f.key, &f.span),
+                    written,
+                    psi,
+                    "ψ_M = (1/k_n) in phase-peak volts per electrical rad/s (6.11)",
+                    2,
+                );
             }
         }
         if let Some(f) = find(m, "torque_constant", |p| p.torque_constant.as_ref()) {
             let k = f.raw;
-            if let Some(v) = self.quantity(&format!("{}.value", f.key), &k.value, Kind::TorqueConstant, f.prov, true) {
+            if let Some(v) = self.quantity(
+                &format!("{}.value", f.key),
+                &k.value,
+                Kind::TorqueConstant,
+                f.prov,
+                true,
+            ) {
                 let psi = crate::design::flux_linkage::from_torque_constant(v.value, *k.current.get_ref(), np);
-                let written = format!("K_t = {} per {} ampere", text(&k.value), amplitude_name(*k.current.get_ref()));
+                let written = format!(
+                    "K_t = {} per {} ampere",
+                    text(&k.value),
+                    amplitude_name(*k.current.get_ref())
+                );
                 let eq = if *k.current.get_ref() == Amplitude::BlockCommutation {
                     "ψ_M = k_M/((3√3/π)·n_p) (block commutation)"
                 } else {
@@ -163,7 +220,8 @@ impl Resolver_<'_> {
         connection: Option<Connection>,
         span: &Range<usize>,
     ) -> Option<bool> {
-        let accepted = "measured = \"line_to_line\", \"phase\" (line to neutral) or \"winding\" (with [motor] connection)";
+        let accepted =
+            "measured = \"line_to_line\", \"phase\" (line to neutral) or \"winding\" (with [motor] connection)";
         match (voltage, measured.map(|m| (*m.get_ref(), m.span()))) {
             (Amplitude::BlockCommutation, None | Some((Between::LineToLine, _))) => Some(true),
             (Amplitude::BlockCommutation, Some((_, s))) => {

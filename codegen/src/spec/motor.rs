@@ -108,7 +108,8 @@ impl Resolver_<'_> {
             return None;
         }
         self.inductance_forms(m);
-        let phase_resistance = self.phase_motor_key(m, "phase_resistance", |p| p.phase_resistance.as_ref(), Kind::Resistance);
+        let phase_resistance =
+            self.phase_motor_key(m, "phase_resistance", |p| p.phase_resistance.as_ref(), Kind::Resistance);
         if phase_resistance.is_none() && !has(m, |p| p.phase_resistance.is_some()) {
             self.missing_motor_key(
                 &motor_span,
@@ -245,7 +246,12 @@ impl Resolver_<'_> {
     }
 
     /// f_n: given, or n_p·ω_m,n/(2π) (2.19) from the nominal speed.
-    fn rated_frequency(&mut self, m: &RawMotor, pole_pairs: Option<u32>, nominal_speed: Option<&Param>) -> Option<Param> {
+    fn rated_frequency(
+        &mut self,
+        m: &RawMotor,
+        pole_pairs: Option<u32>,
+        nominal_speed: Option<&Param>,
+    ) -> Option<Param> {
         let rated_frequency = self.motor_key(
             m,
             "rated_frequency",

@@ -34,14 +34,22 @@ impl Resolver_<'_> {
         };
         let span = v.span();
         if let Some(k) = t.keys().find(|k| *k != "value" && *k != "measured") {
-            self.err(span, key, format!("unknown key `{k}` in the {} table", kind.name()), FORMS);
+            self.err(
+                span,
+                key,
+                format!("unknown key `{k}` in the {} table", kind.name()),
+                FORMS,
+            );
             return None;
         }
         let (Some(toml::Value::String(text)), Some(measured)) = (t.get("value"), t.get("measured")) else {
             self.err(
                 span,
                 key,
-                format!("{} given as a table needs `value` (a quoted quantity) and `measured`", kind.name()),
+                format!(
+                    "{} given as a table needs `value` (a quoted quantity) and `measured`",
+                    kind.name()
+                ),
                 FORMS,
             );
             return None;

@@ -78,34 +78,7 @@ pub(in crate::design) fn field_weakening(cx: &mut Context<'_>) -> Option<FieldWe
         ));
         return None;
     }
-    if let Some(limit) = field_weakening::circle_speed_limit(&inp)
-        && inp.max_speed > limit * (1.0 + 1e-9)
-    {
-        let p = &m.max_speed;
-        let np = f64::from(m.pole_pairs);
-        cx.errors.push(cx.src.error(
-            p.span.clone(),
-            &p.key,
-            format!(
-                "above {:.0} rpm (ω_e = {limit:.0} rad/s) no point of the current circle |i| = I_max = {:.1} A meets V'_max = {:.1} V (2.50), (2.53), R_s included: the field weakening of thesis B (2.55)–(2.57) keeps the current on that circle, so at the top speed {:.0} rpm the loop saturates{}",
-                limit / np * 30.0 / PI,
-                inp.model.i_max,
-                inp.voltage_fraction * inp.voltage_max,
-                inp.max_speed / np * 30.0 / PI,
-                if psi < inp.model.ld * inp.model.i_max {
-                    format!(
-                        " (ψ_m = {psi:.4} Wb < L_d·I_max = {:.4} Wb: the high-speed optimum lies inside the circle, maximum torque per volt, which (2.57) does not reach)",
-                        inp.model.ld * inp.model.i_max
-                    )
-                } else {
-                    String::new()
-                }
-            ),
-            format!(
-                "a maximum speed of at most {:.0} rpm, a higher DC link, or a lower peak current",
-                (limit / np * 30.0 / PI).floor()
-            ),
-        ));
+    if !within_circle_speed_limit(cx, &inp, psi) {
         return None;
     }
     let out = field_weakening::design(&inp);
@@ -124,4 +97,43 @@ pub(in crate::design) fn field_weakening(cx: &mut Context<'_>) -> Option<FieldWe
         ));
     }
     out
+}
+
+/// Whether the top speed is reachable on the current circle |i| = I_max (thesis B
+/// (2.55)–(2.57) hold the current there); if not, an error at `motor.datasheet.max_speed`
+/// with the highest reachable speed ([`field_weakening::circle_speed_limit`]).
+fn within_circle_speed_limit(cx: &mut Context<'_>, inp: &field_weakening::Inputs, psi: f64) -> bool {
+    let Some(limit) = field_weakening::circle_speed_limit(inp) else {
+        return true;
+    };
+    if inp.max_speed <= limit * (1.0 + 1e-9) {
+        return true;
+    }
+    let m = &cx.spec.motor;
+    let p = &m.max_speed;
+    let rpm = 30.0 / PI / f64::from(m.pole_pairs);
+    let inside = if psi < inp.model.ld * inp.model.i_max {
+        format!(
+            " (ψ_m = {psi:.4} Wb < L_d·I_max = {:.4} Wb: the high-speed optimum lies inside the circle, maximum torque per volt, which (2.57) does not reach)",
+            inp.model.ld * inp.model.i_max
+        )
+    } else {
+        String::new()
+    };
+    cx.errors.push(cx.src.error(
+        p.span.clone(),
+        &p.key,
+        format!(
+            "above {:.0} rpm (ω_e = {limit:.0} rad/s) no point of the current circle |i| = I_max = {:.1} A meets V'_max = {:.1} V (2.50), (2.53), R_s included: the field weakening of thesis B (2.55)–(2.57) keeps the current on that circle, so at the top speed {:.0} rpm the loop saturates{inside}",
+            limit * rpm,
+            inp.model.i_max,
+            inp.voltage_fraction * inp.voltage_max,
+            inp.max_speed * rpm,
+        ),
+        format!(
+            "a maximum speed of at most {:.0} rpm, a higher DC link, or a lower peak current",
+            (limit * rpm).floor()
+        ),
+    ));
+    false
 }

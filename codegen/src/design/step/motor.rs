@@ -162,7 +162,13 @@ fn cross_checks(m: &Motor) -> Vec<CrossCheck> {
     }
     if let Some(psi) = &m.flux_linkage {
         let torque = |i_rms: f64| {
-            cross_check::mtpa_torque(m.pole_pairs, psi.value, m.d_inductance.value, m.q_inductance.value, SQRT_2 * i_rms)
+            cross_check::mtpa_torque(
+                m.pole_pairs,
+                psi.value,
+                m.d_inductance.value,
+                m.q_inductance.value,
+                SQRT_2 * i_rms,
+            )
         };
         for (t, i, what) in [
             (&m.peak_torque, Some(&m.peak_current), "peak"),
