@@ -67,6 +67,16 @@ fn amplitude_name(a: Amplitude) -> &'static str {
     }
 }
 
+/// The voltage a back-EMF or speed constant refers to: `rms line-to-line`, `peak phase`,
+/// or `block-commutation DC` (line to line by construction).
+fn voltage_name(a: Amplitude, line_to_line: bool) -> String {
+    match a {
+        Amplitude::BlockCommutation => amplitude_name(a).to_string(),
+        _ if line_to_line => format!("{} line-to-line", amplitude_name(a)),
+        _ => format!("{} phase", amplitude_name(a)),
+    }
+}
+
 impl Resolver_<'_> {
     /// ψ_M: given, or derived from K_e (preferred: it is ψ_M by definition, 6.11), k_n, or
     /// K_t (2.34); and every source the spec gives, for the design's cross-check.
@@ -124,16 +134,9 @@ impl Resolver_<'_> {
                     np,
                 );
                 let written = format!(
-                    "K_e = {} {}{} per {} rad/s",
+                    "K_e = {} {} per {} rad/s",
                     text(&k.value),
-                    amplitude_name(*k.voltage.get_ref()),
-                    if *k.voltage.get_ref() == Amplitude::BlockCommutation {
-                        ""
-                    } else if ll {
-                        " line-to-line"
-                    } else {
-                        " phase"
-                    },
+                    voltage_name(*k.voltage.get_ref(), ll),
                     speed_name(*k.speed.get_ref())
                 );
                 add(
@@ -161,16 +164,9 @@ impl Resolver_<'_> {
                     np,
                 );
                 let written = format!(
-                    "k_n = {} per {}{} volt, K_e = 1/k_n",
+                    "k_n = {} per {} volt, K_e = 1/k_n",
                     text(&k.value),
-                    amplitude_name(*k.voltage.get_ref()),
-                    if *k.voltage.get_ref() == Amplitude::BlockCommutation {
-                        ""
-                    } else if ll {
-                        " line-to-line"
-                    } else {
-                        " phase"
-                    },
+                    voltage_name(*k.voltage.get_ref(), ll),
                 );
                 add(
                     &mut sources,
