@@ -318,10 +318,8 @@ mod tests {
             Some((motor::sensorless::RESET_LOWER, motor::sensorless::RESET_UPPER))
         );
         assert_eq!(e.injection.is_some(), motor::sensorless::INJECTION_GAIN != 0.0);
-        if e.injection.is_some() {
-            assert!(motor::current_loop::FF_LQ != motor::current_loop::FF_LD && motor::sensorless::RHO > 0.0);
-        }
         if let Some(i) = e.injection {
+            assert!(e.lq != e.ld && e.rho > 0.0, "injection needs saliency and an estimator");
             assert_eq!(i.gain, motor::sensorless::INJECTION_GAIN);
             assert_eq!(i.high_speed, 2.0 * i.low_speed);
         }
