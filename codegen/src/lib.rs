@@ -5,6 +5,7 @@
 //! CLI, the firmware's build script and the proc-macros all call it, so a
 //! constant cannot differ between the three paths.
 
+pub mod board;
 pub mod constants;
 pub mod design;
 pub mod diagnostic;

@@ -17,7 +17,8 @@ use crate::diagnostic::{Diagnostic, Diagnostics, Source};
 use crate::units::{self, Kind};
 pub use field_weakening::{DEFAULT_VOLTAGE_FRACTION, FieldWeakeningSpec};
 pub use raw::{Amplitude, Between, Connection, Method, ObserverError, SpeedAxis};
-use raw::{RawParams, RawSpec, Val};
+use raw::{RawParams, RawSpec};
+pub(crate) use raw::Val;
 pub use sensorless::{DEFAULT_ANGLE_ERROR_DEG, DEFAULT_RESISTANCE_ERROR, SensorlessSpec, angle_error_rad};
 
 /// Where a resolved value came from.
@@ -276,21 +277,26 @@ pub fn parse(source: Source<'_>) -> Result<Spec, Diagnostics> {
             )
             .into());
     }
-    let de = toml::Deserializer::parse(source.text).map_err(|e| syntax_error(source, &e))?;
-    let raw: RawSpec = serde_path_to_error::deserialize(de).map_err(|e| {
-        let path = e.path().to_string();
-        let inner = e.into_inner();
-        shape_error(source, &path, &inner)
-    })?;
-    let mut cx = Resolver_ {
-        src: source,
-        errors: Vec::new(),
-    };
+    let raw: RawSpec = deserialize(source, "motors/fischer-ti085.toml")?;
+    let mut cx = Resolver_::new(source);
     let spec = cx.spec(&raw);
     match spec {
         Some(spec) if cx.errors.is_empty() => Ok(spec),
         _ => Err(Diagnostics(cx.errors)),
     }
+}
+
+/// TOML text → the raw (spanned) structure `T`, every syntax or shape problem (unknown
+/// key, missing key, wrong type, unknown value) located at its key; `example` names a
+/// complete file of the same kind for the "accepted" line. Shared by motor specs and
+/// board files (`crate::board`).
+pub(crate) fn deserialize<T: serde::de::DeserializeOwned>(source: Source<'_>, example: &str) -> Result<T, Diagnostics> {
+    let de = toml::Deserializer::parse(source.text).map_err(|e| syntax_error(source, &e))?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        shape_error(source, &path, &inner, example)
+    })
 }
 
 fn syntax_error(source: Source<'_>, e: &toml::de::Error) -> Diagnostics {
@@ -306,7 +312,7 @@ fn syntax_error(source: Source<'_>, e: &toml::de::Error) -> Diagnostics {
 }
 
 /// A serde error (unknown key, missing key, wrong type, unknown variant) at its key path.
-fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error) -> Diagnostics {
+fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error, example: &str) -> Diagnostics {
     let span = e.span().unwrap_or(0..0);
     let message = e.message().trim().to_string();
     // serde_spanned wraps values in a private field; it is not part of the user's key.
@@ -329,7 +335,7 @@ fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error) -> Diagnosti
         };
         (
             format!("missing required key `{key}`"),
-            "the key with a value; see motors/fischer-ti085.toml for a complete spec".to_string(),
+            format!("the key with a value; see {example} for a complete file"),
         )
     } else if let Some(rest) = message.strip_prefix("unknown variant ") {
         let (value, expected) = rest.split_once(", expected ").unwrap_or((rest, "?"));
@@ -340,16 +346,17 @@ fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error) -> Diagnosti
     } else {
         (
             message,
-            "a value of the type this key takes; see motors/fischer-ti085.toml".to_string(),
+            format!("a value of the type this key takes; see {example}"),
         )
     };
     source.error(span, path, problem, accepted).into()
 }
 
-/// The second pass; collects every problem instead of stopping at the first.
-struct Resolver_<'a> {
-    src: Source<'a>,
-    errors: Vec<Diagnostic>,
+/// The second pass; collects every problem instead of stopping at the first. Its value
+/// readers (`quantity`, `number`, `integer`) also read board files (`crate::board`).
+pub(crate) struct Resolver_<'a> {
+    pub(crate) src: Source<'a>,
+    pub(crate) errors: Vec<Diagnostic>,
 }
 
 fn kind_example(kind: Kind) -> &'static str {
@@ -357,13 +364,18 @@ fn kind_example(kind: Kind) -> &'static str {
 }
 
 impl<'a> Resolver_<'a> {
-    fn err(&mut self, span: Range<usize>, key: &str, problem: impl Into<String>, accepted: impl Into<String>) {
+    /// A resolver with no problems found yet.
+    pub(crate) fn new(src: Source<'a>) -> Self {
+        Resolver_ { src, errors: Vec::new() }
+    }
+
+    pub(crate) fn err(&mut self, span: Range<usize>, key: &str, problem: impl Into<String>, accepted: impl Into<String>) {
         let d = self.src.error(span, key, problem, accepted);
         self.errors.push(d);
     }
 
     /// A `"<value> <unit>"` string of `kind`; `positive` requires > 0.
-    fn quantity(&mut self, key: &str, v: &Val, kind: Kind, source: Provenance, positive: bool) -> Option<Param> {
+    pub(crate) fn quantity(&mut self, key: &str, v: &Val, kind: Kind, source: Provenance, positive: bool) -> Option<Param> {
         let span = v.span();
         let text = match v.get_ref() {
             toml::Value::String(s) => s,
@@ -419,7 +431,7 @@ impl<'a> Resolver_<'a> {
     }
 
     /// A plain positive number (ratios, damping); integers are accepted as floats.
-    fn number(&mut self, key: &str, v: &Val, lo_exclusive: f64, hi_exclusive: f64, accepted: &str) -> Option<Param> {
+    pub(crate) fn number(&mut self, key: &str, v: &Val, lo_exclusive: f64, hi_exclusive: f64, accepted: &str) -> Option<Param> {
         let span = v.span();
         let value = match v.get_ref() {
             toml::Value::Float(f) => *f,
@@ -457,7 +469,7 @@ impl<'a> Resolver_<'a> {
     }
 
     /// A whole number in `[lo, hi]`.
-    fn integer(&mut self, key: &str, v: &Val, lo: i64, hi: i64, accepted: &str) -> Option<(i64, Param)> {
+    pub(crate) fn integer(&mut self, key: &str, v: &Val, lo: i64, hi: i64, accepted: &str) -> Option<(i64, Param)> {
         let span = v.span();
         match v.get_ref() {
             toml::Value::Integer(i) if (lo..=hi).contains(i) => Some((
@@ -490,7 +502,7 @@ impl<'a> Resolver_<'a> {
         }
     }
 
-    fn opt_quantity(&mut self, key: &str, v: Option<&Val>, kind: Kind, positive: bool) -> Option<Param> {
+    pub(crate) fn opt_quantity(&mut self, key: &str, v: Option<&Val>, kind: Kind, positive: bool) -> Option<Param> {
         v.and_then(|v| self.quantity(key, v, kind, Provenance::Datasheet, positive))
     }
 
