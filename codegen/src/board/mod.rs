@@ -348,7 +348,12 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
     let mut spans = Vec::new();
     let name = raw.name.get_ref().trim().to_string();
     if name.is_empty() {
-        cx.err(raw.name.span(), "name", "the board name is empty", "a non-empty string such as \"NUCLEO-G474RE + X-NUCLEO-IHM08M1\"");
+        cx.err(
+            raw.name.span(),
+            "name",
+            "the board name is empty",
+            "a non-empty string such as \"NUCLEO-G474RE + X-NUCLEO-IHM08M1\"",
+        );
     }
     let Some(chip) = chip::chip(raw.chip.get_ref().trim()) else {
         cx.err(
@@ -368,7 +373,11 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
         boot0_check(cx, raw, pins);
     }
 
-    let q = |cx: &mut Resolver_<'_>, spans: &mut Vec<(String, Range<usize>)>, key: &str, v: &crate::spec::Val, kind: Kind| {
+    let q = |cx: &mut Resolver_<'_>,
+             spans: &mut Vec<(String, Range<usize>)>,
+             key: &str,
+             v: &crate::spec::Val,
+             kind: Kind| {
         spans.push((key.to_string(), v.span()));
         cx.quantity(key, v, kind, Provenance::Datasheet, true)
     };
@@ -377,46 +386,112 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
     if let Some(v) = &vref
         && !(2.0..=3.6).contains(&v.value)
     {
-        cx.err(v.span.clone(), "sensing.adc_reference", format!("V_REF+ = {} V is outside 2 V … V_DDA ≤ 3.6 V", v.value), "the ADC reference the board supplies, 2 V to 3.6 V (DS12288 Table 66), e.g. \"3.3 V\"");
+        cx.err(
+            v.span.clone(),
+            "sensing.adc_reference",
+            format!("V_REF+ = {} V is outside 2 V … V_DDA ≤ 3.6 V", v.value),
+            "the ADC reference the board supplies, 2 V to 3.6 V (DS12288 Table 66), e.g. \"3.3 V\"",
+        );
     }
-    let gain = q(cx, &mut spans, "sensing.current_gain", &s.current_gain, Kind::Transresistance);
+    let gain = q(
+        cx,
+        &mut spans,
+        "sensing.current_gain",
+        &s.current_gain,
+        Kind::Transresistance,
+    );
     spans.push(("sensing.current_offset".into(), s.current_offset.span()));
-    let offset = cx.quantity("sensing.current_offset", &s.current_offset, Kind::Voltage, Provenance::Datasheet, false);
+    let offset = cx.quantity(
+        "sensing.current_offset",
+        &s.current_offset,
+        Kind::Voltage,
+        Provenance::Datasheet,
+        false,
+    );
     if let (Some(o), Some(v)) = (&offset, &vref)
         && !(o.value > 0.0 && o.value < v.value)
     {
         cx.err(o.span.clone(), "sensing.current_offset", format!("the zero-current level {} V is not inside the ADC range 0 … {} V: one current direction could not be measured", o.value, v.value), "the sensor output at 0 A, between 0 V and the ADC reference (bipolar phase currents), e.g. half the reference");
     }
     spans.push(("sensing.dc_link_divider".into(), s.dc_link_divider.span()));
-    let divider = cx.number("sensing.dc_link_divider", &s.dc_link_divider, 0.0, 1.0, "the divider ratio V_pin/U_dc as a plain number between 0 and 1, e.g. 0.0522 for 9.31 kΩ/(169 kΩ + 9.31 kΩ)");
+    let divider = cx.number(
+        "sensing.dc_link_divider",
+        &s.dc_link_divider,
+        0.0,
+        1.0,
+        "the divider ratio V_pin/U_dc as a plain number between 0 and 1, e.g. 0.0522 for 9.31 kΩ/(169 kΩ + 9.31 kΩ)",
+    );
     let sr = s.source_resistance.get_ref();
-    let r_current = q(cx, &mut spans, "sensing.source_resistance.current", &sr.current, Kind::Resistance);
-    let r_dc = q(cx, &mut spans, "sensing.source_resistance.dc_link", &sr.dc_link, Kind::Resistance);
-    let r_res = q(cx, &mut spans, "sensing.source_resistance.resolver", &sr.resolver, Kind::Resistance);
+    let r_current = q(
+        cx,
+        &mut spans,
+        "sensing.source_resistance.current",
+        &sr.current,
+        Kind::Resistance,
+    );
+    let r_dc = q(
+        cx,
+        &mut spans,
+        "sensing.source_resistance.dc_link",
+        &sr.dc_link,
+        Kind::Resistance,
+    );
+    let r_res = q(
+        cx,
+        &mut spans,
+        "sensing.source_resistance.resolver",
+        &sr.resolver,
+        Kind::Resistance,
+    );
     let cycles = s.sampling_cycles.as_ref().and_then(|v| {
         spans.push(("sensing.sampling_cycles".into(), v.span()));
-        cx.number("sensing.sampling_cycles", v, 0.0, 1e6, "one of the ADC_SMPR options 2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5 (RM0440 §21.4.12)")
+        cx.number(
+            "sensing.sampling_cycles",
+            v,
+            0.0,
+            1e6,
+            "one of the ADC_SMPR options 2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5 (RM0440 §21.4.12)",
+        )
     });
     let fixed_code = match &cycles {
         Some(c) => match sampling::code_of(c.value) {
             Some(code) => Some((code, c.clone())),
             None => {
-                cx.err(c.span.clone(), "sensing.sampling_cycles", format!("{} cycles is not an ADC sampling option", c.value), "one of 2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5 (RM0440 §21.4.12)");
+                cx.err(
+                    c.span.clone(),
+                    "sensing.sampling_cycles",
+                    format!("{} cycles is not an ADC sampling option", c.value),
+                    "one of 2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5 (RM0440 §21.4.12)",
+                );
                 None
             }
         },
         None => None,
     };
     let adc = match (&pins, &r_current, &r_dc, &r_res) {
-        (Some(pins), Some(rc), Some(rd), Some(rr)) => sequence::plan(cx, raw, chip, pins, [rc, rd, rr], fixed_code.as_ref()),
+        (Some(pins), Some(rc), Some(rd), Some(rr)) => {
+            sequence::plan(cx, raw, chip, pins, [rc, rd, rr], fixed_code.as_ref())
+        }
         _ => None,
     };
 
     let pw = raw.pwm.get_ref();
     let dead = q(cx, &mut spans, "pwm.dead_time", &pw.dead_time, Kind::Time);
     let pr = raw.protection.get_ref();
-    let oc = q(cx, &mut spans, "protection.over_current", &pr.over_current, Kind::Current);
-    let ov = q(cx, &mut spans, "protection.over_voltage", &pr.over_voltage, Kind::Voltage);
+    let oc = q(
+        cx,
+        &mut spans,
+        "protection.over_current",
+        &pr.over_current,
+        Kind::Current,
+    );
+    let ov = q(
+        cx,
+        &mut spans,
+        "protection.over_voltage",
+        &pr.over_voltage,
+        Kind::Voltage,
+    );
     let os = q(cx, &mut spans, "protection.over_speed", &pr.over_speed, Kind::Speed);
     if let (Some(oc), Some(o), Some(v), Some(g)) = (&oc, &offset, &vref, &gain) {
         let fs = o.value.min(v.value - o.value) / g.value;
@@ -427,23 +502,57 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
     if let (Some(ov), Some(v), Some(d)) = (&ov, &vref, &divider) {
         let fs = v.value / d.value;
         if ov.value > fs {
-            cx.err(ov.span.clone(), "protection.over_voltage", format!("{} V is beyond what the DC-link divider measures, {fs:.1} V ({} V / {})", ov.value, v.value, d.value), format!("a trip level up to {fs:.1} V, or a divider with a smaller ratio"));
+            cx.err(
+                ov.span.clone(),
+                "protection.over_voltage",
+                format!(
+                    "{} V is beyond what the DC-link divider measures, {fs:.1} V ({} V / {})",
+                    ov.value, v.value, d.value
+                ),
+                format!("a trip level up to {fs:.1} V, or a divider with a smaller ratio"),
+            );
         }
     }
     let c = raw.can.get_ref();
     let bit_rate = q(cx, &mut spans, "can.bit_rate", &c.bit_rate, Kind::BitRate);
     spans.push(("can.setpoint_id".into(), c.setpoint_id.span()));
-    let id = cx.integer("can.setpoint_id", &c.setpoint_id, 0, 0x7FF, "a standard (11-bit) identifier 0 … 0x7FF, e.g. 0x100");
+    let id = cx.integer(
+        "can.setpoint_id",
+        &c.setpoint_id,
+        0,
+        0x7FF,
+        "a standard (11-bit) identifier 0 … 0x7FF, e.g. 0x100",
+    );
     let period = q(cx, &mut spans, "can.setpoint_period", &c.setpoint_period, Kind::Time);
     let timeout = q(cx, &mut spans, "can.setpoint_timeout", &c.setpoint_timeout, Kind::Time);
     let ramp = q(cx, &mut spans, "can.setpoint_ramp", &c.setpoint_ramp, Kind::Time);
-    let lsb = q(cx, &mut spans, "can.torque_resolution", &c.torque_resolution, Kind::Torque);
+    let lsb = q(
+        cx,
+        &mut spans,
+        "can.torque_resolution",
+        &c.torque_resolution,
+        Kind::Torque,
+    );
     if let (Some(p), Some(t)) = (&period, &timeout)
         && t.value < p.value
     {
-        cx.err(t.span.clone(), "can.setpoint_timeout", format!("a timeout of {} s is shorter than the setpoint period {} s: every frame would time out", t.value, p.value), "at least one setpoint period, typically three");
+        cx.err(
+            t.span.clone(),
+            "can.setpoint_timeout",
+            format!(
+                "a timeout of {} s is shorter than the setpoint period {} s: every frame would time out",
+                t.value, p.value
+            ),
+            "at least one setpoint period, typically three",
+        );
     }
-    let wd = q(cx, &mut spans, "watchdog.timeout", &raw.watchdog.get_ref().timeout, Kind::Time);
+    let wd = q(
+        cx,
+        &mut spans,
+        "watchdog.timeout",
+        &raw.watchdog.get_ref().timeout,
+        Kind::Time,
+    );
 
     Some(Board {
         file: cx.src.file.to_string(),
@@ -478,6 +587,7 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
 fn pins(cx: &mut Resolver_<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<Vec<PinUse>> {
     let table = raw.pins.get_ref();
     let mut out: Vec<PinUse> = Vec::new();
+    let mut seen: Vec<(&'static str, Signal)> = Vec::new();
     let mut ok = true;
     for signal in Signal::ALL {
         let key = format!("pins.{}", signal.key());
@@ -487,24 +597,61 @@ fn pins(cx: &mut Resolver_<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<V
                     Need::Digital(p, s) => format!("a pin with {p}_{s}: {}", list_pins_with(chip, p, s)),
                     Need::Analog => format!("an ADC1/ADC2 input: {}", adc_inputs(chip)),
                 };
-                cx.err(raw.pins.span(), &key, format!("missing required key `{key}`: the firmware needs a pin for {}", signal.key().replace('_', " ")), accepted);
+                cx.err(
+                    raw.pins.span(),
+                    &key,
+                    format!(
+                        "missing required key `{key}`: the firmware needs a pin for {}",
+                        signal.key().replace('_', " ")
+                    ),
+                    accepted,
+                );
                 ok = false;
             }
             continue;
         };
         let name = v.get_ref().trim();
         let Some(functions) = chip.functions(name) else {
-            cx.err(v.span(), &key, format!("\"{name}\" is not a pin of the {} ({})", chip.name, chip.package), format!("one of its pins: {}", chip.pin_names().join(", ")));
+            cx.err(
+                v.span(),
+                &key,
+                format!("\"{name}\" is not a pin of the {} ({})", chip.name, chip.package),
+                format!("one of its pins: {}", chip.pin_names().join(", ")),
+            );
             ok = false;
             continue;
         };
         let pin = chip.pin_names().into_iter().find(|p| *p == name).unwrap_or("?");
         let _ = functions;
+        if let Some(first) = seen.iter().find(|(p, _)| *p == pin) {
+            cx.err(
+                v.span(),
+                &key,
+                format!(
+                    "two signals on {pin}: `pins.{}` and `pins.{}`",
+                    first.1.key(),
+                    signal.key()
+                ),
+                "one pin per signal",
+            );
+            ok = false;
+            continue;
+        }
+        seen.push((pin, signal));
         let af = match signal.need() {
             Need::Digital(p, s) => match chip.alternate_function(pin, p, s) {
                 Some(af) => Some(af),
                 None => {
-                    cx.err(v.span(), &key, format!("{pin} has no {p}_{s} function on the {} (alternate functions: {})", chip.name, chip.describe(pin)), format!("a pin with {p}_{s}: {}", list_pins_with(chip, p, s)));
+                    cx.err(
+                        v.span(),
+                        &key,
+                        format!(
+                            "{pin} has no {p}_{s} function on the {} (alternate functions: {})",
+                            chip.name,
+                            chip.describe(pin)
+                        ),
+                        format!("a pin with {p}_{s}: {}", list_pins_with(chip, p, s)),
+                    );
                     ok = false;
                     continue;
                 }
@@ -518,16 +665,18 @@ fn pins(cx: &mut Resolver_<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<V
                 None
             }
         };
-        if let Some(first) = out.iter().find(|u| u.pin == pin) {
-            cx.err(v.span(), &key, format!("two signals on {pin}: `pins.{}` and `pins.{}`", first.signal.key(), signal.key()), "one pin per signal");
-            ok = false;
-            continue;
-        }
         let Some((port, number)) = port_and_number(pin) else {
             ok = false;
             continue;
         };
-        out.push(PinUse { signal, pin, port, number, af, span: v.span() });
+        out.push(PinUse {
+            signal,
+            pin,
+            port,
+            number,
+            af,
+            span: v.span(),
+        });
     }
     ok.then_some(out)
 }
@@ -557,12 +706,89 @@ fn boot0_check(cx: &mut Resolver_<'_>, raw: &RawBoard, pins: &[PinUse]) {
 
 /// A located design-time note about a board key (used for motor-vs-board checks).
 pub fn warning_at(board: &Board, text: &str, key: &str, problem: &str) -> String {
-    let src = Source { file: &board.file, text };
+    let src = Source {
+        file: &board.file,
+        text,
+    };
     let d = src.error(board.span(key), key, problem, "");
     format!("{}:{}:{}: `{key}`: {problem}", d.file, d.line, d.column)
 }
 
 /// A resolved value's provenance for the constants (board files are datasheet-like).
 pub fn param(value: f64, key: &str) -> Param {
-    Param { value, source: Provenance::Datasheet, key: key.into(), span: 0..0, note: None }
+    Param {
+        value,
+        source: Provenance::Datasheet,
+        key: key.into(),
+        span: 0..0,
+        note: None,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn board(file: &str, text: &str) -> Result<Board, Diagnostics> {
+        parse(Source { file, text })
+    }
+
+    /// The reference board (the facts of the old hw.rs): every pin where the README's
+    /// table put it, PB8 with its BOOT0 handling, and the slow PA4 (ADC2_IN17) at 24.5
+    /// cycles — DS12288 Table 67 for 1.1 kΩ — instead of 2.5 (defect 5).
+    #[test]
+    fn reference_board() {
+        let b = board(
+            "boards/motorgen-reference.toml",
+            include_str!("../../../boards/motorgen-reference.toml"),
+        )
+        .unwrap();
+        assert_eq!(b.pin(Signal::GateWLow).map(|p| (p.pin, p.af)), Some(("PB15", Some(4))));
+        assert_eq!(
+            b.pin(Signal::CanRx).map(|p| (p.pin, p.af, p.code())),
+            Some(("PB8", Some(9), 0x18))
+        );
+        assert_eq!(b.boot0, Some(Boot0Handling::OptionBytes));
+        let w = b.adc.iter().flatten().find(|s| s.signal == Signal::CurrentW).unwrap();
+        assert_eq!(
+            (w.pin, w.channel, w.sampling.fast, w.sampling.cycles),
+            ("PA4", 17, false, 24.5)
+        );
+        // Fast channels at 1.1 kΩ: the 1.5 kΩ row (408.33 ns) → 24.5 cycles too.
+        let u = b.adc.iter().flatten().find(|s| s.signal == Signal::CurrentU).unwrap();
+        assert_eq!((u.channel, u.sampling.fast, u.sampling.cycles), (1, true, 24.5));
+        // SIN and COS on different converters; every current in the first two ranks.
+        let conv = |s: Signal| b.adc.iter().position(|q| q.iter().any(|x| x.signal == s));
+        assert_ne!(conv(Signal::ResolverSin), conv(Signal::ResolverCos));
+        for q in &b.adc {
+            for (rank, s) in q.iter().enumerate() {
+                if matches!(s.signal, Signal::CurrentU | Signal::CurrentV | Signal::CurrentW) {
+                    assert!(rank <= 1, "{:?} at rank {rank}", s.signal);
+                }
+            }
+        }
+        // ±1.65 V/15 mV/A = ±110 A; 3.3 V/0.0044 = 750 V.
+        assert!((b.current_full_scale_a() - 110.0).abs() < 1e-9);
+        assert!((b.dc_link_full_scale_v() - 750.0).abs() < 1e-9);
+    }
+
+    /// The NUCLEO-G474RE + X-NUCLEO-IHM08M1: low-side shunts at the low-side centre,
+    /// ±min(1.71, 1.59) V/51.8 mV/A = ±30.69 A, 3.3 V/0.05221 = 63.2 V (ST's MC SDK
+    /// figure for the board); the divider's 8.82 kΩ on the fast PA1 needs the 12 kΩ row
+    /// (4125 ns) → 247.5 cycles at 42.5 MHz (5.82 µs).
+    #[test]
+    fn nucleo_ihm08m1_board() {
+        let b = board(
+            "boards/nucleo-g474re-ihm08m1.toml",
+            include_str!("../../../boards/nucleo-g474re-ihm08m1.toml"),
+        )
+        .unwrap();
+        assert_eq!(b.sample_instant, SampleInstant::LowSideCentre);
+        assert_eq!(b.pin(Signal::GateULow).map(|p| (p.pin, p.af)), Some(("PA7", Some(6))));
+        assert_eq!(b.pin(Signal::BreakInput).map(|p| (p.pin, p.af)), Some(("PA6", Some(6))));
+        assert!((b.current_full_scale_a() - (3.3 - 1.71) / 0.0518).abs() < 1e-9);
+        assert!((b.dc_link_full_scale_v() - 63.206).abs() < 1e-3);
+        let dc = b.adc.iter().flatten().find(|s| s.signal == Signal::DcLink).unwrap();
+        assert_eq!((dc.pin, dc.sampling.fast, dc.sampling.cycles), ("PA1", true, 247.5));
+    }
 }

@@ -58,7 +58,13 @@ pub struct TooSlow {
 pub fn table_time(r_ohm: f64, fast: bool) -> Result<f64, TooSlow> {
     TABLE_67_12_BIT
         .iter()
-        .find(|(_, _, f, s)| if fast { r_ohm <= *f } else { s.is_some_and(|s| r_ohm <= s) })
+        .find(|(_, _, f, s)| {
+            if fast {
+                r_ohm <= *f
+            } else {
+                s.is_some_and(|s| r_ohm <= s)
+            }
+        })
         .map(|(_, ns, _, _)| ns * 1e-9)
         .ok_or(TooSlow {
             max_ohm: if fast { 39_000.0 } else { 33_000.0 },

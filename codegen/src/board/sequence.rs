@@ -67,7 +67,12 @@ fn cost(seqs: &[Vec<Signal>; 2]) -> u32 {
         .any(|s| s.contains(&Signal::ResolverSin) && s.contains(&Signal::ResolverCos));
     let current_ranks: u32 = seqs
         .iter()
-        .flat_map(|s| s.iter().enumerate().filter(|(_, x)| priority(**x) <= 2).map(|(k, _)| k as u32))
+        .flat_map(|s| {
+            s.iter()
+                .enumerate()
+                .filter(|(_, x)| priority(**x) <= 2)
+                .map(|(k, _)| k as u32)
+        })
         .sum();
     let (n1, n2) = (seqs[0].len() as u32, seqs[1].len() as u32);
     u32::from(same_resolver) * 1000 + current_ranks * 10 + n1.abs_diff(n2) + u32::from(n2 > n1)
@@ -119,6 +124,8 @@ pub(super) fn plan(
     };
     let mut out: [Vec<AdcSlot>; 2] = [Vec::new(), Vec::new()];
     let mut ok = true;
+    // Inputs a board-wide `sampling_cycles` is too short for: (cycles needed, slow, message).
+    let mut too_short: Vec<(f64, bool, String)> = Vec::new();
     for (c, seq) in seqs.iter().enumerate() {
         for signal in seq {
             let Some(p) = analog.iter().find(|p| p.signal == *signal) else {
@@ -137,28 +144,27 @@ pub(super) fn plan(
                 Ok(mut s) => {
                     if let Some((code, given)) = fixed {
                         if *code < s.smp_code {
-                            cx.err(
-                                given.span.clone(),
-                                "sensing.sampling_cycles",
-                                format!(
-                                    "{} cycles is too short for `pins.{}`: {what}; {:.0} Ω needs ≥ {} cycles at {:.1} MHz (DS12288 Table 67: {:.0} ns, thesis A (7.4): {:.1} ns)",
-                                    given.value,
-                                    signal.key(),
-                                    r.value,
-                                    s.cycles,
-                                    ADC_CLOCK_HZ / 1e6,
-                                    s.table_time_s * 1e9,
-                                    s.settling_time_s * 1e9
-                                ),
-                                format!("sampling_cycles = {} or more, or leave the key out to let each input get the shortest time that settles it", s.cycles),
-                            );
-                            ok = false;
+                            too_short.push((s.cycles, !fast, format!(
+                                "{} cycles is too short for `pins.{}`: {what}; {:.0} Ω needs ≥ {} cycles at {:.1} MHz (DS12288 Table 67: {:.0} ns, thesis A (7.4): {:.1} ns)",
+                                given.value,
+                                signal.key(),
+                                r.value,
+                                s.cycles,
+                                ADC_CLOCK_HZ / 1e6,
+                                s.table_time_s * 1e9,
+                                s.settling_time_s * 1e9
+                            )));
                         } else {
                             s.smp_code = *code;
                             s.cycles = given.value;
                         }
                     }
-                    out[c].push(AdcSlot { signal: *signal, pin: p.pin, channel, sampling: s });
+                    out[c].push(AdcSlot {
+                        signal: *signal,
+                        pin: p.pin,
+                        channel,
+                        sampling: s,
+                    });
                 }
                 Err(e) => {
                     cx.err(
@@ -171,6 +177,20 @@ pub(super) fn plan(
                 }
             }
         }
+    }
+    // One error, for the input that needs the most (a slow one first on a tie).
+    if let (Some((code, given)), Some((cycles, _, problem))) = (
+        fixed,
+        too_short.iter().max_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))),
+    ) {
+        let _ = code;
+        cx.err(
+            given.span.clone(),
+            "sensing.sampling_cycles",
+            problem.clone(),
+            format!("sampling_cycles = {cycles} or more, or leave the key out to let each input get the shortest time that settles it"),
+        );
+        ok = false;
     }
     ok.then_some(out)
 }

@@ -16,9 +16,9 @@ use serde::Serialize;
 use crate::diagnostic::{Diagnostic, Diagnostics, Source};
 use crate::units::{self, Kind};
 pub use field_weakening::{DEFAULT_VOLTAGE_FRACTION, FieldWeakeningSpec};
+pub(crate) use raw::Val;
 pub use raw::{Amplitude, Between, Connection, Method, ObserverError, SpeedAxis};
 use raw::{RawParams, RawSpec};
-pub(crate) use raw::Val;
 pub use sensorless::{DEFAULT_ANGLE_ERROR_DEG, DEFAULT_RESISTANCE_ERROR, SensorlessSpec, angle_error_rad};
 
 /// Where a resolved value came from.
@@ -344,10 +344,7 @@ fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error, example: &st
             format!("one of {}", expected.trim_start_matches("one of ")),
         )
     } else {
-        (
-            message,
-            format!("a value of the type this key takes; see {example}"),
-        )
+        (message, format!("a value of the type this key takes; see {example}"))
     };
     source.error(span, path, problem, accepted).into()
 }
@@ -366,16 +363,32 @@ fn kind_example(kind: Kind) -> &'static str {
 impl<'a> Resolver_<'a> {
     /// A resolver with no problems found yet.
     pub(crate) fn new(src: Source<'a>) -> Self {
-        Resolver_ { src, errors: Vec::new() }
+        Resolver_ {
+            src,
+            errors: Vec::new(),
+        }
     }
 
-    pub(crate) fn err(&mut self, span: Range<usize>, key: &str, problem: impl Into<String>, accepted: impl Into<String>) {
+    pub(crate) fn err(
+        &mut self,
+        span: Range<usize>,
+        key: &str,
+        problem: impl Into<String>,
+        accepted: impl Into<String>,
+    ) {
         let d = self.src.error(span, key, problem, accepted);
         self.errors.push(d);
     }
 
     /// A `"<value> <unit>"` string of `kind`; `positive` requires > 0.
-    pub(crate) fn quantity(&mut self, key: &str, v: &Val, kind: Kind, source: Provenance, positive: bool) -> Option<Param> {
+    pub(crate) fn quantity(
+        &mut self,
+        key: &str,
+        v: &Val,
+        kind: Kind,
+        source: Provenance,
+        positive: bool,
+    ) -> Option<Param> {
         let span = v.span();
         let text = match v.get_ref() {
             toml::Value::String(s) => s,
@@ -431,7 +444,14 @@ impl<'a> Resolver_<'a> {
     }
 
     /// A plain positive number (ratios, damping); integers are accepted as floats.
-    pub(crate) fn number(&mut self, key: &str, v: &Val, lo_exclusive: f64, hi_exclusive: f64, accepted: &str) -> Option<Param> {
+    pub(crate) fn number(
+        &mut self,
+        key: &str,
+        v: &Val,
+        lo_exclusive: f64,
+        hi_exclusive: f64,
+        accepted: &str,
+    ) -> Option<Param> {
         let span = v.span();
         let value = match v.get_ref() {
             toml::Value::Float(f) => *f,

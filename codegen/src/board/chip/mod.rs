@@ -139,7 +139,10 @@ mod tests {
         assert_eq!(c.alternate_function("PB8", "FDCAN1", "RX"), Some(9));
         assert_eq!(c.adc_channel("PA4", "ADC2"), Some(17));
         assert!(!is_fast_channel(17));
-        assert_eq!((c.adc_channel("PA0", "ADC1"), c.adc_channel("PA0", "ADC2")), (Some(1), Some(1)));
+        assert_eq!(
+            (c.adc_channel("PA0", "ADC1"), c.adc_channel("PA0", "ADC2")),
+            (Some(1), Some(1))
+        );
         assert!(is_fast_channel(1));
         assert_eq!(c.adc_channel("PA8", "ADC1"), None);
         assert!(c.describe("PA5").contains("AF1 TIM2_CH1"), "{}", c.describe("PA5"));
