@@ -12,6 +12,7 @@
 //! resistance ([`sampling`]); trip levels inside the measurable ranges.
 
 pub mod chip;
+pub mod design;
 mod raw;
 pub mod sampling;
 mod sequence;

@@ -209,6 +209,9 @@ pub struct ObserverOut {
     pub lead_q16: i32,
     /// Lag k·ω_e,max·T_s at maximum speed [deg] (4.23).
     pub lead_at_max_speed_deg: f64,
+    /// The error form as the generated `observer::ERROR_FORM`: 0 = trig identity (4.8),
+    /// 1 = atan2 (CORDIC phase, normalised by π).
+    pub error_form: u8,
 }
 
 /// Fixed-point scalings of every quantity the firmware represents.
@@ -281,6 +284,9 @@ pub struct Design {
     pub field_weakening: Option<field_weakening::FieldWeakeningOut>,
     /// Sensorless estimator (thesis B chapter 4), when ψ_M is known.
     pub sensorless: Option<sensorless::SensorlessOut>,
+    /// The inverter board's values with this motor (`crate::design_with_board`); `None`
+    /// for a motor designed on its own.
+    pub board: Option<crate::board::design::BoardOut>,
     /// Non-fatal observations.
     pub warnings: Vec<String>,
 }
@@ -822,6 +828,10 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
             lead_samples: lead,
             lead_q16: (lead * 65_536.0).round() as i32,
             lead_at_max_speed_deg: angle_observer::lag_angle(lead, 2.0 * PI * fe_max, fs).to_degrees(),
+            error_form: match o.error {
+                ObserverError::TrigIdentity => 0,
+                ObserverError::Atan2 => 1,
+            },
         },
         scaling: ScalingsOut {
             margin,
@@ -868,6 +878,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         },
         field_weakening: fw,
         sensorless,
+        board: None,
         warnings,
     };
     Ok(design)
