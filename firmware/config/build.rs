@@ -4,7 +4,8 @@
 //! `motorgen` (`codegen::design_with_board` → the Rust template): the motor's constants
 //! and the `board` group. `MOTORS_DIR` and `BOARDS_DIR` override the folders. A bad
 //! spec or board file fails the build with the CLI's located message, not a panic; the
-//! design's warnings (a board too small for the motor, …) are printed as cargo warnings.
+//! board's warnings for this motor (a current range below its peak current, …) are
+//! printed as cargo warnings.
 //! (Linker setup for the image is in `../app/build.rs`.)
 
 use std::path::{Path, PathBuf};
@@ -94,7 +95,9 @@ fn main() {
         Ok(d) => d,
         Err(e) => return fail(&e.to_string()),
     };
-    for w in &design.warnings {
+    // What does not fit between the board and the motor (the motor's own design notes
+    // are `motorgen design`'s to print).
+    for w in design.board.iter().flat_map(|b| &b.warnings) {
         println!("cargo::warning={w}");
     }
     let code = match codegen::render::render(&design, codegen::render::Output::Rust) {

@@ -66,6 +66,9 @@ pub struct BoardOut {
     pub over_speed_electrical_rad_s: f64,
     /// CAN nominal bit rate \[bit/s\].
     pub can_bit_rate: u32,
+    /// What does not fit between this board and this motor (also in the design's
+    /// warnings), located at the board key.
+    pub warnings: Vec<String>,
 }
 
 /// Worst trigger-to-end time of a converter's sequence: latency 3 ADC cycles (DS12288
@@ -156,7 +159,8 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
         current_full_scale_a: i_fs,
         dc_link_volts_per_lsb: board.adc_reference_v / (board.dc_link_divider * CODES_15),
         dc_link_full_scale_v: u_fs,
-        dead_time_ns: (dead_s * 1e9).ceil() as u32,
+        // Whole nanoseconds, never shorter than asked (the −1e-6 absorbs 500e-9·1e9 = 500.0000000000001).
+        dead_time_ns: (dead_s * 1e9 - 1e-6).ceil() as u32,
         conversion_time_s: t_conv,
         gate_pins: gates.map(|s| pin_code(board, s)),
         gate_afs: gates.map(|s| pin_af(board, s)),
@@ -171,6 +175,11 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
         boot0_option_bytes: u8::from(checks_option_bytes(board)),
         over_speed_electrical_rad_s: board.over_speed_rad_s * f64::from(d.motor.pole_pairs),
         can_bit_rate: board.can_bit_rate.round() as u32,
+        warnings: Vec::new(),
+    };
+    let out = BoardOut {
+        warnings: warnings.clone(),
+        ..out
     };
     (out, warnings)
 }

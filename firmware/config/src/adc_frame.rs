@@ -161,12 +161,12 @@ mod tests {
 
     /// A board with 0 A at code 32 768, a trip 8 000 codes away, U_dc trip at code
     /// 20 000, ω_e trip at 4 000 rad/s: 12-bit 2048 (= 32 768) and 2500 (40 000, 7 232
-    /// away) pass; 2600 (41 600, 8 832 away) trips, so does the rail 4095 and code 0;
+    /// away) and 1600 (25 600, 7 168 away) pass; 2600 (41 600, 8 832 away) trips, so does the rail 4095 and code 0;
     /// DC link 2501 → 20 008 > 20 000 trips; ω_e 4 001 trips.
     #[test]
     fn trips_at_the_board_levels() {
         let t = Trips { current_offset: 32_768, current_codes: 8_000, dc_link_code: 20_000, speed: 4_000.0 };
-        let ok = RawConversions { phases: [2048, 2500, 1536], dc_link: 2500, ..Default::default() };
+        let ok = RawConversions { phases: [2048, 2500, 1600], dc_link: 2500, ..Default::default() };
         assert!(!t.tripped(&ok, 3, 3_999.0));
         assert!(t.tripped(&RawConversions { phases: [2048, 2600, 2048], ..ok }, 3, 0.0));
         assert!(t.tripped(&RawConversions { phases: [4095, 2048, 2048], ..ok }, 3, 0.0));
