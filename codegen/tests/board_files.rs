@@ -175,17 +175,40 @@ fn check_and_design_take_board_files() {
             .output()
             .expect("motorgen runs")
     };
-    let out = run(&["check", "boards/motorgen-reference.toml", "boards/nucleo-g474re-ihm08m1.toml", "motors/fischer-ti085.toml"]);
+    let out = run(&[
+        "check",
+        "boards/motorgen-reference.toml",
+        "boards/nucleo-g474re-ihm08m1.toml",
+        "motors/fischer-ti085.toml",
+    ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{stdout}{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains("ok: boards/nucleo-g474re-ihm08m1.toml (board: NUCLEO-G474RE + X-NUCLEO-IHM08M1, STM32G474RE LQFP64)"), "{stdout}");
+    assert!(
+        stdout.contains(
+            "ok: boards/nucleo-g474re-ihm08m1.toml (board: NUCLEO-G474RE + X-NUCLEO-IHM08M1, STM32G474RE LQFP64)"
+        ),
+        "{stdout}"
+    );
     let bad = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad-boards/wrong-af.toml");
     let out = run(&["check", bad.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("wrong-af.toml:16:14: `pins.gate_u_low`: PA5 has no TIM1_CH1N"), "{stderr}");
-    let out = run(&["design", "motors/chalmers-hev50.toml", "--board", "boards/motorgen-reference.toml", "--format", "rust"]);
+    assert!(
+        stderr.contains("wrong-af.toml:16:14: `pins.gate_u_low`: PA5 has no TIM1_CH1N"),
+        "{stderr}"
+    );
+    let out = run(&[
+        "design",
+        "motors/chalmers-hev50.toml",
+        "--board",
+        "boards/motorgen-reference.toml",
+        "--format",
+        "rust",
+    ]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    assert!(stdout.contains("pub mod board {") && stdout.contains("pub const DEAD_TIME_NS: u32 = 500;"), "{stdout}");
+    assert!(
+        stdout.contains("pub mod board {") && stdout.contains("pub const DEAD_TIME_NS: u32 = 500;"),
+        "{stdout}"
+    );
 }

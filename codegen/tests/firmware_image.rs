@@ -89,7 +89,10 @@ fn every_motor_builds_on_the_nucleo_ihm08m1_board() {
     let out = firmware(&["--all", "--board", board]);
     let stdout = String::from_utf8_lossy(&out.stdout);
     let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(out.status.success(), "motorgen firmware --all --board failed:\n{stdout}\n{stderr}");
+    assert!(
+        out.status.success(),
+        "motorgen firmware --all --board failed:\n{stdout}\n{stderr}"
+    );
     println!("{stdout}{stderr}");
     let dir = repo().join("target").join("firmware").join(board);
     for stem in common::motor_stems() {
@@ -118,7 +121,11 @@ fn bad_board_fails_with_its_location_before_cargo_runs() {
     let out = firmware(&["fischer-ti085", "--board", "bad", "--boards-dir", dir.to_str().unwrap()]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
-    for expected in [format!("bad.toml:{line}:14"), "`pins.gate_u_low`".into(), "PA5 has no TIM1_CH1N".into()] {
+    for expected in [
+        format!("bad.toml:{line}:14"),
+        "`pins.gate_u_low`".into(),
+        "PA5 has no TIM1_CH1N".into(),
+    ] {
         assert!(stderr.contains(&expected), "expected {expected:?} in\n{stderr}");
     }
     assert!(!stderr.contains("Compiling"), "cargo ran for a bad board:\n{stderr}");
@@ -126,7 +133,10 @@ fn bad_board_fails_with_its_location_before_cargo_runs() {
     let out = firmware(&["fischer-ti085", "--board", "no-such-board"]);
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1), "{stderr}");
-    assert!(stderr.contains("no board `no-such-board`") && stderr.contains("nucleo-g474re-ihm08m1"), "{stderr}");
+    assert!(
+        stderr.contains("no board `no-such-board`") && stderr.contains("nucleo-g474re-ihm08m1"),
+        "{stderr}"
+    );
 }
 
 #[test]

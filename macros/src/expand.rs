@@ -23,7 +23,10 @@ pub fn motor_constants(input: TokenStream) -> syn::Result<TokenStream> {
             if p.parse::<Option<syn::Token![,]>>()?.is_some() && !p.is_empty() {
                 let key: syn::Ident = p.parse()?;
                 if key != "board" {
-                    return Err(syn::Error::new(key.span(), "unknown argument; accepted: board = \"<board file>\""));
+                    return Err(syn::Error::new(
+                        key.span(),
+                        "unknown argument; accepted: board = \"<board file>\"",
+                    ));
                 }
                 p.parse::<syn::Token![=]>()?;
                 board = Some(p.parse::<LitStr>()?);
@@ -55,7 +58,10 @@ pub fn motor_constants(input: TokenStream) -> syn::Result<TokenStream> {
         syn::Error::new(span, msg.strip_prefix("error: ").unwrap_or(&msg).trim_end().to_string())
     };
     let (design, board_path) = match &board {
-        None => (codegen::design_source(&rel, &text).map_err(|e| located(lit.span(), e))?, None),
+        None => (
+            codegen::design_source(&rel, &text).map_err(|e| located(lit.span(), e))?,
+            None,
+        ),
         Some(b) => {
             let (brel, bpath, btext) = read(b)?;
             let d = codegen::design_with_board(&rel, &text, &brel, &btext).map_err(|e| located(b.span(), e))?;

@@ -101,19 +101,28 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
     if board.over_current_a < peak && i_fs >= peak {
         warn(
             "protection.over_current",
-            format!("the drive trips at {:.1} A, below {}'s peak current {peak:.1} A", board.over_current_a, d.name),
+            format!(
+                "the drive trips at {:.1} A, below {}'s peak current {peak:.1} A",
+                board.over_current_a, d.name
+            ),
         );
     }
     let udc = d.drive.dc_link_voltage_v;
     if u_fs < udc {
         warn(
             "sensing.dc_link_divider",
-            format!("the divider measures up to {u_fs:.1} V but {} runs at U_dc = {udc:.0} V: the DC-link reading saturates (the 1/U_dc feed-forward (5.1) and the over-voltage trip go blind)", d.name),
+            format!(
+                "the divider measures up to {u_fs:.1} V but {} runs at U_dc = {udc:.0} V: the DC-link reading saturates (the 1/U_dc feed-forward (5.1) and the over-voltage trip go blind)",
+                d.name
+            ),
         );
     } else if board.over_voltage_v < udc {
         warn(
             "protection.over_voltage",
-            format!("the drive trips at {:.0} V, below {}'s DC link {udc:.0} V", board.over_voltage_v, d.name),
+            format!(
+                "the drive trips at {:.0} V, below {}'s DC link {udc:.0} V",
+                board.over_voltage_v, d.name
+            ),
         );
     }
     let n_max = d.motor.max_speed_rad_s;
@@ -149,7 +158,12 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
         Signal::GateVLow,
         Signal::GateWLow,
     ];
-    let io = [Signal::BreakInput, Signal::ResolverExcitation, Signal::CanRx, Signal::CanTx];
+    let io = [
+        Signal::BreakInput,
+        Signal::ResolverExcitation,
+        Signal::CanRx,
+        Signal::CanTx,
+    ];
     let board_dead = board.dead_time_s;
     let dead_s = d.drive.dead_time_s.map_or(board_dead, |spec| spec.max(board_dead));
     let out = BoardOut {
@@ -167,8 +181,14 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
         io_pins: io.map(|s| pin_code(board, s)),
         io_afs: io.map(|s| pin_af(board, s)),
         adc_channels: board.adc.clone().map(|q| q.iter().map(|x| x.channel).collect()),
-        adc_signals: board.adc.clone().map(|q| q.iter().map(|x| signal_code(x.signal)).collect()),
-        adc_smp: board.adc.clone().map(|q| q.iter().map(|x| x.sampling.smp_code).collect()),
+        adc_signals: board
+            .adc
+            .clone()
+            .map(|q| q.iter().map(|x| signal_code(x.signal)).collect()),
+        adc_smp: board
+            .adc
+            .clone()
+            .map(|q| q.iter().map(|x| x.sampling.smp_code).collect()),
         current_phases: if board.pin(Signal::CurrentW).is_some() { 3 } else { 2 },
         break_active_high: u8::from(break_active_high(board)),
         sample_at_carrier_maximum: u8::from(samples_at_carrier_maximum(board)),

@@ -165,14 +165,51 @@ mod tests {
     /// DC link 2501 → 20 008 > 20 000 trips; ω_e 4 001 trips.
     #[test]
     fn trips_at_the_board_levels() {
-        let t = Trips { current_offset: 32_768, current_codes: 8_000, dc_link_code: 20_000, speed: 4_000.0 };
-        let ok = RawConversions { phases: [2048, 2500, 1600], dc_link: 2500, ..Default::default() };
+        let t = Trips {
+            current_offset: 32_768,
+            current_codes: 8_000,
+            dc_link_code: 20_000,
+            speed: 4_000.0,
+        };
+        let ok = RawConversions {
+            phases: [2048, 2500, 1600],
+            dc_link: 2500,
+            ..Default::default()
+        };
         assert!(!t.tripped(&ok, 3, 3_999.0));
-        assert!(t.tripped(&RawConversions { phases: [2048, 2600, 2048], ..ok }, 3, 0.0));
-        assert!(t.tripped(&RawConversions { phases: [4095, 2048, 2048], ..ok }, 3, 0.0));
-        assert!(t.tripped(&RawConversions { phases: [2048, 2048, 0], ..ok }, 3, 0.0));
+        assert!(t.tripped(
+            &RawConversions {
+                phases: [2048, 2600, 2048],
+                ..ok
+            },
+            3,
+            0.0
+        ));
+        assert!(t.tripped(
+            &RawConversions {
+                phases: [4095, 2048, 2048],
+                ..ok
+            },
+            3,
+            0.0
+        ));
+        assert!(t.tripped(
+            &RawConversions {
+                phases: [2048, 2048, 0],
+                ..ok
+            },
+            3,
+            0.0
+        ));
         // With two phases the third code is not a measurement.
-        assert!(!t.tripped(&RawConversions { phases: [2048, 2048, 0], ..ok }, 2, 0.0));
+        assert!(!t.tripped(
+            &RawConversions {
+                phases: [2048, 2048, 0],
+                ..ok
+            },
+            2,
+            0.0
+        ));
         assert!(t.tripped(&RawConversions { dc_link: 2501, ..ok }, 3, 0.0));
         assert!(t.tripped(&ok, 3, -4_001.0));
         assert!(t.tripped(&ok, 3, f32::NAN));
@@ -187,6 +224,14 @@ mod tests {
             &[400, 500, 600, 0],
             &[signal::CURRENT_V, signal::CURRENT_W, signal::COS],
         );
-        assert_eq!(raw, RawConversions { phases: [100, 400, 500], dc_link: 300, sin: 200, cos: 600 });
+        assert_eq!(
+            raw,
+            RawConversions {
+                phases: [100, 400, 500],
+                dc_link: 300,
+                sin: 200,
+                cos: 600
+            }
+        );
     }
 }

@@ -56,7 +56,11 @@ pub enum BreakActive {
 /// off.
 pub fn arm_break<T: BreakControl>(tim: &mut T) -> Result<(), BreakActive> {
     tim.clear_break_flag();
-    if tim.break_flag() { Err(BreakActive::Input) } else { Ok(()) }
+    if tim.break_flag() {
+        Err(BreakActive::Input)
+    } else {
+        Ok(())
+    }
 }
 
 /// The end of a control period: MOE is set only if nothing tripped, the drive should
@@ -106,7 +110,13 @@ mod tests {
     }
 
     fn adc(ignored: u32) -> CalibratedAdc {
-        CalibratedAdc { ignored, ready_after: 3, aden: false, polls: 0, writes: 0 }
+        CalibratedAdc {
+            ignored,
+            ready_after: 3,
+            aden: false,
+            polls: 0,
+            writes: 0,
+        }
     }
 
     /// Defect 1: with the write lost to the calibration logic a single ADEN write (the old
@@ -153,9 +163,17 @@ mod tests {
     /// input still active keeps it off.
     #[test]
     fn break_is_armed_after_routing() {
-        let mut t = Tim1 { input_active: false, bif: true, moe: false };
+        let mut t = Tim1 {
+            input_active: false,
+            bif: true,
+            moe: false,
+        };
         assert_eq!(arm_break(&mut t), Ok(()));
-        let mut t = Tim1 { input_active: true, bif: true, moe: false };
+        let mut t = Tim1 {
+            input_active: true,
+            bif: true,
+            moe: false,
+        };
         assert_eq!(arm_break(&mut t), Err(BreakActive::Input));
     }
 
@@ -164,7 +182,11 @@ mod tests {
     /// tripped) instead of setting MOE from a flag read before the pulse.
     #[test]
     fn a_break_during_the_step_keeps_the_outputs_off() {
-        let mut t = Tim1 { input_active: false, bif: false, moe: true };
+        let mut t = Tim1 {
+            input_active: false,
+            bif: false,
+            moe: true,
+        };
         let mut tripped = false;
         // The interrupt starts: no break yet.
         assert!(!t.break_flag());
@@ -177,7 +199,11 @@ mod tests {
         // And it stays off in the following periods.
         assert!(!finish_period(&mut t, &mut tripped, true));
         // Without a break the outputs follow `run`.
-        let mut t = Tim1 { input_active: false, bif: false, moe: false };
+        let mut t = Tim1 {
+            input_active: false,
+            bif: false,
+            moe: false,
+        };
         let mut tripped = false;
         assert!(finish_period(&mut t, &mut tripped, true) && t.moe);
         assert!(!finish_period(&mut t, &mut tripped, false) && !t.moe);

@@ -16,7 +16,9 @@ use motor_control::pi::{CurrentPiConfig, PiConfig, VoltageLimit};
 use motor_control::setpoint::SetpointConfig;
 
 use crate::hw;
-use crate::motor::{board, current_loop as cl, field_weakening as fw, filter, limits, observer, scaling, sensorless as sl};
+use crate::motor::{
+    board, current_loop as cl, field_weakening as fw, filter, limits, observer, scaling, sensorless as sl,
+};
 use crate::registers::{self, Field, PORTS, PortConfig};
 use crate::timing;
 
@@ -186,7 +188,10 @@ pub const BDTR: u32 = registers::bdtr(
 pub const TRIGGER: (u8, u16) = registers::trigger_channel(board::SAMPLE_AT_CARRIER_MAXIMUM == 1, PWM_PERIOD);
 
 /// ADC_JSQR of ADC1 and ADC2: the board's channels on TIM1_TRGO2.
-pub const JSQR: [u32; 2] = match (registers::jsqr(&board::ADC1_CHANNELS), registers::jsqr(&board::ADC2_CHANNELS)) {
+pub const JSQR: [u32; 2] = match (
+    registers::jsqr(&board::ADC1_CHANNELS),
+    registers::jsqr(&board::ADC2_CHANNELS),
+) {
     (Some(a), Some(b)) => [a, b],
     _ => panic!("an ADC sequence the JSQR cannot hold"),
 };

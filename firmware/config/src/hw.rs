@@ -22,7 +22,6 @@ pub const LSI_HZ: u32 = 32_000;
 /// FDCAN kernel clock \[Hz\]: PCLK1 (RCC_CCIPR.FDCANSEL = 0b10).
 pub const FDCAN_CLOCK_HZ: u32 = SYSCLK_HZ;
 
-
 /// PLL input divider M (HSI16/4 = 4 MHz, within RM0440's 2.66–8 MHz).
 pub const PLL_M: u32 = 4;
 /// PLL multiplier N (VCO 4 MHz·85 = 340 MHz, within 96–344 MHz).

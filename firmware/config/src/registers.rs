@@ -252,17 +252,47 @@ mod tests {
         let pins = [0x08, 0x09, 0x0A, 0x1D, 0x1E, 0x1F];
         let afs = [6, 6, 6, 6, 6, 4];
         let c = port_config(&pins, &afs).unwrap();
-        assert_eq!(c[0].moder, Field { mask: 0x003F_0000, value: 0x002A_0000 });
-        assert_eq!(c[0].afrh, Field { mask: 0x0000_0FFF, value: 0x0000_0666 });
+        assert_eq!(
+            c[0].moder,
+            Field {
+                mask: 0x003F_0000,
+                value: 0x002A_0000
+            }
+        );
+        assert_eq!(
+            c[0].afrh,
+            Field {
+                mask: 0x0000_0FFF,
+                value: 0x0000_0666
+            }
+        );
         assert_eq!(c[0].afrl, Field::default());
-        assert_eq!(c[1].moder, Field { mask: 0xFC00_0000, value: 0xA800_0000 });
-        assert_eq!(c[1].afrh, Field { mask: 0xFFF0_0000, value: 0x4660_0000 });
+        assert_eq!(
+            c[1].moder,
+            Field {
+                mask: 0xFC00_0000,
+                value: 0xA800_0000
+            }
+        );
+        assert_eq!(
+            c[1].afrh,
+            Field {
+                mask: 0xFFF0_0000,
+                value: 0x4660_0000
+            }
+        );
         assert_eq!(c[1].ospeedr.value, 0xFC00_0000);
         // A pin elsewhere in the register is kept: reset MODER of port A is 0xABFF_FFFF
         // (RM0440 GPIOA_MODER reset value: PA13/PA14/PA15 in their debug AF).
         assert_eq!(c[0].moder.apply(0xABFF_FFFF), 0xABEA_FFFF);
         // Output mode and BSRR reset bits of the same pins.
-        assert_eq!(output_mode(&pins)[1], Field { mask: 0xFC00_0000, value: 0x5400_0000 });
+        assert_eq!(
+            output_mode(&pins)[1],
+            Field {
+                mask: 0xFC00_0000,
+                value: 0x5400_0000
+            }
+        );
         assert_eq!(reset_bits(&pins), [0x0700_0000, 0xE000_0000, 0]);
         assert_eq!(port_config(&[0x32], &[1]), None); // port D
         assert_eq!(port_config(&[0x08], &[16]), None);
@@ -285,8 +315,20 @@ mod tests {
     #[test]
     fn sampling_registers_by_hand() {
         let [r1, r2] = smpr(&[3, 17], &[1, 3]);
-        assert_eq!(r1, Field { mask: 0b111 << 9, value: 1 << 9 });
-        assert_eq!(r2, Field { mask: 0b111 << 21, value: 3 << 21 });
+        assert_eq!(
+            r1,
+            Field {
+                mask: 0b111 << 9,
+                value: 1 << 9
+            }
+        );
+        assert_eq!(
+            r2,
+            Field {
+                mask: 0b111 << 21,
+                value: 3 << 21
+            }
+        );
     }
 
     /// 500 ns at 170 MHz → DTG 85 (0x55); LOCK 1 (0x100); OSSI, OSSR (0xC00); BKE
@@ -315,6 +357,8 @@ mod tests {
         let factory = OPTR_NSWBOOT0 | OPTR_NBOOT0 | 0x0000_00AA;
         assert!(!boots_from_flash_regardless_of_pb8(factory));
         assert!(boots_from_flash_regardless_of_pb8(factory & !OPTR_NSWBOOT0));
-        assert!(!boots_from_flash_regardless_of_pb8(factory & !OPTR_NSWBOOT0 & !OPTR_NBOOT0));
+        assert!(!boots_from_flash_regardless_of_pb8(
+            factory & !OPTR_NSWBOOT0 & !OPTR_NBOOT0
+        ));
     }
 }

@@ -293,7 +293,10 @@ fn pin_accessors(src: &str) -> Vec<(usize, String)> {
     for (n, line) in text.lines().enumerate() {
         for (i, _) in line.match_indices('.') {
             let rest = &line[i + 1..];
-            let ident: String = rest.chars().take_while(|c| c.is_ascii_alphanumeric() || *c == '_').collect();
+            let ident: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
             let digits = ident.trim_start_matches(|c: char| c.is_ascii_alphabetic());
             let name = &ident[..ident.len() - digits.len()];
             if !digits.is_empty()
@@ -324,10 +327,7 @@ fn scanner_catches_motor_numbers() {
     assert!(violations("hw.rs", bad).is_empty());
     // Pin-numbered register accessors are board facts; the generic ones are not.
     let pins = "gpioa.afrh().modify(|_, w| w.afrh8().set(6));\nw.br13().set_bit(); r.bits(); w.oc4m().set(7);";
-    assert_eq!(
-        pin_accessors(pins),
-        [(1, "afrh8".to_string()), (2, "br13".to_string())]
-    );
+    assert_eq!(pin_accessors(pins), [(1, "afrh8".to_string()), (2, "br13".to_string())]);
     assert_eq!(
         literals("let a = 5e-5; let b = 1.5e3;")
             .iter()

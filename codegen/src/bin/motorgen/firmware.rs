@@ -271,8 +271,7 @@ fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, Strin
         };
         return Err(format!(
             "MOTOR={stem} BOARD={} cargo build --release --target {TARGET} -p {PACKAGE} failed ({}):\n{stderr}{hint}",
-            t.board,
-            output.status
+            t.board, output.status
         ));
     }
     let stdout = String::from_utf8_lossy(&output.stdout);
@@ -378,7 +377,11 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
         eprintln!(
             "error: no board `{board}` in {} (no {board}.toml)\n  accepted: {}",
             boards.display(),
-            if known.is_empty() { "none: the folder holds no *.toml".to_string() } else { known.join(", ") }
+            if known.is_empty() {
+                "none: the folder holds no *.toml".to_string()
+            } else {
+                known.join(", ")
+            }
         );
         return ExitCode::FAILURE;
     }

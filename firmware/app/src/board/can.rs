@@ -14,7 +14,12 @@ use crate::hw;
 use crate::motor::board;
 
 /// FDCAN_NBTP of the bus (a build error if the clock does not divide).
-const NBTP: u32 = match nominal_bit_timing(hw::FDCAN_CLOCK_HZ, board::CAN_BIT_RATE, hw::CAN_TQ_PER_BIT, hw::CAN_TSEG2) {
+const NBTP: u32 = match nominal_bit_timing(
+    hw::FDCAN_CLOCK_HZ,
+    board::CAN_BIT_RATE,
+    hw::CAN_TQ_PER_BIT,
+    hw::CAN_TSEG2,
+) {
     Some(v) => v,
     None => panic!("the FDCAN clock does not divide into the bit rate"),
 };

@@ -52,11 +52,20 @@ pub fn init(tim1: &pac::TIM1) {
             .oc2pe()
             .set_bit()
     });
-    tim1.ccmr2_output()
-        .write(|w| w.oc3m().set(PWM_MODE_1).oc3pe().set_bit().oc4m().set(oc4m).oc4pe().set_bit());
+    tim1.ccmr2_output().write(|w| {
+        w.oc3m()
+            .set(PWM_MODE_1)
+            .oc3pe()
+            .set_bit()
+            .oc4m()
+            .set(oc4m)
+            .oc4pe()
+            .set_bit()
+    });
     // SAFETY: MMS and MMS2 take OC4REF's code (RM0440 TIMx_CR2; ST's LL_TIM_TRGO_OC4REF,
     // LL_TIM_TRGO2_OC4).
-    tim1.cr2().write(|w| unsafe { w.mms().bits(MMS_OC4REF).mms2().bits(MMS_OC4REF) });
+    tim1.cr2()
+        .write(|w| unsafe { w.mms().bits(MMS_OC4REF).mms2().bits(MMS_OC4REF) });
     tim1.ccer().write(|w| {
         w.cc1e()
             .set_bit()
