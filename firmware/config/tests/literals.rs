@@ -14,7 +14,7 @@
 //!
 //! In addition no literal anywhere in `src/` (hw.rs included; hexadecimal too) may equal
 //! a number of the generated module of the motor and board being built (magnitudes
-//! > 32, powers of ten ≥ 100 and a file's allowlisted register facts excepted): a motor
+//! up to 32, powers of ten ≥ 100 and a file's allowlisted register facts excepted): a motor
 //! or board number copied into the firmware fails even where literals are otherwise
 //! allowed. And no board-layer source may name a pin in a register accessor
 //! (`afrh8()`, `moder13()`, `idr6()`, `br13()`, …): which pins carry which signal is the
