@@ -45,8 +45,17 @@ fn position(text: &str, needle: &str) -> (usize, usize) {
     (line, col)
 }
 
-/// (file, text the error points at, key, words of the problem, words of the accepted line).
-const CORPUS: &[(&str, &str, &str, &[&str], &[&str])] = &[
+/// One corpus entry: (file, text the error points at, key, words of the problem, words
+/// of the accepted line).
+type Case = (
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static [&'static str],
+    &'static [&'static str],
+);
+
+const CORPUS: &[Case] = &[
     (
         "wrong-af.toml",
         "\"PA5\"",
