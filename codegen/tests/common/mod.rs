@@ -3,8 +3,15 @@
 
 #![allow(dead_code)] // each test crate uses its own subset
 
+pub mod recordings;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
+
+/// `motorgen`'s exit code for an I/O failure (EX_IOERR, see the CLI's `output` module).
+pub const EXIT_IO: i32 = 74;
+/// SIGXFSZ (Linux: 25): the default action of exceeding RLIMIT_FSIZE (`ulimit -f`).
+pub const SIGXFSZ: i32 = 25;
 
 /// The repository root.
 pub fn repo() -> PathBuf {
@@ -38,4 +45,23 @@ pub fn tmp(group: &str, name: &str) -> PathBuf {
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
     dir
+}
+
+/// A finished process's status, stdout and stderr, for assertion messages.
+pub fn text_of(o: &Output) -> String {
+    format!(
+        "status {:?}\nstdout:\n{}\nstderr:\n{}",
+        o.status,
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr)
+    )
+}
+
+/// Names of the temporary files (`*.tmp`) in `dir`.
+pub fn temporaries(dir: &Path) -> Vec<String> {
+    std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".tmp"))
+        .collect()
 }

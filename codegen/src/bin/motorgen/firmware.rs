@@ -27,6 +27,8 @@ use object::elf;
 use object::read::elf::{ElfFile32, FileHeader, ProgramHeader, SectionHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol};
 
+use crate::output::{err, errln, out};
+
 /// The firmware's target triple.
 const TARGET: &str = "thumbv7em-none-eabihf";
 /// The firmware package (a binary of the same name).
@@ -303,11 +305,11 @@ fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, String> 
     if t.board != codegen::board::DEFAULT_BOARD {
         out = out.join(t.board);
     }
-    std::fs::create_dir_all(&out).map_err(|e| format!("cannot create {}: {e}", out.display()))?;
     let elf_out = out.join(format!("{stem}.elf"));
     let bin_out = out.join(format!("{stem}.bin"));
-    std::fs::write(&elf_out, &bytes).map_err(|e| format!("cannot write {}: {e}", elf_out.display()))?;
-    std::fs::write(&bin_out, &image.bin).map_err(|e| format!("cannot write {}: {e}", bin_out.display()))?;
+    // The pair is replaced together or not at all.
+    crate::atomic::write_set(&out, &[(elf_out.clone(), bytes), (bin_out.clone(), image.bin.clone())])
+        .map_err(|e| e.to_string())?;
     let _ = writeln!(
         report,
         "{stem}: wrote {} and {} (load address {:#010x})",
@@ -323,13 +325,13 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
     let known = match stems(motors) {
         Ok(k) => k,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return ExitCode::FAILURE;
         }
     };
     let selected = match which {
         Which::All if known.is_empty() => {
-            eprintln!(
+            errln!(
                 "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
                 motors.display()
             );
@@ -338,7 +340,7 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
         Which::All => known,
         Which::One(stem) if known.contains(&stem) => vec![stem],
         Which::One(stem) => {
-            eprintln!(
+            errln!(
                 "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
                 motors.display(),
                 if known.is_empty() {
@@ -353,7 +355,7 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
     let root = match repo_root(motors) {
         Ok(r) => r,
         Err(e) => {
-            eprintln!("error: {e}");
+            errln!("error: {e}");
             return ExitCode::FAILURE;
         }
     };
@@ -374,7 +376,7 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
             })
             .unwrap_or_default();
         known.sort();
-        eprintln!(
+        errln!(
             "error: no board `{board}` in {} (no {board}.toml)\n  accepted: {}",
             boards.display(),
             if known.is_empty() {
@@ -392,11 +394,11 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
         match super::design_on(&motors.join(format!("{stem}.toml")), Some(&board_file)) {
             Ok(d) => {
                 for w in d.board.iter().flat_map(|b| &b.warnings) {
-                    eprintln!("warning: {stem} on {board}: {w}");
+                    errln!("warning: {stem} on {board}: {w}");
                 }
                 designs.push(d);
             }
-            Err(d) => eprint!("{d}"),
+            Err(d) => err!("{d}"),
         }
     }
     if designs.len() != selected.len() {
@@ -409,17 +411,17 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
     };
     // One motor: the constants the image is built from, as `motorgen design` prints them.
     if let [d] = designs.as_slice() {
-        print!("{}", codegen::summary::summary(d));
+        out!("{}", codegen::summary::summary(d));
     }
     let mut ok = true;
     for stem in &selected {
         match build_one(&root, &target, stem) {
-            Ok(report) => print!("{report}"),
+            Ok(report) => out!("{report}"),
             Err(e) => {
                 ok = false;
-                eprint!("error: {e}");
+                err!("error: {e}");
                 if !e.ends_with('\n') {
-                    eprintln!();
+                    errln!();
                 }
             }
         }

@@ -1,10 +1,12 @@
 //! `motorgen identify step|flux|resolver <spec> …`: identified values from recorded
 //! commissioning runs (thesis A chapter 6) into the spec's `[motor.identified]`.
 //!
-//! Every recording is read and evaluated first; the spec is only rewritten when all of
-//! them are good and the updated spec designs without error, through a temporary file
-//! in the same directory that is then renamed over the spec (nothing partial is ever
-//! written). `--dry-run` prints the change instead.
+//! The spec is locked before it is read (see [`crate::atomic::LockedSpec`]): two
+//! identifications of one spec run one after the other, and the second rewrites what the
+//! first wrote. Every recording is read and evaluated first; the spec is only rewritten
+//! when all of them are good and the updated spec designs without error, through a
+//! temporary file renamed over the spec (never a partial spec). `--dry-run` reads without
+//! the lock and prints the change instead.
 
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
@@ -18,6 +20,9 @@ use codegen::identify::{Spread, flux};
 use codegen::units::{self, Kind};
 use codegen::{Design, Diagnostic, Diagnostics, Source};
 use motor_control::commissioning::Axis;
+
+use crate::atomic::{IoFailure, LockedSpec};
+use crate::output::{err, errln, out, outln};
 
 /// What to identify.
 #[derive(Subcommand)]
@@ -88,13 +93,35 @@ pub enum AxisArg {
     Q,
 }
 
+/// Why an identification failed: bad input (located) or a file that cannot be written.
+enum Failure {
+    Input(Diagnostics),
+    Io(IoFailure),
+}
+
+impl From<Diagnostics> for Failure {
+    fn from(d: Diagnostics) -> Failure {
+        Failure::Input(d)
+    }
+}
+
+impl From<IoFailure> for Failure {
+    fn from(e: IoFailure) -> Failure {
+        Failure::Io(e)
+    }
+}
+
 /// Runs one identification; prints results or located errors.
 pub fn run(what: What) -> ExitCode {
     match run_inner(what) {
         Ok(()) => ExitCode::SUCCESS,
-        Err(e) => {
-            eprint!("{e}");
+        Err(Failure::Input(e)) => {
+            err!("{e}");
             ExitCode::FAILURE
+        }
+        Err(Failure::Io(e)) => {
+            errln!("error: {e}");
+            crate::output::io_failure()
         }
     }
 }
@@ -111,11 +138,44 @@ fn plain_error(file: &str, problem: String, accepted: &str) -> Diagnostics {
     }])
 }
 
-/// The spec's text and design.
-fn load(spec: &Path) -> Result<(String, Design), Diagnostics> {
-    let text = crate::read_spec(spec)?;
+/// The spec to update: its text and design, and (unless `--dry-run`) its lock, taken
+/// before the text is read.
+struct Loaded {
+    lock: Option<LockedSpec>,
+    text: String,
+    design: Design,
+    /// `--date` or today.
+    date: String,
+}
+
+/// Checks `--date`, then locks (unless `--dry-run`), reads and designs the spec.
+fn load(spec: &Path, common: &Common) -> Result<Loaded, Failure> {
+    let date = match &common.date {
+        Some(d) => {
+            writeback::parse_date(d)
+                .map_err(|e| plain_error("--date", e, "a date YYYY-MM-DD, e.g. --date 2025-03-14"))?;
+            d.clone()
+        }
+        None => today(),
+    };
+    let (lock, text) = if common.dry_run {
+        (None, crate::read_spec(spec)?)
+    } else {
+        if std::fs::metadata(spec).is_err() {
+            // A missing spec is reported as every command reports it.
+            crate::read_spec(spec)?;
+        }
+        let mut lock = LockedSpec::open(spec)?;
+        let text = crate::spec_text(spec, std::mem::take(&mut lock.bytes))?;
+        (Some(lock), text)
+    };
     let design = codegen::design_source(&spec.display().to_string(), &text)?;
-    Ok((text, design))
+    Ok(Loaded {
+        lock,
+        text,
+        design,
+        date,
+    })
 }
 
 /// Reads and parses every recording; all problems are reported together.
@@ -196,54 +256,79 @@ fn spread_note(label: &str, s: &Spread) -> String {
     }
 }
 
-/// Writes `entries` into the spec (or prints the change), after checking the new spec.
-fn write_back(
-    spec: &Path,
-    text: &str,
-    entries: &[Entry],
-    origin: &Origin<'_>,
-    dry_run: bool,
-) -> Result<(), Diagnostics> {
-    let file = spec.display().to_string();
-    let new = writeback::apply(text, entries, origin)
-        .map_err(|e| plain_error(&file, e, "a spec that `motorgen check` accepts"))?;
-    // The updated spec must still design; otherwise nothing is written.
-    let design = codegen::design_source(&file, &new)?;
-    if dry_run {
-        println!("--dry-run: {file} would change as follows (nothing written):");
-        print!("{}", writeback::line_diff(text, &new));
-        return Ok(());
+/// `e`, a problem of the updated spec `new`, as a problem of the identified values in
+/// the spec on disk `old`: a line identify did not change keeps its place in `old`; a
+/// line it wrote is shown as it would be written.
+fn blame_identified(e: Diagnostic, old: &str, new: &str, keys: &str) -> Diagnostic {
+    let problem = format!(
+        "with the identified {keys} written, the spec would not design: {}",
+        e.problem
+    );
+    let accepted = format!(
+        "{}; nothing was written: check the recordings, or the spec's values that this rule also uses",
+        e.accepted
+    );
+    match writeback::old_line(old, new, e.line) {
+        Some(line) => Diagnostic {
+            line,
+            problem,
+            accepted,
+            ..e
+        },
+        None => Diagnostic {
+            problem: format!(
+                "{problem} (line {} of the updated spec, which identify would write)",
+                e.line
+            ),
+            accepted,
+            ..e
+        },
     }
-    let dir = spec
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
-    let stem = spec
-        .file_name()
-        .map_or_else(|| "spec".into(), |n| n.to_string_lossy().into_owned());
-    let tmp = dir.join(format!(".{stem}.identify.tmp"));
-    let result = std::fs::write(&tmp, new.as_bytes()).and_then(|()| std::fs::rename(&tmp, spec));
-    if let Err(e) = result {
-        let _ = std::fs::remove_file(&tmp);
-        return Err(plain_error(
-            &file,
-            format!("cannot write the updated spec: {e}"),
-            "a writable spec file and directory",
+}
+
+/// Writes `entries` into the spec (or prints the change), after checking the new spec.
+fn write_back(spec: &Path, loaded: Loaded, entries: &[Entry], origin: &Origin<'_>) -> Result<(), Failure> {
+    let file = spec.display().to_string();
+    let text = &loaded.text;
+    let src = Source { file: &file, text };
+    let new = writeback::apply(text, entries, origin).map_err(|r| {
+        let at = writeback::value_span(text, &r.path).unwrap_or(0..0);
+        Diagnostics::from(src.error(at, r.key(), r.problem.clone(), r.accepted.clone()))
+    })?;
+    let keys: Vec<&str> = entries.iter().map(|e| e.key).collect();
+    let keys = keys.join(", ");
+    // The updated spec must still design; otherwise nothing is written.
+    let design = codegen::design_source(&file, &new).map_err(|d| {
+        Diagnostics(
+            d.0.into_iter()
+                .map(|e| blame_identified(e, text, &new, &keys))
+                .collect(),
+        )
+    })?;
+    let Some(lock) = loaded.lock else {
+        outln!("--dry-run: {file} would change as follows (nothing written):");
+        out!("{}", writeback::line_diff(text, &new));
+        return Ok(());
+    };
+    if lock.links() > 1 {
+        crate::output::warn(format_args!(
+            "{file} has {} hard links: it is replaced by a new file, the other links keep the old text",
+            lock.links()
         ));
     }
-    let keys: Vec<&str> = entries.iter().map(|e| e.key).collect();
-    println!("wrote [motor.identified] {} to {file}", keys.join(", "));
+    lock.replace(new.as_bytes())?;
+    outln!("wrote [motor.identified] {keys} to {file}");
     let prov: Vec<String> = design
         .motor
         .provenance
         .iter()
         .map(|(k, o)| format!("{k}: {}", format!("{:?}", o.source).to_lowercase()))
         .collect();
-    println!("design provenance now: {}", prov.join(", "));
+    outln!("design provenance now: {}", prov.join(", "));
     Ok(())
 }
 
-fn run_inner(what: What) -> Result<(), Diagnostics> {
+fn run_inner(what: What) -> Result<(), Failure> {
     match what {
         What::Step {
             spec,
@@ -261,9 +346,10 @@ fn run_inner(what: What) -> Result<(), Diagnostics> {
     }
 }
 
-fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
-    let (text, design) = load(spec)?;
-    let ts = sample_period(common, &design)?;
+fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<(), Failure> {
+    let loaded = load(spec, common)?;
+    let design = &loaded.design;
+    let ts = sample_period(common, design)?;
     let recs = recordings(csv, RecordingKind::Step, ts)?;
     let (axis, name) = match axis {
         AxisArg::D => (Axis::D, "d"),
@@ -285,21 +371,27 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
-    println!(
+    outln!(
         "{name} axis, {} recording(s), FIR order {} (group delay {} samples), T_s = {:.1} µs",
         recs.len(),
         design.fir.order,
         design.fir.group_delay_samples,
         recs[0].sample_period_s * 1e6
     );
-    println!(
+    outln!(
         "  {:<20} {:>8} {:>10} {:>10} {:>10} {:>12} {:>12}",
-        "recording", "U [V]", "R [Ω]", "τ [ms]", "L [mH]", "t_5% [T_s]", "T_d [T_s]"
+        "recording",
+        "U [V]",
+        "R [Ω]",
+        "τ [ms]",
+        "L [mH]",
+        "t_5% [T_s]",
+        "T_d [T_s]"
     );
     for (r, e) in recs.iter().zip(&estimates) {
-        println!(
+        outln!(
             "  {:<20} {:>8.3} {:>10.5} {:>10.4} {:>10.5} {:>12.2} {:>12.2}",
             short(&r.file),
             e.voltage_v,
@@ -316,13 +408,9 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         collect(|e| e.inductance_h),
         collect(|e| e.delay_samples),
     ) else {
-        return Err(plain_error(
-            &spec.display().to_string(),
-            "no recordings".into(),
-            "--csv FILE…",
-        ));
+        return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
-    println!(
+    outln!(
         "  mean: R = {:.5} Ω ± {:.2} %, L_{name} = {:.5} mH ± {:.2} %, transport delay {:.2} ± {:.2} samples (1σ)",
         r.mean,
         r.relative_percent(),
@@ -331,13 +419,12 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         d.mean,
         d.std_dev
     );
-    println!(
+    outln!(
         "  (the angle lead assumes {} samples of delay, angle_observer.lead_samples)",
         design.angle_observer.lead_samples
     );
     let label = format!("step {name}");
     let files = names(csv);
-    let date = common.date.clone().unwrap_or_else(today);
     let entries = [
         Entry {
             key: "phase_resistance",
@@ -350,17 +437,19 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
             note: spread_note(&format!("L = R·T_r/ln 9 (6.8), {label}"), &l),
         },
     ];
+    let date = loaded.date.clone();
     let origin = Origin {
         date: &date,
         label: &label,
         files: &files,
     };
-    write_back(spec, &text, &entries, &origin, common.dry_run)
+    write_back(spec, loaded, &entries, &origin)
 }
 
-fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
-    let (text, design) = load(spec)?;
-    let ts = sample_period(common, &design)?;
+fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure> {
+    let loaded = load(spec, common)?;
+    let design = &loaded.design;
+    let ts = sample_period(common, design)?;
     let recs = recordings(csv, RecordingKind::Flux, ts)?;
     let setup = flux::FluxSetup {
         resistance_ohm: design.motor.phase_resistance_ohm,
@@ -374,7 +463,7 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnos
     for r in &recs {
         match flux::identify_flux(r, &setup) {
             Ok(e) => {
-                println!(
+                outln!(
                     "  {:<20} ω_e = {:>9.1} rad/s  ψ_M = {:.5} Wb (current correction {:+.2e} Wb)",
                     short(&r.file),
                     e.mean_speed_rad_s,
@@ -387,42 +476,40 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Diagnos
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     let Some(s) = Spread::of(&values) else {
-        return Err(plain_error(
-            &spec.display().to_string(),
-            "no recordings".into(),
-            "--csv FILE…",
-        ));
+        return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
-    println!("  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
+    outln!("  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
     let files = names(csv);
-    let date = common.date.clone().unwrap_or_else(today);
     let entries = [Entry {
         key: "flux_linkage",
         value: writeback::webers(s.mean),
         note: spread_note("ψ_M = Σu_q/Σω_e at i = 0 (6.10), flux", &s),
     }];
+    let date = loaded.date.clone();
     let origin = Origin {
         date: &date,
         label: "flux",
         files: &files,
     };
-    write_back(spec, &text, &entries, &origin, common.dry_run)
+    write_back(spec, loaded, &entries, &origin)
 }
 
-fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Common) -> Result<(), Diagnostics> {
+fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Common) -> Result<(), Failure> {
     let file = spec.display().to_string();
     if offset.is_empty() && ratio.is_empty() {
         return Err(plain_error(
             "motorgen identify resolver",
             "no recordings given".into(),
             "--offset FILE… (resolver_offset runs) and/or --ratio FILE… (pole_pair_ratio runs)",
-        ));
+        )
+        .into());
     }
-    let (text, design) = load(spec)?;
-    let ts = sample_period(common, &design)?;
+    let loaded = load(spec, common)?;
+    let (text, design) = (&loaded.text, &loaded.design);
+    let ts = sample_period(common, design)?;
     let (np, nr) = (
         design.angle_observer.motor_pole_pairs,
         design.angle_observer.resolver_pole_pairs,
@@ -434,7 +521,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
     for r in &ratio_recs {
         match resolver::identify_ratio(r) {
             Ok(e) => {
-                println!(
+                outln!(
                     "  {:<20} n_p/n_r = {:.4}, directions {}",
                     short(&r.file),
                     e.ratio,
@@ -446,14 +533,11 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     let expected = f64::from(np) / f64::from(nr);
-    let src = Source {
-        file: &file,
-        text: &text,
-    };
-    let at = writeback::value_span(&text, &["motor", "pole_pairs"]).unwrap_or(0..0);
+    let src = Source { file: &file, text };
+    let at = writeback::value_span(text, &["motor", "pole_pairs"]).unwrap_or(0..0);
     for (r, e) in ratio_recs.iter().zip(&ratios) {
         if !e.directions_agree {
             errors.push(src.error(
@@ -482,10 +566,10 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     if !ratios.is_empty() {
-        println!("  pole-pair ratio agrees with the spec ({np}/{nr}); directions agree");
+        outln!("  pole-pair ratio agrees with the spec ({np}/{nr}); directions agree");
     }
     if offset.is_empty() {
         return Ok(());
@@ -495,7 +579,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
     for r in &recs {
         match resolver::identify_offset(r, np, nr) {
             Ok(e) => {
-                println!(
+                outln!(
                     "  {:<20} θ_off = {:.5} rad (θ_r within ±{:.5} rad over {} rows)",
                     short(&r.file),
                     e.offset_rad,
@@ -508,26 +592,26 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         }
     }
     if !errors.is_empty() {
-        return Err(Diagnostics(errors));
+        return Err(Diagnostics(errors).into());
     }
     let Some((mean, dev)) = resolver::combine_offsets(&offsets, np, nr) else {
-        return Err(plain_error(&file, "no recordings".into(), "--offset FILE…"));
+        return Err(plain_error(&file, "no recordings".into(), "--offset FILE…").into());
     };
-    println!(
+    outln!(
         "  mean: θ_off = {mean:.5} rad (mod 2π·n_r/n_p), runs within ±{:.3}° electrical",
         (dev * f64::from(np) / f64::from(nr)).to_degrees()
     );
     let files = names(offset);
-    let date = common.date.clone().unwrap_or_else(today);
     let entries = [Entry {
         key: "resolver_offset",
         value: writeback::radians(mean),
         note: format!("θ_off = θ_r aligned to phase U (6.9), {} run(s)", offsets.len()),
     }];
+    let date = loaded.date.clone();
     let origin = Origin {
         date: &date,
         label: "resolver offset",
         files: &files,
     };
-    write_back(spec, &text, &entries, &origin, common.dry_run)
+    write_back(spec, loaded, &entries, &origin)
 }

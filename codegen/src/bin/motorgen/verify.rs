@@ -4,19 +4,21 @@
 use std::path::Path;
 use std::process::ExitCode;
 
+use crate::output::{err, out};
+
 /// Reads, designs and verifies `spec`; prints the table; non-zero exit if a scenario fails
 /// or the spec is bad (with the located message).
 pub fn run(spec: &Path) -> ExitCode {
     let text = match crate::read_spec(spec) {
         Ok(t) => t,
         Err(e) => {
-            eprint!("{e}");
+            err!("{e}");
             return ExitCode::FAILURE;
         }
     };
     match codegen::verify::verify_source(&spec.display().to_string(), &text) {
         Ok((_, v)) => {
-            print!("{}", v.table());
+            out!("{}", v.table());
             if v.passed() {
                 ExitCode::SUCCESS
             } else {
@@ -24,7 +26,7 @@ pub fn run(spec: &Path) -> ExitCode {
             }
         }
         Err(e) => {
-            eprint!("{e}");
+            err!("{e}");
             ExitCode::FAILURE
         }
     }

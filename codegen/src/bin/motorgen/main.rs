@@ -1,12 +1,10 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
-#[path = "motorgen/firmware.rs"]
+mod atomic;
 mod firmware;
-#[path = "motorgen/identify.rs"]
 mod identify;
-#[path = "motorgen/report.rs"]
+mod output;
 mod report;
-#[path = "motorgen/verify.rs"]
 mod verify;
 
 use std::path::{Path, PathBuf};
@@ -15,6 +13,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 use codegen::render::{Output, render_with};
 use codegen::{Diagnostic, Diagnostics};
+use output::{err, errln, out, outln};
 
 /// Motor description (TOML) → tuned motor-controller constants.
 #[derive(Parser)]
@@ -158,20 +157,11 @@ fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String
     }
 }
 
-/// Writes `bytes` to `path` unless it already holds exactly them; returns whether it wrote.
-fn write_if_changed(path: &Path, bytes: &[u8]) -> std::io::Result<bool> {
-    if std::fs::read(path).is_ok_and(|old| old == bytes) {
-        return Ok(false);
-    }
-    std::fs::write(path, bytes).map(|()| true)
-}
-
 /// Reads a spec as UTF-8 text, or a diagnostic naming the file.
 fn read_spec(path: &Path) -> Result<String, Diagnostics> {
-    let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| {
         Diagnostics(vec![Diagnostic {
-            file: file.clone(),
+            file: path.display().to_string(),
             line: 1,
             column: 1,
             key: String::new(),
@@ -180,6 +170,12 @@ fn read_spec(path: &Path) -> Result<String, Diagnostics> {
             excerpt: String::new(),
         }])
     })?;
+    spec_text(path, bytes)
+}
+
+/// A spec's bytes as UTF-8 text, or a diagnostic at the first invalid byte.
+fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, Diagnostics> {
+    let file = path.display().to_string();
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(e.as_bytes());
@@ -230,7 +226,12 @@ fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    let code = run(Cli::parse());
+    output::flush();
+    code
+}
+
+fn run(cli: Cli) -> ExitCode {
     match cli.command {
         Command::Design {
             spec,
@@ -247,7 +248,7 @@ fn main() -> ExitCode {
                         match render(&d, o, templates.as_deref()) {
                             Ok(s) => s,
                             Err(e) => {
-                                eprintln!("{e}");
+                                errln!("{e}");
                                 return ExitCode::FAILURE;
                             }
                         }
@@ -256,16 +257,16 @@ fn main() -> ExitCode {
                     Format::Json => match serde_json::to_string_pretty(&d) {
                         Ok(s) => s + "\n",
                         Err(e) => {
-                            eprintln!("error: cannot serialise the design: {e}");
+                            errln!("error: cannot serialise the design: {e}");
                             return ExitCode::FAILURE;
                         }
                     },
                 };
-                print!("{out}");
+                out!("{out}");
                 ExitCode::SUCCESS
             }
             Err(e) => {
-                eprint!("{e}");
+                err!("{e}");
                 ExitCode::FAILURE
             }
         },
@@ -275,10 +276,14 @@ fn main() -> ExitCode {
             templates,
             board,
         } => {
+            if let Err(e) = atomic::check_out_dir(&out) {
+                errln!("{e}");
+                return ExitCode::FAILURE;
+            }
             let d = match design_on(&spec, board.as_deref()) {
                 Ok(d) => d,
                 Err(e) => {
-                    eprint!("{e}");
+                    err!("{e}");
                     return ExitCode::FAILURE;
                 }
             };
@@ -290,28 +295,25 @@ fn main() -> ExitCode {
             let mut files = Vec::new();
             for o in Output::ALL {
                 match render(&d, o, templates.as_deref()) {
-                    Ok(text) => files.push((out.join(o.file_name(&stem)), text)),
+                    Ok(text) => files.push((out.join(o.file_name(&stem)), text.into_bytes())),
                     Err(e) => {
-                        eprintln!("{e}");
+                        errln!("{e}");
                         return ExitCode::FAILURE;
                     }
                 }
             }
-            if let Err(e) = std::fs::create_dir_all(&out) {
-                eprintln!("error: cannot create {}: {e}", out.display());
-                return ExitCode::FAILURE;
-            }
-            for (path, text) in files {
-                match write_if_changed(&path, text.as_bytes()) {
-                    Ok(true) => println!("wrote {}", path.display()),
-                    Ok(false) => println!("unchanged {}", path.display()),
-                    Err(e) => {
-                        eprintln!("error: cannot write {}: {e}", path.display());
-                        return ExitCode::FAILURE;
+            match atomic::write_set(&out, &files) {
+                Ok(written) => {
+                    for ((path, _), w) in files.iter().zip(written) {
+                        outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
                     }
+                    ExitCode::SUCCESS
+                }
+                Err(e) => {
+                    errln!("error: {e}");
+                    output::io_failure()
                 }
             }
-            ExitCode::SUCCESS
         }
         Command::Check { specs } => {
             let mut ok = true;
@@ -319,24 +321,24 @@ fn main() -> ExitCode {
                 let is_board = std::fs::read_to_string(path).is_ok_and(|t| codegen::board::is_board_file(&t));
                 if is_board {
                     match read_spec(path).and_then(|t| codegen::board_source(&path.display().to_string(), &t)) {
-                        Ok(b) => println!("ok: {} (board: {}, {} {})", path.display(), b.name, b.chip, b.package),
+                        Ok(b) => outln!("ok: {} (board: {}, {} {})", path.display(), b.name, b.chip, b.package),
                         Err(e) => {
                             ok = false;
-                            eprint!("{e}");
+                            err!("{e}");
                         }
                     }
                     continue;
                 }
                 match design(path) {
                     Ok(d) => {
-                        println!("ok: {} ({})", path.display(), d.name);
+                        outln!("ok: {} ({})", path.display(), d.name);
                         for w in &d.warnings {
-                            println!("  warning: {w}");
+                            outln!("  warning: {w}");
                         }
                     }
                     Err(e) => {
                         ok = false;
-                        eprint!("{e}");
+                        err!("{e}");
                     }
                 }
             }
@@ -349,7 +351,7 @@ fn main() -> ExitCode {
                     .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
                 || stem.starts_with('-')
             {
-                eprintln!(
+                errln!(
                     "error: `{stem}` is not a valid motor stem\n  accepted: lowercase letters, digits and '-', e.g. my-motor-80kw"
                 );
                 return ExitCode::FAILURE;
@@ -357,7 +359,7 @@ fn main() -> ExitCode {
             let dir = motors_dir(dir);
             let path = dir.join(format!("{stem}.toml"));
             if path.exists() {
-                eprintln!(
+                errln!(
                     "error: {} already exists\n  accepted: a new stem, or edit the existing file",
                     path.display()
                 );
@@ -366,13 +368,13 @@ fn main() -> ExitCode {
             let text = match codegen::render::new_spec(&stem) {
                 Ok(t) => t,
                 Err(e) => {
-                    eprintln!("{e}");
+                    errln!("{e}");
                     return ExitCode::FAILURE;
                 }
             };
-            match std::fs::create_dir_all(&dir).and_then(|()| std::fs::write(&path, text)) {
+            match atomic::create_new(&path, text.as_bytes()) {
                 Ok(()) => {
-                    println!(
+                    outln!(
                         "wrote {}; edit it, then run `motorgen check {}`",
                         path.display(),
                         path.display()
@@ -380,8 +382,8 @@ fn main() -> ExitCode {
                     ExitCode::SUCCESS
                 }
                 Err(e) => {
-                    eprintln!("error: cannot write {}: {e}", path.display());
-                    ExitCode::FAILURE
+                    errln!("error: {e}");
+                    output::io_failure()
                 }
             }
         }
@@ -418,7 +420,7 @@ fn main() -> ExitCode {
                     .filter(|p| p.extension().is_some_and(|x| x == "toml"))
                     .collect(),
                 Err(e) => {
-                    eprintln!("error: cannot read {}: {e}", dir.display());
+                    errln!("error: cannot read {}: {e}", dir.display());
                     return ExitCode::FAILURE;
                 }
             };
@@ -429,8 +431,8 @@ fn main() -> ExitCode {
                     .map(|s| s.to_string_lossy().into_owned())
                     .unwrap_or_default();
                 match design(&path) {
-                    Ok(d) => println!("{stem:<24} {}", d.name),
-                    Err(e) => println!(
+                    Ok(d) => outln!("{stem:<24} {}", d.name),
+                    Err(e) => outln!(
                         "{stem:<24} INVALID ({} problem{})",
                         e.0.len(),
                         if e.0.len() == 1 { "" } else { "s" }

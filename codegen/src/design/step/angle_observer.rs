@@ -1,0 +1,124 @@
+//! The angle-tracking-observer section: gains (4.15) scaled to Q1.31 (4.22), the speed
+//! full scale f_s·π (4.20) against the top speed, the resolver ratio and offset (4.5) and
+//! the angle lead (4.23).
+
+use std::f64::consts::PI;
+
+use serde::Serialize;
+
+use super::Context;
+use crate::design::angle_observer;
+use crate::spec::ObserverError;
+
+/// The angle-tracking-observer design.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct ObserverOut {
+    /// Error architecture.
+    pub error: ObserverError,
+    /// ω_n [rad/s].
+    pub natural_frequency_rad_s: f64,
+    /// ζ.
+    pub damping: f64,
+    /// K_p = 2ζω_n (4.15).
+    pub kp: f64,
+    /// K_i = ω_n² (4.15).
+    pub ki: f64,
+    /// K̃_p as a real number (4.22).
+    pub kp_scaled: f64,
+    /// K̃_i as a real number (4.22).
+    pub ki_scaled: f64,
+    /// K̃_p stored integer, Q1.31.
+    pub kp_q31: i32,
+    /// K̃_i stored integer, Q1.31.
+    pub ki_q31: i32,
+    /// Relative rounding error of K̃_i.
+    pub ki_quantisation_error: f64,
+    /// n_p (motor).
+    pub motor_pole_pairs: u32,
+    /// n_r (resolver).
+    pub resolver_pole_pairs: u32,
+    /// n_p/n_r of (4.5).
+    pub electrical_per_resolver: f64,
+    /// θ_off [rad] of (4.5), if known.
+    pub resolver_offset_rad: Option<f64>,
+    /// θ_off as a Q1.31 stored integer (angle/π), if known.
+    pub resolver_offset_q31: Option<i32>,
+    /// Delay k in samples compensated by the angle lead (4.23).
+    pub lead_samples: f64,
+    /// k in Q16.16: θ_e,lead^i = θ_e^i + (ω_e^i·LEAD) >> 16, ω_e^i the per-sample electrical angle step (4.19), (4.23).
+    pub lead_q16: i32,
+    /// Lag k·ω_e,max·T_s at maximum speed [deg] (4.23).
+    pub lead_at_max_speed_deg: f64,
+    /// The error form as the generated `observer::ERROR_FORM`: 0 = trig identity (4.8),
+    /// 1 = atan2 (CORDIC phase, normalised by π).
+    pub error_form: u8,
+}
+
+/// The observer section, or `None` with the broken rules in `cx.errors`.
+pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<ObserverOut> {
+    let spec = cx.spec;
+    let m = &spec.motor;
+    let fs = cx.switching_frequency();
+    let fe_max = cx.max_electrical_frequency();
+    let o = &spec.angle_observer;
+    let obs = angle_observer::design(o.natural_frequency.value, o.damping.value, fs, o.error)
+        .map_err(|e| {
+            let (gain, scaled, what) = match e {
+                angle_observer::ObserverGainError::Overflow { gain, scaled } => {
+                    (gain, scaled, "does not fit Q1.31 (|K̃| must be < 1)")
+                }
+                angle_observer::ObserverGainError::Underflow { gain, scaled } => {
+                    (gain, scaled, "rounds to zero in Q1.31")
+                }
+            };
+            cx.errors.push(cx.src.error(
+                o.natural_frequency.span.clone(),
+                &o.natural_frequency.key,
+                format!("observer gain K̃_{} = {scaled:.3e} (4.22) {what}", &gain[1..]),
+                "a natural frequency that keeps K̃_p = 2ζω_n/(f_s·π) below 1 and K̃_i = ω_n²/(f_s²·π) above 2^−32",
+            ))
+        })
+        .ok();
+    let np = m.pole_pairs;
+    let nr = spec.resolver.pole_pairs;
+    // Observer speed full scale f_s·π rad/s of resolver angle (4.20) must hold the top speed.
+    let wr_max = f64::from(nr) * m.max_speed.value;
+    if wr_max >= fs * PI {
+        cx.errors.push(cx.src.error(
+            m.max_speed.span.clone(),
+            &m.max_speed.key,
+            format!("resolver speed n_r·ω_m,max = {wr_max:.0} rad/s exceeds the observer speed full scale f_s·π = {:.0} rad/s (4.20)", fs * PI),
+            "a maximum speed below f_s·π/n_r",
+        ));
+    }
+    let obs = obs?;
+    let offset = spec.resolver.offset.as_ref().map(|p| p.value);
+    let lead = o.lead_samples.value;
+    Some(ObserverOut {
+        error: o.error,
+        natural_frequency_rad_s: o.natural_frequency.value,
+        damping: o.damping.value,
+        kp: obs.kp,
+        ki: obs.ki,
+        kp_scaled: obs.kp_scaled,
+        ki_scaled: obs.ki_scaled,
+        kp_q31: obs.kp_q31,
+        ki_q31: obs.ki_q31,
+        ki_quantisation_error: obs.ki_quantisation_error,
+        motor_pole_pairs: np,
+        resolver_pole_pairs: nr,
+        electrical_per_resolver: f64::from(np) / f64::from(nr),
+        resolver_offset_rad: offset,
+        resolver_offset_q31: offset.map(|a| {
+            let wrapped = (a / PI + 1.0).rem_euclid(2.0) - 1.0; // [−1, 1)
+            ((wrapped * angle_observer::Q31_ONE).round() as i64).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
+        }),
+        lead_samples: lead,
+        lead_q16: (lead * 65_536.0).round() as i32,
+        lead_at_max_speed_deg: angle_observer::lag_angle(lead, 2.0 * PI * fe_max, fs).to_degrees(),
+        error_form: match o.error {
+            ObserverError::TrigIdentity => 0,
+            ObserverError::Atan2 => 1,
+        },
+    })
+}

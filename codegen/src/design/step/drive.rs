@@ -1,0 +1,51 @@
+//! The inverter operating point and the sampling rule f_s ≥ 12·f_e,max (thesis A 1.1).
+
+use serde::Serialize;
+
+use super::Context;
+use crate::design::sampling;
+
+/// Inverter operating point.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct DriveOut {
+    /// f_s [Hz].
+    pub switching_frequency_hz: f64,
+    /// T_s = 1/f_s [s].
+    pub sample_period_s: f64,
+    /// 12·f_e,max [Hz] (1.1).
+    pub min_switching_frequency_hz: f64,
+    /// U_dc [V].
+    pub dc_link_voltage_v: f64,
+    /// Lowest U_dc [V].
+    pub dc_link_voltage_min_v: f64,
+    /// Dead time [s].
+    pub dead_time_s: Option<f64>,
+}
+
+/// The drive section; f_s below 12·f_e,max (1.1) is an error at `drive.switching_frequency`.
+pub(in crate::design) fn drive(cx: &mut Context<'_>) -> DriveOut {
+    let spec = cx.spec;
+    let fs = cx.switching_frequency();
+    let fe_max = cx.max_electrical_frequency();
+    let fs_min = sampling::min_switching_frequency(fe_max);
+    if fs < fs_min {
+        let p = &spec.drive.switching_frequency;
+        cx.errors.push(cx.src.error(
+            p.span.clone(),
+            &p.key,
+            format!("f_s = {fs} Hz is below 12·f_e,max = {fs_min:.0} Hz (thesis A 1.1) for f_e,max = {fe_max:.1} Hz"),
+            format!(
+                "a switching frequency of at least {:.0} Hz, or a lower motor.max_speed",
+                fs_min.ceil()
+            ),
+        ));
+    }
+    DriveOut {
+        switching_frequency_hz: fs,
+        sample_period_s: 1.0 / fs,
+        min_switching_frequency_hz: fs_min,
+        dc_link_voltage_v: spec.drive.dc_link_voltage.value,
+        dc_link_voltage_min_v: spec.drive.dc_link_voltage_min.value,
+        dead_time_s: spec.drive.dead_time.as_ref().map(|p| p.value),
+    }
+}

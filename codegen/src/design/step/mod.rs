@@ -1,0 +1,44 @@
+//! The steps of [`super::design`], one per concern: each reads the resolved spec, checks
+//! the design rules of its concern (reporting a violation at the key that caused it) and
+//! returns its section of the [`super::Design`].
+//!
+//! The steps run in a fixed order, so diagnostics and warnings keep a stable order.
+
+pub(super) mod adc;
+pub(super) mod angle_observer;
+pub(super) mod current_loop;
+pub(super) mod drive;
+pub(super) mod field_weakening;
+pub(super) mod fir;
+pub(super) mod motor;
+pub(super) mod per_unit;
+pub(super) mod scaling;
+pub(super) mod sensorless;
+
+use crate::diagnostic::{Diagnostic, Source};
+use crate::spec::Spec;
+
+/// What every step reads and where it reports.
+pub(super) struct Context<'a> {
+    /// The resolved spec.
+    pub spec: &'a Spec,
+    /// Its file and text, for located diagnostics.
+    pub src: Source<'a>,
+    /// Rules broken so far; the design fails if any.
+    pub errors: Vec<Diagnostic>,
+    /// Non-fatal observations so far.
+    pub warnings: Vec<String>,
+}
+
+impl Context<'_> {
+    /// f_s [Hz].
+    pub fn switching_frequency(&self) -> f64 {
+        self.spec.drive.switching_frequency.value
+    }
+
+    /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).
+    pub fn max_electrical_frequency(&self) -> f64 {
+        let m = &self.spec.motor;
+        super::sampling::max_electrical_frequency(m.pole_pairs, m.max_speed.value)
+    }
+}

@@ -1,0 +1,135 @@
+//! The motor section: the values the design used, their provenance, and the warnings
+//! about ψ_M (K_t and K_e disagreeing, or ψ_M unknown).
+
+use std::collections::BTreeMap;
+use std::f64::consts::{PI, SQRT_2};
+
+use serde::Serialize;
+
+use super::Context;
+use crate::spec::{FluxCrossCheck, Param, Provenance};
+
+/// A value with where it came from, for the JSON provenance table.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Origin {
+    /// datasheet / identified / derived / default.
+    pub source: Provenance,
+    /// The key it was read from.
+    pub key: String,
+    /// Formula and inputs, for derived values.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+}
+
+impl From<&Param> for Origin {
+    fn from(p: &Param) -> Self {
+        Origin {
+            source: p.source,
+            key: p.key.clone(),
+            note: p.note.clone(),
+        }
+    }
+}
+
+/// Motor values the design used (SI).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MotorOut {
+    /// n_p.
+    pub pole_pairs: u32,
+    /// R_s [Ω].
+    pub phase_resistance_ohm: f64,
+    /// R_s at the maximum winding temperature [Ω] (thesis B 2.24), if `[thermal]` is given.
+    pub phase_resistance_hot_ohm: Option<f64>,
+    /// L_d [H].
+    pub d_inductance_h: f64,
+    /// L_q [H].
+    pub q_inductance_h: f64,
+    /// ψ_M [Wb], null if unknown.
+    pub flux_linkage_wb: Option<f64>,
+    /// ψ_M from K_t and from K_e, when both are given.
+    pub flux_cross_check: Option<FluxCrossCheck>,
+    /// τ_d = L_d/R [s].
+    pub d_time_constant_s: f64,
+    /// τ_q = L_q/R [s].
+    pub q_time_constant_s: f64,
+    /// Peak phase current, rms [A].
+    pub peak_current_a_rms: f64,
+    /// Nominal phase current, rms [A].
+    pub nominal_current_a_rms: Option<f64>,
+    /// Maximum shaft speed [rad/s].
+    pub max_speed_rad_s: f64,
+    /// Maximum shaft speed [rpm].
+    pub max_speed_rpm: f64,
+    /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).
+    pub max_electrical_frequency_hz: f64,
+    /// ω_e,max = 2π·f_e,max [rad/s] (2.19).
+    pub max_electrical_speed_rad_s: f64,
+    /// Peak phase-current amplitude √2·I_peak,rms [A] (current-circle radius, thesis B 2.51).
+    pub peak_current_a: f64,
+    /// Where each value came from.
+    pub provenance: BTreeMap<&'static str, Origin>,
+}
+
+/// The motor section; `hot_resistance` is R_s at the maximum winding temperature, when
+/// the current loop designed for it.
+pub(in crate::design) fn motor(cx: &mut Context<'_>, hot_resistance: Option<f64>) -> MotorOut {
+    let spec = cx.spec;
+    let m = &spec.motor;
+    if let Some(check) = &m.flux_cross_check
+        && check.disagreement_percent > 10.0
+    {
+        cx.warnings.push(format!(
+            "ψ_M from K_t ({:.4} Wb) and from K_e ({:.4} Wb) disagree by {:.1} %",
+            check.from_torque_constant_wb, check.from_back_emf_constant_wb, check.disagreement_percent
+        ));
+    }
+    if m.flux_linkage.is_none() {
+        cx.warnings
+            .push("ψ_M is unknown: the back-EMF feed-forward term and torque → i_q conversion are omitted".into());
+    }
+    let fe_max = cx.max_electrical_frequency();
+    let r = m.phase_resistance.value;
+    MotorOut {
+        pole_pairs: m.pole_pairs,
+        phase_resistance_ohm: r,
+        phase_resistance_hot_ohm: hot_resistance,
+        d_inductance_h: m.d_inductance.value,
+        q_inductance_h: m.q_inductance.value,
+        flux_linkage_wb: m.flux_linkage.as_ref().map(|p| p.value),
+        flux_cross_check: m.flux_cross_check.clone(),
+        d_time_constant_s: m.d_inductance.value / r,
+        q_time_constant_s: m.q_inductance.value / r,
+        peak_current_a_rms: m.peak_current.value,
+        nominal_current_a_rms: m.nominal_current.as_ref().map(|p| p.value),
+        max_speed_rad_s: m.max_speed.value,
+        max_speed_rpm: m.max_speed.value * 30.0 / PI,
+        max_electrical_frequency_hz: fe_max,
+        max_electrical_speed_rad_s: 2.0 * PI * fe_max,
+        peak_current_a: SQRT_2 * m.peak_current.value,
+        provenance: provenance(cx),
+    }
+}
+
+/// Where the design's main motor values came from; identified values carry the
+/// identification's date and source.
+fn provenance(cx: &Context<'_>) -> BTreeMap<&'static str, Origin> {
+    let m = &cx.spec.motor;
+    let mut provenance = BTreeMap::new();
+    provenance.insert("phase_resistance", Origin::from(&m.phase_resistance));
+    provenance.insert("d_inductance", Origin::from(&m.d_inductance));
+    provenance.insert("q_inductance", Origin::from(&m.q_inductance));
+    provenance.insert("peak_current", Origin::from(&m.peak_current));
+    provenance.insert("max_speed", Origin::from(&m.max_speed));
+    if let Some(p) = &m.flux_linkage {
+        provenance.insert("flux_linkage", Origin::from(p));
+    }
+    if let Some(p) = &cx.spec.resolver.offset {
+        provenance.insert("resolver_offset", Origin::from(p));
+    }
+    if let Some(note) = &m.identification {
+        for o in provenance.values_mut().filter(|o| o.source == Provenance::Identified) {
+            o.note = Some(note.clone());
+        }
+    }
+    provenance
+}

@@ -1,0 +1,86 @@
+//! `[current_loop]`: the tuning method and its bandwidth, damping and delay-compensation choices.
+
+use std::ops::Range;
+
+use super::raw::{Method, RawSpec};
+use super::resolve::Resolver_;
+use super::{Param, Provenance};
+use crate::units::Kind;
+
+/// The resolved current-loop request.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CurrentLoopSpec {
+    /// Tuning method.
+    pub method: Method,
+    /// Span of the method value.
+    pub method_span: Range<usize>,
+    /// Closed-loop bandwidth α [rad/s].
+    pub bandwidth: Param,
+    /// ζ for pole placement.
+    pub damping: Option<Param>,
+    /// Design each axis for the rise time ln 9/α of the sampled loop with its 1.5·T_s delay
+    /// (first-order methods; see `design::discrete_loop`).
+    pub compensate_delay: bool,
+}
+
+impl Resolver_<'_> {
+    pub(super) fn current_loop(&mut self, raw: &RawSpec) -> Option<CurrentLoopSpec> {
+        let c = raw.current_loop.get_ref();
+        let method = *c.method.get_ref();
+        let bandwidth = self.quantity(
+            "current_loop.bandwidth",
+            &c.bandwidth,
+            Kind::AngularFrequency,
+            Provenance::Datasheet,
+            true,
+        );
+        let damping = match (&c.damping, method) {
+            (Some(v), Method::PolePlacement) => self.number(
+                "current_loop.damping",
+                v,
+                0.0,
+                10.0,
+                "a damping ratio ζ with 0 < ζ < 10, e.g. 0.7071 (= 1/√2, thesis A §5.4.1)",
+            ),
+            (Some(v), _) => {
+                self.err(
+                    v.span(),
+                    "current_loop.damping",
+                    "`damping` is only used by method = \"pole_placement\"",
+                    "remove `damping`, or set method = \"pole_placement\"",
+                );
+                None
+            }
+            (None, Method::PolePlacement) => {
+                self.err(
+                    raw.current_loop.span(),
+                    "current_loop.damping",
+                    "method = \"pole_placement\" needs `damping`",
+                    "damping = 0.7071 (ζ = 1/√2, recommended in thesis A §5.4.1)",
+                );
+                None
+            }
+            (None, _) => None,
+        };
+        let compensate_delay = match (&c.compensate_delay, method) {
+            (Some(v), Method::PolePlacement) if *v.get_ref() => {
+                self.err(
+                    v.span(),
+                    "current_loop.compensate_delay",
+                    "delay compensation is designed for the first-order loops only",
+                    "compensate_delay = false, or method = \"imc\" or \"imc_active_damping\"",
+                );
+                false
+            }
+            (Some(v), _) => *v.get_ref(),
+            (None, _) => false,
+        };
+        Some(CurrentLoopSpec {
+            method,
+            method_span: c.method.span(),
+            bandwidth: bandwidth?,
+            damping,
+            compensate_delay,
+        })
+    }
+}

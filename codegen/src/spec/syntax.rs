@@ -1,0 +1,54 @@
+//! The first pass's errors: TOML syntax errors and serde shape errors (unknown, missing or
+//! mistyped keys), each located and rewritten in the spec's terms.
+
+use crate::diagnostic::{Diagnostics, Source};
+
+pub(super) fn syntax_error(source: Source<'_>, e: &toml::de::Error) -> Diagnostics {
+    let span = e.span().unwrap_or(0..0);
+    source
+        .error(
+            span,
+            "",
+            format!("TOML syntax error: {}", e.message().trim()),
+            "valid TOML 1.0 (https://toml.io): `key = value` lines, [section] headers, quoted strings",
+        )
+        .into()
+}
+
+/// A serde error (unknown key, missing key, wrong type, unknown variant) at its key path.
+pub(super) fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error, example: &str) -> Diagnostics {
+    let span = e.span().unwrap_or(0..0);
+    let message = e.message().trim().to_string();
+    // serde_spanned wraps values in a private field; it is not part of the user's key.
+    let path = path
+        .split('.')
+        .filter(|seg| !seg.starts_with("$__serde_spanned") && !seg.is_empty())
+        .collect::<Vec<_>>()
+        .join(".");
+    let (problem, accepted) = if let Some(rest) = message.strip_prefix("unknown field ") {
+        let (field, expected) = rest.split_once(", expected ").unwrap_or((rest, "no other keys"));
+        (
+            format!("unknown key {field} (is it misspelt?)"),
+            format!("one of {}", expected.trim_start_matches("one of ")),
+        )
+    } else if let Some(field) = message.strip_prefix("missing field ") {
+        let key = if path.is_empty() {
+            field.trim_matches('`').to_string()
+        } else {
+            format!("{path}.{}", field.trim_matches('`'))
+        };
+        (
+            format!("missing required key `{key}`"),
+            format!("the key with a value; see {example} for a complete file"),
+        )
+    } else if let Some(rest) = message.strip_prefix("unknown variant ") {
+        let (value, expected) = rest.split_once(", expected ").unwrap_or((rest, "?"));
+        (
+            format!("{value} is not a known value"),
+            format!("one of {}", expected.trim_start_matches("one of ")),
+        )
+    } else {
+        (message, format!("a value of the type this key takes; see {example}"))
+    };
+    source.error(span, path, problem, accepted).into()
+}
