@@ -217,16 +217,25 @@ fn repo_root(motors: &Path) -> Result<PathBuf, String> {
         })
 }
 
-/// Motor stems in `dir`, sorted.
-fn stems(dir: &Path) -> Result<Vec<String>, String> {
+/// The `*.toml` stems (motors or boards) in `dir`, sorted.
+fn stems(dir: &Path, what: &str) -> Result<Vec<String>, String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| format!("cannot read the motors folder {}: {e}", dir.display()))?
+        .map_err(|e| format!("cannot read the {what} folder {}: {e}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
         .collect();
     v.sort();
     Ok(v)
+}
+
+/// The "accepted:" list of an unknown stem: the stems that exist.
+fn accepted(known: &[String]) -> String {
+    if known.is_empty() {
+        "none: the folder holds no *.toml".to_string()
+    } else {
+        known.join(", ")
+    }
 }
 
 /// The motor and board an image is built for, with their folders.
@@ -322,7 +331,7 @@ fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, String> 
 
 /// The `firmware` subcommand.
 pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode {
-    let known = match stems(motors) {
+    let known = match stems(motors, "motors") {
         Ok(k) => k,
         Err(e) => {
             errln!("error: {e}");
@@ -343,11 +352,7 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
             errln!(
                 "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
                 motors.display(),
-                if known.is_empty() {
-                    "none: the folder holds no *.toml".to_string()
-                } else {
-                    known.join(", ")
-                }
+                accepted(&known)
             );
             return ExitCode::FAILURE;
         }
@@ -363,27 +368,10 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
     let boards = boards.canonicalize().unwrap_or_else(|_| boards.to_path_buf());
     let board_file = boards.join(format!("{board}.toml"));
     if !board_file.is_file() {
-        let mut known: Vec<String> = std::fs::read_dir(&boards)
-            .map(|rd| {
-                rd.flatten()
-                    .filter_map(|e| {
-                        let p = e.path();
-                        (p.extension().is_some_and(|x| x == "toml"))
-                            .then(|| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-                            .flatten()
-                    })
-                    .collect()
-            })
-            .unwrap_or_default();
-        known.sort();
         errln!(
             "error: no board `{board}` in {} (no {board}.toml)\n  accepted: {}",
             boards.display(),
-            if known.is_empty() {
-                "none: the folder holds no *.toml".to_string()
-            } else {
-                known.join(", ")
-            }
+            accepted(&stems(&boards, "boards").unwrap_or_default())
         );
         return ExitCode::FAILURE;
     }
