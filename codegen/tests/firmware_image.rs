@@ -1,6 +1,7 @@
 //! `motorgen firmware` as a user runs it: the fischer-ti085 image is built into
 //! `target/firmware/`, is a valid STM32G474 flash image and fits in 64 KiB; an unknown
-//! stem and a bad spec are refused before anything is built or written.
+//! stem and a bad spec are refused before anything is built or written; `--all` builds
+//! every motor on the default board and on the NUCLEO-G474RE + X-NUCLEO-IHM08M1 board.
 //!
 //! The image builds in the firmware workspace's own target directory, `firmware/target`,
 //! where `motorgen firmware` builds it for a user and where `tests/firmware.rs` builds the
@@ -80,26 +81,49 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
     );
 }
 
+/// `motorgen firmware --all [--board <board>]`: every motor's image is written into `dir`
+/// (relative to `target/firmware/`), under 64 KiB with the G474's stack pointer, and a
+/// flash line is printed for each; returns stderr (the board warnings).
+fn every_motor_builds(board: Option<&str>) -> String {
+    let mut args = vec!["--all"];
+    args.extend(board.iter().flat_map(|b| ["--board", *b]));
+    let out = firmware(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "motorgen firmware {args:?} failed:\n{stdout}\n{stderr}"
+    );
+    println!("{stdout}{stderr}");
+    let mut dir = repo().join("target").join("firmware");
+    if let Some(b) = board {
+        dir = dir.join(b);
+    }
+    for stem in common::motor_stems() {
+        let bin = std::fs::read(dir.join(format!("{stem}.bin"))).expect("the .bin is written");
+        assert!(bin.len() < 64 * 1024, "{stem}: {} bytes", bin.len());
+        assert_eq!(word(&bin, 0), RAM_END, "{stem}: initial stack pointer");
+        assert!(
+            stdout.contains(&format!("{stem}: flash {} bytes", bin.len())),
+            "{stem}: no flash line for {} bytes in\n{stdout}",
+            bin.len()
+        );
+    }
+    stderr.into_owned()
+}
+
+/// `firmware --all` builds every motor on the default board into `target/firmware/`.
+#[test]
+fn every_motor_builds_on_the_default_board() {
+    every_motor_builds(None);
+}
+
 /// Every motor builds on the second board, the NUCLEO-G474RE + X-NUCLEO-IHM08M1, into
 /// `target/firmware/nucleo-g474re-ihm08m1/`; the motors its ±30.7 A / 63.2 V sensing
 /// cannot serve are warned about at the board key (stderr), not refused.
 #[test]
 fn every_motor_builds_on_the_nucleo_ihm08m1_board() {
-    let board = "nucleo-g474re-ihm08m1";
-    let out = firmware(&["--all", "--board", board]);
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let stderr = String::from_utf8_lossy(&out.stderr);
-    assert!(
-        out.status.success(),
-        "motorgen firmware --all --board failed:\n{stdout}\n{stderr}"
-    );
-    println!("{stdout}{stderr}");
-    let dir = repo().join("target").join("firmware").join(board);
-    for stem in common::motor_stems() {
-        let bin = std::fs::read(dir.join(format!("{stem}.bin"))).expect("the .bin is written");
-        assert!(bin.len() < 64 * 1024, "{stem}: {} bytes", bin.len());
-        assert_eq!(word(&bin, 0), RAM_END, "{stem}: initial stack pointer");
-    }
+    let stderr = every_motor_builds(Some("nucleo-g474re-ihm08m1"));
     // Fischer's 600 V DC link is beyond the divider's 63.2 V: a warning at the key.
     assert!(
         stderr.contains("warning: fischer-ti085 on nucleo-g474re-ihm08m1:")
