@@ -230,7 +230,14 @@ impl Constant {
 /// All constants of `d`, grouped: current loop, observer, scalings, filter, limits.
 pub fn constants(d: &Design) -> Vec<Group> {
     let m = &d.motor;
-    let pv = |k: &str| prov(m.provenance.get(k));
+    // The provenance label, with the conversion from the datasheet's form where there was one.
+    let pv = |k: &str| {
+        let o = m.provenance.get(k);
+        match o.and_then(|o| o.note.as_deref()).filter(|n| n.starts_with("converted")) {
+            Some(n) => format!("{}, {n}", prov(o)),
+            None => prov(o).to_string(),
+        }
+    };
     let r_in = format!(
         "R_s = {} ({})",
         phys(m.phase_resistance_ohm, "Ω"),
@@ -440,7 +447,7 @@ pub fn constants(d: &Design) -> Vec<Group> {
             o.resolver_pole_pairs.to_string(),
             "n_r",
             "thesis A (4.5)",
-            "n_r (datasheet)".into(),
+            "n_r (spec [resolver])".into(),
         )
         .at("/angle_observer/resolver_pole_pairs"),
         c(
@@ -449,7 +456,12 @@ pub fn constants(d: &Design) -> Vec<Group> {
             phys(o.lead_samples, "samples"),
             "k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16",
             "thesis A (4.19), (4.23)",
-            format!("k = {} samples (spec)", o.lead_samples),
+            match o.lead_samples_source {
+                Provenance::Default => {
+                    format!("k = {} samples (default: 1.5·T_s delay, thesis A §4.6)", o.lead_samples)
+                }
+                _ => format!("k = {} samples (spec angle_observer.lead_samples)", o.lead_samples),
+            },
         )
         .at("/angle_observer/lead_q16"),
     ];

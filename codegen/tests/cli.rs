@@ -94,14 +94,19 @@ fn summary_shows_field_weakening_and_sensorless() {
     for needle in [
         "field weakening: V'_max = 0.9 V_max",
         "ρ = 147.0 rad/s",
-        "γ1 = ρ² = 21609.0, γ2 = 2ρ = 294.0 (4.7)",
+        "γ1 = ρ² = 21609.0 1/s², γ2 = 2ρ = 294.0 1/s (4.7)",
+        "K_p = 2ζω_n = 140 1/s, K_i = ω_n² = 4900 1/s² (4.15)",
+        "ω_min2 = 65.9 (4.69, i_d = -99.56 A at I_base)",
         "17-point MTPA table",
     ] {
         assert!(s.contains(needle), "{needle:?} not in\n{s}");
     }
-    // Fischer has no [sensorless] section and is not salient: no injection line.
+    // Fischer has no [sensorless] section and is not salient: no injection line, and the
+    // summary says why.
     let out = motorgen(&["design", "motors/fischer-ti085.toml"]);
-    assert!(!String::from_utf8_lossy(&out.stdout).contains("injection:"));
+    let s = String::from_utf8_lossy(&out.stdout);
+    assert!(!s.contains("injection:"));
+    assert!(s.contains("no signal injection — L_q = L_d: no saliency"), "{s}");
 }
 
 #[test]
@@ -531,4 +536,70 @@ fn field_weakening_rules_in_the_design() {
         "fw_085.toml",
     );
     assert_eq!(fw["voltage_fraction"].as_f64(), Some(0.85));
+}
+
+/// A misspelt key names the nearest accepted key (strsim), not only the whole list.
+#[test]
+fn unknown_key_suggests_the_nearest() {
+    let (t, line) = mutate("phase_resistance = \"0.126 Ω\"", "phase_resistence = \"0.126 Ω\"");
+    fails(
+        "typo_nearest",
+        &t,
+        line,
+        "motor.datasheet.phase_resistence",
+        &["unknown key `phase_resistence`: did you mean `phase_resistance`?"],
+    );
+}
+
+/// Datasheet forms that cannot be converted say so at their key: an rms back-EMF constant
+/// without `measured` (line to line and phase differ by √3), an unknown `measured`, and
+/// a quantity of the wrong dimension inside a compound unit.
+#[test]
+fn datasheet_forms_are_located_errors() {
+    let (t, line) = mutate(
+        "back_emf_constant = { value = \"0.296 V·s/rad\", voltage = \"rms\", measured = \"line_to_line\", speed = \"mechanical\" }",
+        "back_emf_constant = { value = \"0.296 V·s/rad\", voltage = \"rms\", speed = \"mechanical\" }",
+    );
+    fails(
+        "emf_measured",
+        &t,
+        line,
+        "motor.datasheet.back_emf_constant.measured",
+        &["differ by √3", "line_to_line"],
+    );
+    let (t, line) = mutate(
+        "phase_resistance = \"0.126 Ω\"",
+        "phase_resistance = { value = \"0.252 Ω\", measured = \"terminal\" }",
+    );
+    fails(
+        "r_measured",
+        &t,
+        line,
+        "motor.datasheet.phase_resistance.measured",
+        &["\"line_to_line\", \"phase\" or \"winding\""],
+    );
+    let (t, line) = mutate("\"0.492 N·m/A\"", "\"492 mN·m/V\"");
+    fails(
+        "kt_unit",
+        &t,
+        line,
+        "motor.datasheet.torque_constant.value",
+        &["is not a torque constant", "mN·m/A"],
+    );
+}
+
+/// Thesis B's motor without its rated current: the estimator needs I_base = √2·I_n and
+/// says so at the key that gives it (issue 13: no silent fallback to the peak current).
+#[test]
+fn estimator_without_rated_current_names_the_key() {
+    let text = std::fs::read_to_string(repo().join("motors/chalmers-hev50.toml")).unwrap();
+    let text = text.replacen("nominal_current = \"160 A\"", "", 1);
+    let line = line_of(&text, "[motor]");
+    fails(
+        "no_nominal_current",
+        &text,
+        line,
+        "motor.datasheet.nominal_current",
+        &["I_base = √2·I_n", "(4.35)"],
+    );
 }

@@ -91,11 +91,11 @@ static const int32_t OBSERVER_KI = 33495;
 static const uint32_t OBSERVER_MOTOR_POLE_PAIRS = 2;
 
 /** 1: n_r, thesis A (4.5).
- *  Inputs: n_r (datasheet). */
+ *  Inputs: n_r (spec [resolver]). */
 static const uint32_t OBSERVER_RESOLVER_POLE_PAIRS = 1;
 
 /** 1.5 samples: k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16, thesis A (4.19), (4.23).
- *  Inputs: k = 1.5 samples (spec). */
+ *  Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6). */
 static const int32_t OBSERVER_LEAD_Q16 = 98304;
 
 /** 0 rad = 0°: θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9)), thesis A (4.5), (6.9).
@@ -288,11 +288,11 @@ static const float SENSORLESS_GAMMA2 = 294.0f;
  *  Inputs: 5α_c = 7350 rad/s, ω_sw/10 = 6283.19 rad/s. */
 static const float SENSORLESS_INJECTION_FREQUENCY = 3141.5928f;
 
-/** 27.7451 V: V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum), thesis B (4.35).
+/** 27.7451 V: V_e ≥ I_base·ω_e·L_d·L_q/(10·|ΔL|) (spec sensorless.injection_voltage, default the minimum), thesis B (4.35).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, minimum 27.7451 V. */
 static const float SENSORLESS_INJECTION_VOLTAGE = 27.74513f;
 
-/** 5.65685 A: K_e = V_e·ΔL/(4·ω_e·L_d·L_q), thesis B (4.19).
+/** 5.65685 A: K_e = V_e·ΔL/(4·ω_e·L_d·L_q), ΔL = L_q − L_d signed (negative for inverse saliency; e = e_si/(2K̂_e) (4.20) either way), thesis B (4.19).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb. */
 static const float SENSORLESS_INJECTION_GAIN = 5.656854f;
 
@@ -304,8 +304,8 @@ static const float SENSORLESS_HIGHPASS = 18.849556f;
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
 static const float SENSORLESS_LOWPASS = 735.0f;
 
-/** 246.269 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max, thesis B (4.59), (4.69), Table 4.1.
- *  Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 65.8568 rad/s (θ̃ = 10.0°), I_max = 316.784 A. */
+/** 246.269 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at the MTPA i_d (3.10) of I_base, thesis B (4.59), (4.69), Table 4.1.
+ *  Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 65.8568 rad/s (θ̃ = 10.0°, i_d = -99.5588 A), I_max = 316.784 A, I_base = 226.274 A. */
 static const float SENSORLESS_LOW_SPEED = 246.26897f;
 
 /** 492.538 rad/s: ω_hs = 2·ω_ls, thesis B Table 4.1.
@@ -320,11 +320,11 @@ static const float SENSORLESS_RESET_LOWER = 147.0f;
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
 static const float SENSORLESS_RESET_UPPER = 294.0f;
 
-/** 18.433 A: |i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed), thesis B (4.92).
+/** 18.433 A: |i_q^ref| < ρ²·ψ_m/(γ0·ω_max·|ΔL|) with γ0 = ρ, while the resetting term acts (0: no limit needed), thesis B (4.92).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, ω_max = 2513.27 rad/s. */
 static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 18.433037f;
 
-/** 315.152 A: |i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency), thesis B (4.66).
+/** 315.152 A: |i_q| ≤ ψ_m/|ΔL|: no unwanted equilibria of the back-EMF estimator (0: no saliency), thesis B (4.66).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb. */
 static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 315.15152f;
 

@@ -6,7 +6,9 @@
 
 pub mod adc;
 pub mod angle_observer;
+pub mod cross_check;
 pub mod current_loop;
+pub mod dead_time;
 pub mod discrete_loop;
 
 pub mod field_weakening;
@@ -51,8 +53,8 @@ pub struct Design {
     pub angle_observer: ObserverOut,
     /// Fixed-point scalings.
     pub scaling: ScalingsOut,
-    /// Thesis-B per-unit system, if rated current and frequency are known.
-    pub per_unit: Option<PerUnitOut>,
+    /// Thesis-B per-unit system: every base the spec determines (Appendix A).
+    pub per_unit: PerUnitOut,
     /// FIR low-pass for identification.
     pub fir: fir::FirDesign,
     /// Modulator.
@@ -91,12 +93,11 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     };
     let motor = step::motor::motor(&mut cx, current_loop.hot.as_ref().map(|h| h.phase_resistance_ohm));
     let per_unit = step::per_unit::per_unit(spec);
-    let sensorless = match step::sensorless::sensorless(&cx, per_unit.as_ref()) {
-        Ok(Some((out, notes))) => {
+    let sensorless = match step::sensorless::sensorless(&cx, &per_unit) {
+        Ok((out, notes)) => {
             cx.warnings.extend(notes);
-            Some(out)
+            out
         }
-        Ok(None) => None,
         Err(e) => return Err(Diagnostics(vec![*e])),
     };
     Ok(Design {

@@ -22,6 +22,7 @@ mod resolver;
 mod sensorless;
 mod syntax;
 mod thermal;
+mod winding;
 
 use std::ops::Range;
 
@@ -34,7 +35,7 @@ pub use current_loop::CurrentLoopSpec;
 pub use drive::Drive;
 pub use field_weakening::{DEFAULT_VOLTAGE_FRACTION, FieldWeakeningSpec};
 pub use fir::FirSpec;
-pub use flux_linkage::FluxCrossCheck;
+pub use flux_linkage::FluxSource;
 pub use inverter::InverterSpec;
 pub use motor::{Harmonics, Motor};
 use raw::RawSpec;

@@ -97,7 +97,12 @@ impl<'a> Resolver_<'a> {
                 source,
                 key: key.to_string(),
                 span,
-                note: None,
+                // Compound datasheet units (mN·m/A, rpm/V, g·cm², …) keep what was written.
+                note: matches!(
+                    kind,
+                    Kind::Inertia | Kind::TorqueConstant | Kind::SpeedConstant | Kind::BackEmfConstant
+                )
+                .then(|| format!("converted from \"{text}\"")),
             }),
             Err(e) => {
                 self.err(span, key, e.problem, kind_example(kind).to_string());

@@ -70,13 +70,16 @@ pub struct SensorlessSpec {
     pub resistance_error: Option<Param>,
     /// ω_ν [rad/s], if given.
     pub speed_noise: Option<Param>,
+    /// Byte span of the `[sensorless]` table, when the spec has one.
+    pub section: Option<std::ops::Range<usize>>,
 }
 
 impl Resolver_<'_> {
     pub(super) fn sensorless(&mut self, raw: &RawSpec) -> Option<SensorlessSpec> {
-        let Some(s) = raw.sensorless.as_ref().map(|s| s.get_ref()) else {
+        let Some(section) = raw.sensorless.as_ref() else {
             return Some(SensorlessSpec::default());
         };
+        let s = section.get_ref();
         let q = |r: &mut Self, key: &str, v: &Option<Val>, kind: Kind| r.opt_quantity(key, v.as_ref(), kind, true);
         let bandwidth = q(self, "sensorless.bandwidth", &s.bandwidth, Kind::AngularFrequency);
         let max_acceleration = q(
@@ -138,6 +141,7 @@ impl Resolver_<'_> {
             lowpass,
             resistance_error,
             speed_noise,
+            section: Some(section.span()),
         })
     }
 }

@@ -124,8 +124,9 @@ pub const FIELD_WEAKENING: FieldWeakeningConfig = FieldWeakeningConfig {
 
 /// The sensorless estimator of thesis B chapter 4, every field a generated constant
 /// (`motor::sensorless`: ρ, Δω1, Δω2, ω_e, V_e, K_e, ω_hp, ω_lp, ω_ls, ω_hs; R̂_s, L̂_d,
-/// L̂_q, ψ̂_m) and the firmware's carrier delay. Signal injection only for a salient
-/// motor (generated K_e > 0); with ψ_M unknown the generated ρ is 0 (estimator off).
+/// L̂_q, ψ̂_m) and the firmware's carrier delay. Signal injection only where the design
+/// has one (generated K_e ≠ 0, negative for inverse saliency L_d > L_q); with ψ_M unknown
+/// the generated ρ is 0 (estimator off).
 pub const ESTIMATOR: EstimatorConfig = EstimatorConfig {
     sample_period: limits::SAMPLE_PERIOD_S,
     rho: sl::RHO,
@@ -138,7 +139,7 @@ pub const ESTIMATOR: EstimatorConfig = EstimatorConfig {
         upper: sl::RESET_UPPER,
         speed_max: limits::MAX_ELECTRICAL_SPEED,
     }),
-    injection: if sl::INJECTION_GAIN > 0.0 {
+    injection: if sl::INJECTION_GAIN != 0.0 {
         Some(InjectionConfig {
             amplitude: sl::INJECTION_VOLTAGE,
             frequency: sl::INJECTION_FREQUENCY,
@@ -374,7 +375,7 @@ mod tests {
     }
 
     /// The estimator is the generated constants (thesis B (4.7), (4.83), (4.19)); the
-    /// injection exists exactly when the motor is salient (L_q > L_d).
+    /// injection exists exactly when the design has one (K_e ≠ 0, which needs L_q ≠ L_d).
     #[test]
     fn estimator_is_the_generated_constants() {
         let e = ESTIMATOR;
@@ -383,11 +384,9 @@ mod tests {
             e.resetting.map(|r| (r.lower, r.upper)),
             Some((motor::sensorless::RESET_LOWER, motor::sensorless::RESET_UPPER))
         );
-        assert_eq!(
-            e.injection.is_some(),
-            motor::current_loop::FF_LQ > motor::current_loop::FF_LD && motor::sensorless::RHO > 0.0
-        );
+        assert_eq!(e.injection.is_some(), motor::sensorless::INJECTION_GAIN != 0.0);
         if let Some(i) = e.injection {
+            assert!(e.lq != e.ld && e.rho > 0.0, "injection needs saliency and an estimator");
             assert_eq!(i.gain, motor::sensorless::INJECTION_GAIN);
             assert_eq!(i.high_speed, 2.0 * i.low_speed);
         }

@@ -8,7 +8,7 @@ use serde::Serialize;
 
 use super::Context;
 use crate::design::angle_observer;
-use crate::spec::ObserverError;
+use crate::spec::{ObserverError, Provenance};
 
 /// The angle-tracking-observer design.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -45,6 +45,8 @@ pub struct ObserverOut {
     pub resolver_offset_q31: Option<i32>,
     /// Delay k in samples compensated by the angle lead (4.23).
     pub lead_samples: f64,
+    /// Where k came from: `angle_observer.lead_samples`, or the default 1.5 (thesis A §4.6).
+    pub lead_samples_source: Provenance,
     /// k in Q16.16: θ_e,lead^i = θ_e^i + (ω_e^i·LEAD) >> 16, ω_e^i the per-sample electrical angle step (4.19), (4.23).
     pub lead_q16: i32,
     /// Lag k·ω_e,max·T_s at maximum speed [deg] (4.23).
@@ -114,6 +116,7 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
             ((wrapped * angle_observer::Q31_ONE).round() as i64).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
         }),
         lead_samples: lead,
+        lead_samples_source: o.lead_samples.source,
         lead_q16: (lead * 65_536.0).round() as i32,
         lead_at_max_speed_deg: angle_observer::lag_angle(lead, 2.0 * PI * fe_max, fs).to_degrees(),
         error_form: match o.error {

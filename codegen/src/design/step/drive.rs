@@ -3,7 +3,7 @@
 use serde::Serialize;
 
 use super::Context;
-use crate::design::sampling;
+use crate::design::{dead_time, sampling};
 
 /// Inverter operating point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -18,8 +18,10 @@ pub struct DriveOut {
     pub dc_link_voltage_v: f64,
     /// Lowest U_dc [V].
     pub dc_link_voltage_min_v: f64,
-    /// Dead time [s].
+    /// Dead time [s] (`drive.dead_time`).
     pub dead_time_s: Option<f64>,
+    /// Its average voltage error U_dc·t_d·f_s [V] (see [`dead_time`]).
+    pub dead_time_voltage_error_v: Option<f64>,
 }
 
 /// The drive section; f_s below 12·f_e,max (1.1) is an error at `drive.switching_frequency`.
@@ -47,5 +49,10 @@ pub(in crate::design) fn drive(cx: &mut Context<'_>) -> DriveOut {
         dc_link_voltage_v: spec.drive.dc_link_voltage.value,
         dc_link_voltage_min_v: spec.drive.dc_link_voltage_min.value,
         dead_time_s: spec.drive.dead_time.as_ref().map(|p| p.value),
+        dead_time_voltage_error_v: spec
+            .drive
+            .dead_time
+            .as_ref()
+            .map(|p| dead_time::voltage_error(spec.drive.dc_link_voltage.value, p.value, fs)),
     }
 }
