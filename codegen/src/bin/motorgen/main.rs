@@ -37,6 +37,10 @@ enum Command {
         /// Directory with replacement templates (for rust, c, markdown).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
+        /// A board file (boards/<name>.toml): adds the `board` constants and the checks
+        /// of the motor on that board.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
     /// Write the Rust module, C header and Markdown summary of one motor into a directory
     /// (files are only rewritten when their bytes change).
@@ -50,11 +54,15 @@ enum Command {
         /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
+        /// A board file: adds its `board` constants (as `design --board`).
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
-    /// Validate specs; warnings go to stderr; exit 1 if any spec has a problem.
+    /// Validate motor specs and board files (a file with a top-level `chip` is a board);
+    /// warnings go to stderr; exit 1 if any has a problem.
     Check {
-        /// One or more motor specs.
-        #[arg(required = true, value_name = "SPEC")]
+        /// One or more motor specs or board files.
+        #[arg(required = true, value_name = "FILE")]
         specs: Vec<PathBuf>,
     },
     /// Write a commented starting spec to DIR/STEM.toml, DIR defaulting to motors/
@@ -67,9 +75,10 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
-    /// Build the STM32G474 image of one motor (or --all) into target/firmware/STEM.elf
-    /// and .bin and print its flash and RAM use (fails above the 64 KiB flash budget);
-    /// cargo's build progress is shown on stderr.
+    /// Build the STM32G474 image of one motor (or --all) on a board into
+    /// target/firmware/STEM.elf and .bin (target/firmware/BOARD/… for a board other than
+    /// the default) and print its flash and RAM use (fails above the 64 KiB flash
+    /// budget); cargo's build progress is shown on stderr.
     Firmware {
         /// Motor file stem in the motors folder, e.g. fischer-ti085.
         #[arg(required_unless_present = "all", conflicts_with = "all", value_name = "STEM")]
@@ -80,6 +89,12 @@ enum Command {
         /// Directory of motor specs (default: motors/).
         #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
+        /// Board file stem in the boards folder (default: motorgen-reference).
+        #[arg(long, value_name = "BOARD", default_value = codegen::board::DEFAULT_BOARD)]
+        board: String,
+        /// Directory of board files (default: boards/ beside the motors folder).
+        #[arg(long, value_name = "DIR")]
+        boards_dir: Option<PathBuf>,
     },
     /// Simulate the firmware's current loop and observer with the motor and print a
     /// pass/fail table of measured vs designed figures (exit 3 on a failure).
@@ -195,6 +210,21 @@ fn design(path: &Path) -> Result<codegen::Design, Failure> {
     Ok(codegen::design_source(&path.display().to_string(), &text)?)
 }
 
+/// The design of a motor, on `board` if given (its constants and checks added).
+fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failure> {
+    let Some(board) = board else {
+        return design(path);
+    };
+    let text = read_spec(path)?;
+    let board_text = read_spec(board)?;
+    Ok(codegen::design_with_board(
+        &path.display().to_string(),
+        &text,
+        &board.display().to_string(),
+        &board_text,
+    )?)
+}
+
 /// `motors/` in the working directory, else the one in this repository.
 fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
     dir.unwrap_or_else(|| {
@@ -222,8 +252,9 @@ fn run(command: Command) -> Result<(), Failure> {
             spec,
             format,
             templates,
+            board,
         } => {
-            let d = design(&spec)?;
+            let d = design_on(&spec, board.as_deref())?;
             let out = match format.output() {
                 Some(o) => render(&d, o, templates.as_deref())?,
                 None if matches!(format, Format::Json) => serde_json::to_string_pretty(&d)
@@ -234,9 +265,14 @@ fn run(command: Command) -> Result<(), Failure> {
             out!("{out}");
             Ok(())
         }
-        Command::Generate { spec, out, templates } => {
+        Command::Generate {
+            spec,
+            out,
+            templates,
+            board,
+        } => {
             atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
-            let d = design(&spec)?;
+            let d = design_on(&spec, board.as_deref())?;
             let stem = spec
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -258,6 +294,19 @@ fn run(command: Command) -> Result<(), Failure> {
             // Every spec is checked; the exit code is the gravest failure's (I/O over bad input).
             let mut failed = Vec::new();
             for path in &specs {
+                let is_board = std::fs::read_to_string(path).is_ok_and(|t| codegen::board::is_board_file(&t));
+                if is_board {
+                    let board =
+                        read_spec(path).and_then(|t| Ok(codegen::board_source(&path.display().to_string(), &t)?));
+                    match board {
+                        Ok(b) => outln!("ok: {} (board: {}, {} {})", path.display(), b.name, b.chip, b.package),
+                        Err(f) => {
+                            failed.push(f.exit);
+                            f.report();
+                        }
+                    }
+                    continue;
+                }
                 match design(path) {
                     Ok(d) => {
                         outln!("ok: {} ({})", path.display(), d.name);
@@ -275,7 +324,7 @@ fn run(command: Command) -> Result<(), Failure> {
                 None => Ok(()),
                 Some(&exit) => Err(Failure::new(
                     exit,
-                    format!("check: {} of {} specs failed", failed.len(), specs.len()),
+                    format!("check: {} of {} files failed", failed.len(), specs.len()),
                 )),
             }
         }
@@ -313,12 +362,27 @@ fn run(command: Command) -> Result<(), Failure> {
             );
             Ok(())
         }
-        Command::Firmware { stem, all, dir } => {
+        Command::Firmware {
+            stem,
+            all,
+            dir,
+            board,
+            boards_dir,
+        } => {
             let which = match stem {
                 Some(stem) if !all => firmware::Which::One(stem),
                 _ => firmware::Which::All,
             };
-            firmware::run(which, &motors_dir(dir))
+            let motors = motors_dir(dir);
+            let boards = boards_dir.unwrap_or_else(|| {
+                let beside = motors.join("..").join("boards");
+                if beside.is_dir() {
+                    beside
+                } else {
+                    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("boards")
+                }
+            });
+            firmware::run(which, &motors, &board, &boards)
         }
         Command::Verify { spec } => verify::run(&spec),
         Command::Report { spec, out } => report::run(&spec, &out),
