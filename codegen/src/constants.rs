@@ -5,6 +5,7 @@
 //! constant cannot differ between them. Every entry carries its physical value
 //! with unit, its formula, the source equation and the provenance of its inputs.
 
+mod board;
 mod field_weakening;
 mod sensorless;
 
@@ -20,11 +21,12 @@ pub struct Value {
     pub rust_type: String,
     /// Rust const expression.
     pub rust_expr: String,
-    /// C type, e.g. `float`, `int32_t`.
+    /// C type, e.g. `float`, `int32_t` (of the elements, for an array).
     pub c_type: String,
-    /// C array suffix (`[21]`) or empty.
-    pub c_array: String,
-    /// C initialiser.
+    /// Number of elements of an array constant; `None` for a scalar.
+    pub c_len: Option<usize>,
+    /// C initialiser; for an integer scalar an integer constant expression (`INT32_C(…)`),
+    /// which the header `#define`s so that it works in `#if`, `case` labels and array sizes.
     pub c_expr: String,
     /// The value as JSON-able number(s) for tests: integers are exact, floats are the f32 value.
     pub number: serde_json::Value,
@@ -116,24 +118,40 @@ fn f32v(x: f64) -> Value {
         rust_type: "f32".into(),
         rust_expr,
         c_type: "float".into(),
-        c_array: String::new(),
+        c_len: None,
         c_expr: c,
         number: serde_json::json!(x as f32),
     }
 }
 
-fn intv(x: i64, rust: &str, c: &str) -> Value {
-    let c_expr = if rust == "i32" && x == i64::from(i32::MIN) {
-        "INT32_MIN".to_string()
-    } else {
-        x.to_string()
+/// `x` as a C integer constant expression of the `<stdint.h>` type `c` (`int32_t`,
+/// `uint8_t`, …): the type's constant macro (`INT32_C(5)`, C99 §7.18.4), whose argument
+/// must be an unsigned literal, so a negative value is `(-INT32_C(5))` and the type's
+/// minimum is its named limit (`INT32_MIN`).
+fn c_integer(x: i64, c: &str) -> String {
+    let stem = c.strip_suffix("_t").unwrap_or(c).to_uppercase();
+    let min = match c {
+        "int8_t" => i64::from(i8::MIN),
+        "int16_t" => i64::from(i16::MIN),
+        "int32_t" => i64::from(i32::MIN),
+        _ => i64::MIN,
     };
+    if x == min {
+        format!("{stem}_MIN")
+    } else if x < 0 {
+        format!("(-{stem}_C({}))", x.unsigned_abs())
+    } else {
+        format!("{stem}_C({x})")
+    }
+}
+
+fn intv(x: i64, rust: &str, c: &str) -> Value {
     Value {
         rust_type: rust.into(),
         rust_expr: x.to_string(),
         c_type: c.into(),
-        c_array: String::new(),
-        c_expr,
+        c_len: None,
+        c_expr: c_integer(x, c),
         number: serde_json::json!(x),
     }
 }
@@ -143,9 +161,21 @@ fn q31v(bits: i32) -> Value {
         rust_type: "::fixed::types::I1F31".into(),
         rust_expr: format!("::fixed::types::I1F31::from_bits({bits})"),
         c_type: "int32_t".into(),
-        c_array: String::new(),
-        c_expr: bits.to_string(),
+        c_len: None,
+        c_expr: c_integer(i64::from(bits), "int32_t"),
         number: serde_json::json!(bits),
+    }
+}
+
+fn u8_array(v: &[u8]) -> Value {
+    let list = v.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
+    Value {
+        rust_type: format!("[u8; {}]", v.len()),
+        rust_expr: format!("[{list}]"),
+        c_type: "uint8_t".into(),
+        c_len: Some(v.len()),
+        c_expr: format!("{{{list}}}"),
+        number: serde_json::json!(v),
     }
 }
 
@@ -155,7 +185,7 @@ fn i16_array(v: &[i16]) -> Value {
         rust_type: format!("[i16; {}]", v.len()),
         rust_expr: format!("[{list}]"),
         c_type: "int16_t".into(),
-        c_array: format!("[{}]", v.len()),
+        c_len: Some(v.len()),
         c_expr: format!("{{{list}}}"),
         number: serde_json::json!(v),
     }
@@ -217,7 +247,14 @@ impl Constant {
 /// All constants of `d`, grouped: current loop, observer, scalings, filter, limits.
 pub fn constants(d: &Design) -> Vec<Group> {
     let m = &d.motor;
-    let pv = |k: &str| prov(m.provenance.get(k));
+    // The provenance label, with the conversion from the datasheet's form where there was one.
+    let pv = |k: &str| {
+        let o = m.provenance.get(k);
+        match o.and_then(|o| o.note.as_deref()).filter(|n| n.starts_with("converted")) {
+            Some(n) => format!("{}, {n}", prov(o)),
+            None => prov(o).to_string(),
+        }
+    };
     let r_in = format!(
         "R_s = {} ({})",
         phys(m.phase_resistance_ohm, "Ω"),
@@ -316,19 +353,20 @@ pub fn constants(d: &Design) -> Vec<Group> {
             )
             .at(j("anti_windup_gain")),
         );
-        if let Some(p) = &g.prefilter {
-            current.push(
-                c(
-                    format!("{axis}_PREFILTER"),
-                    f32v(p.discrete_coefficient),
-                    phys(p.discrete_coefficient, ""),
-                    "a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y)",
-                    "thesis A (5.16)",
-                    format!("{ins}, {fs_in}"),
-                )
-                .at(j("prefilter/discrete_coefficient")),
-            );
-        }
+        current.push(
+            c(
+                format!("{axis}_PREFILTER"),
+                f32v(g.reference_filter),
+                phys(g.reference_filter, ""),
+                match g.prefilter {
+                    Some(_) => "a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y)",
+                    None => "y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel",
+                },
+                "thesis A (5.16)",
+                format!("{ins}, {fs_in}"),
+            )
+            .at(j("reference_filter")),
+        );
     }
     let ff = &cl.feedforward;
     current.push(
@@ -427,7 +465,7 @@ pub fn constants(d: &Design) -> Vec<Group> {
             o.resolver_pole_pairs.to_string(),
             "n_r",
             "thesis A (4.5)",
-            "n_r (datasheet)".into(),
+            "n_r (spec [resolver])".into(),
         )
         .at("/angle_observer/resolver_pole_pairs"),
         c(
@@ -436,23 +474,44 @@ pub fn constants(d: &Design) -> Vec<Group> {
             phys(o.lead_samples, "samples"),
             "k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16",
             "thesis A (4.19), (4.23)",
-            format!("k = {} samples (spec)", o.lead_samples),
+            match o.lead_samples_source {
+                Provenance::Default => {
+                    format!("k = {} samples (default: 1.5·T_s delay, thesis A §4.6)", o.lead_samples)
+                }
+                _ => format!("k = {} samples (spec angle_observer.lead_samples)", o.lead_samples),
+            },
         )
         .at("/angle_observer/lead_q16"),
     ];
-    if let (Some(rad), Some(bits)) = (o.resolver_offset_rad, o.resolver_offset_q31) {
-        observer.push(
-            c(
-                "RESOLVER_OFFSET",
-                q31v(bits),
-                phys(rad, "rad"),
-                "θ_off/π, Q1.31 (wrapping)",
-                "thesis A (4.5), (6.9)",
-                format!("θ_off ({})", prov(m.provenance.get("resolver_offset"))),
-            )
-            .at("/angle_observer/resolver_offset_q31"),
-        );
-    }
+    let offset_rad = o.resolver_offset_rad.unwrap_or(0.0);
+    observer.push(
+        c(
+            "RESOLVER_OFFSET",
+            q31v(o.resolver_offset_q31.unwrap_or(0)),
+            format!("{} = {}°", phys(offset_rad, "rad"), phys(offset_rad.to_degrees(), "")),
+            "θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9))",
+            "thesis A (4.5), (6.9)",
+            match o.resolver_offset_rad {
+                Some(_) => format!("θ_off ({})", prov(m.provenance.get("resolver_offset"))),
+                None => "θ_off not in the spec: 0".into(),
+            },
+        )
+        .at("/angle_observer/resolver_offset_q31"),
+    );
+    observer.push(
+        c(
+            "ERROR_FORM",
+            intv(i64::from(o.error_form), "u8", "uint8_t"),
+            match o.error {
+                crate::spec::ObserverError::TrigIdentity => "0: trig identity".into(),
+                crate::spec::ObserverError::Atan2 => "1: atan2".into(),
+            },
+            "error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π",
+            "thesis A (4.8)–(4.10), (4.22)",
+            "angle_observer.error (spec)".into(),
+        )
+        .at("/angle_observer/error_form"),
+    );
 
     let s = &d.scaling;
     let mut scalings = Vec::new();
@@ -650,6 +709,9 @@ pub fn constants(d: &Design) -> Vec<Group> {
         field_weakening::group(d),
         sensorless::group(d),
     ]
+    .into_iter()
+    .chain(board::group(d))
+    .collect()
 }
 
 #[cfg(test)]
@@ -668,5 +730,18 @@ mod tests {
         // A value one f32 ulp off π is an ordinary literal.
         assert_eq!(f32v(f64::from(f32::from_bits(0x4049_0FDC))).rust_expr, "3.141593");
         assert_eq!(f32v(3.0).rust_expr, "3.0");
+    }
+
+    /// Integer scalars are C integer constant expressions (C99 §7.18.4.1): the stdint
+    /// macro takes an unsigned literal, the minimum is the named limit.
+    #[test]
+    fn c_integers_are_constant_expressions() {
+        assert_eq!(intv(5, "u32", "uint32_t").c_expr, "UINT32_C(5)");
+        assert_eq!(intv(-7, "i32", "int32_t").c_expr, "(-INT32_C(7))");
+        assert_eq!(intv(i64::from(i32::MIN), "i32", "int32_t").c_expr, "INT32_MIN");
+        assert_eq!(q31v(i32::MIN).c_expr, "INT32_MIN");
+        assert_eq!(q31v(1 << 30).c_expr, "INT32_C(1073741824)");
+        assert_eq!(intv(12, "u8", "uint8_t").c_expr, "UINT8_C(12)");
+        assert_eq!(i16_array(&[1, -2]).c_len, Some(2));
     }
 }

@@ -30,11 +30,17 @@ pub fn summary(d: &Design) -> String {
             )?,
             None => writeln!(s, "  ψ_M unknown")?,
         }
-        if let Some(x) = &m.flux_cross_check {
+        for x in &m.cross_checks {
             writeln!(
                 s,
-                "  ψ_M cross-check: K_t → {:.5} Wb, K_e → {:.5} Wb, disagreement {:.2} %",
-                x.from_torque_constant_wb, x.from_back_emf_constant_wb, x.disagreement_percent
+                "  cross-check {}: {:.5} vs {:.5}, {:.2} % apart{} ({} vs {})",
+                x.quantity,
+                x.a,
+                x.b,
+                x.disagreement_percent,
+                if x.fails() { " — above 5 %" } else { "" },
+                x.a_from,
+                x.b_from
             )?;
         }
         writeln!(
@@ -84,6 +90,14 @@ pub fn summary(d: &Design) -> String {
             )?;
             writeln!(s, "     {}", g.sampled.describe())?;
         }
+        if let (Some(t), Some(du)) = (d.drive.dead_time_s, d.drive.dead_time_voltage_error_v) {
+            writeln!(
+                s,
+                "  dead time {:.0} ns: voltage error U_dc·t_d·f_s = {du:.3} V ({:.2} % of V_max = U_dc/√3), a disturbance the integral action removes",
+                t * 1e9,
+                100.0 * du / (d.drive.dc_link_voltage_v / 3f64.sqrt())
+            )?;
+        }
         if let Some(k) = c.feedforward.iq_per_nm {
             writeln!(s, "  torque → i_q: {k:.5} A/(N·m) (2.34)")?;
         }
@@ -94,7 +108,7 @@ pub fn summary(d: &Design) -> String {
         )?;
         writeln!(
             s,
-            "  K_p = {}, K_i = {} (4.15); Q1.31: K̃_p = {}, K̃_i = {} (4.22)",
+            "  K_p = 2ζω_n = {} 1/s, K_i = ω_n² = {} 1/s² (4.15); Q1.31: K̃_p = {}, K̃_i = {} (4.22)",
             o.kp, o.ki, o.kp_q31, o.ki_q31
         )?;
         writeln!(
@@ -111,6 +125,19 @@ pub fn summary(d: &Design) -> String {
             "  n_p/n_r = {}; lead {} samples = {:.1}° at max speed (4.23)",
             o.electrical_per_resolver, o.lead_samples, o.lead_at_max_speed_deg
         )?;
+        let b = &d.per_unit.bases;
+        let opt = |x: Option<f64>, unit: &str| x.map_or("—".to_string(), |x| format!("{x:.6} {unit}"));
+        writeln!(
+            s,
+            "per-unit bases (thesis B App. A): V_base = {:.6} V, I_base = {}, Z_base = {}, ω_base = {}",
+            b.voltage_v,
+            opt(b.current_a, "A"),
+            opt(b.impedance_ohm, "Ω"),
+            opt(b.angular_frequency_rad_s, "rad/s")
+        )?;
+        if !d.per_unit.missing.is_empty() {
+            writeln!(s, "  not determined: {}", d.per_unit.missing.join("; "))?;
+        }
         writeln!(s, "scalings")?;
         for (name, sc) in [
             ("phase current", &d.scaling.phase_current),
@@ -148,12 +175,17 @@ pub fn summary(d: &Design) -> String {
         if let Some(fw) = &d.field_weakening {
             writeln!(
                 s,
-                "field weakening: V'_max = {} V_max = {:.2} V, α_fw = {:.2} rad/s ({:?}), ω_base = {:.1} rad/s, γ(ω_base) = {:.5} A/(V²·s) (2.60)",
+                "field weakening: V'_max = {} V_max = {:.2} V, α_fw = {:.2} rad/s ({:?}), ω_base = {:.1} rad/s ({}), γ(ω_base) = {:.5} A/(V²·s) (2.60)",
                 fw.voltage_fraction,
                 fw.voltage_limit_v,
                 fw.bandwidth_rad_s,
                 fw.bandwidth_rule,
                 fw.base_speed_rad_s,
+                match (d.per_unit.bases.angular_frequency_rad_s, fw.corner_speed_rad_s) {
+                    (Some(_), Some(w)) => format!("2π·f_n; full-current corner speed with R_s {w:.1} rad/s"),
+                    (Some(_), None) => "2π·f_n".to_string(),
+                    (None, _) => "full-current corner speed at V'_max, R_s included".to_string(),
+                },
                 fw.gain_at_base_speed
             )?;
             writeln!(
@@ -178,7 +210,7 @@ pub fn summary(d: &Design) -> String {
         if let Some(se) = &d.sensorless {
             writeln!(
                 s,
-                "sensorless: ρ = {:.1} rad/s ({:?}, ≤ α_c/10 = {:.1}), γ1 = ρ² = {:.1}, γ2 = 2ρ = {:.1} (4.7)",
+                "sensorless: ρ = {:.1} rad/s ({:?}, ≤ α_c/10 = {:.1}), γ1 = ρ² = {:.1} 1/s², γ2 = 2ρ = {:.1} 1/s (4.7)",
                 se.rho_rad_s, se.rho_rule, se.rho_max_rad_s, se.gamma1, se.gamma2
             )?;
             if let Some(inj) = &se.injection {
@@ -193,10 +225,13 @@ pub fn summary(d: &Design) -> String {
                     inj.gain_ke_a
                 )?;
             }
+            if let Some(why) = &se.no_injection {
+                writeln!(s, "  no signal injection — {why}")?;
+            }
             writeln!(
                 s,
-                "  ω_min1 = {:.1} (4.59), ω_min2 = {:.1} (4.69), ω_ls = {:.1}, ω_hs = {:.1} rad/s (Table 4.1)",
-                se.omega_min1_rad_s, se.omega_min2_rad_s, se.omega_ls_rad_s, se.omega_hs_rad_s
+                "  ω_min1 = {:.1} (4.59), ω_min2 = {:.1} (4.69, i_d = {:.2} A at I_base), ω_ls = {:.1}, ω_hs = {:.1} rad/s (Table 4.1)",
+                se.omega_min1_rad_s, se.omega_min2_rad_s, se.id_at_base_current_a, se.omega_ls_rad_s, se.omega_hs_rad_s
             )?;
         }
         for w in &d.warnings {

@@ -41,11 +41,13 @@ pub enum Kind {
     Time,
     /// dB, returned in dB (positive = attenuation).
     Decibel,
-    /// N·m/A, returned in N·m/A.
+    /// Any torque per any current (N·m/A, mN·m/A, …), returned in N·m/A.
     TorqueConstant,
-    /// V·s/rad (per rad/s), V/krpm or V/rpm, returned in V·s/rad.
+    /// V·s/rad (per rad/s), or any voltage per any speed (V/krpm, mV/rpm, …), returned in V·s/rad.
     BackEmfConstant,
-    /// kg·m².
+    /// Any speed per any voltage (rpm/V, rad/s/V, …), returned in rad/s per V.
+    SpeedConstant,
+    /// kg·m², or any mass times any area (g·cm², kg·cm², …), returned in kg·m².
     Inertia,
     /// N·m·s/rad (viscous friction b).
     ViscousFriction,
@@ -53,6 +55,10 @@ pub enum Kind {
     Angle,
     /// rad/s² or rpm/s, returned in rad/s².
     AngularAcceleration,
+    /// V/A (a current sensor's output voltage per ampere), returned in V/A.
+    Transresistance,
+    /// bit/s (a bus bit rate), returned in bit/s.
+    BitRate,
 }
 
 impl Kind {
@@ -76,10 +82,13 @@ impl Kind {
             Kind::Decibel => "a level in decibels",
             Kind::TorqueConstant => "a torque constant",
             Kind::BackEmfConstant => "a back-EMF constant",
+            Kind::SpeedConstant => "a speed constant",
             Kind::Inertia => "a moment of inertia",
             Kind::ViscousFriction => "a viscous friction coefficient",
             Kind::Angle => "an angle",
             Kind::AngularAcceleration => "an angular acceleration",
+            Kind::Transresistance => "a current-sensor gain",
+            Kind::BitRate => "a bit rate",
         }
     }
 
@@ -96,23 +105,32 @@ impl Kind {
             Kind::AngularFrequency => {
                 "an angular frequency such as \"100 rad/s\" (units: rad/s; Hz, kHz are taken as 2π·f)"
             }
-            Kind::Torque => "a torque such as \"11.1 N·m\" (units: N·m, Nm, N m)",
+            Kind::Torque => "a torque such as \"11.1 N·m\" (units: N·m, Nm, N m, mN·m, mNm, N·cm)",
             Kind::TemperatureCelsius => "a temperature such as \"20 °C\" (units: °C, degC, K)",
             Kind::Capacitance => "a capacitance such as \"5 pF\" (units: F, µF, nF, pF)",
             Kind::Energy => "an energy such as \"306 mJ\" (units: J, mJ, µJ)",
             Kind::Power => "a power such as \"50 kW\" (units: W, kW)",
             Kind::Time => "a time such as \"1.5 ms\" (units: s, ms, µs, ns)",
             Kind::Decibel => "a level in decibels such as \"40 dB\"",
-            Kind::TorqueConstant => "a torque constant such as \"0.492 N·m/A\" (units: N·m/A, Nm/A)",
-            Kind::BackEmfConstant => {
-                "a back-EMF constant such as \"0.296 V·s/rad\" (units: V·s/rad, V/(rad/s), V/krpm, V/rpm, mV/rpm)"
+            Kind::TorqueConstant => {
+                "a torque constant such as \"0.492 N·m/A\" or \"36.9 mN·m/A\" (a torque unit per a current unit: N·m/A, Nm/A, mN·m/A, mNm/A, N·cm/A)"
             }
-            Kind::Inertia => "a moment of inertia such as \"0.01 kg·m²\" (units: kg·m², kg m^2)",
+            Kind::BackEmfConstant => {
+                "a back-EMF constant such as \"0.296 V·s/rad\" or \"31 V/krpm\" (V·s/rad, or a voltage unit per a speed unit: V/(rad/s), V/krpm, V/rpm, mV/rpm, V/1000 rpm)"
+            }
+            Kind::SpeedConstant => {
+                "a speed constant such as \"259 rpm/V\" (a speed unit per a voltage unit: rpm/V, krpm/V, rad/s/V, (rad/s)/V)"
+            }
+            Kind::Inertia => {
+                "a moment of inertia such as \"181 g·cm²\" or \"0.01 kg·m²\" (kg·m², or a mass unit times an area unit: g·cm², kg·cm², g·mm², kg m^2)"
+            }
             Kind::ViscousFriction => "a viscous friction coefficient such as \"0.001 N·m·s/rad\"",
             Kind::Angle => "an angle such as \"10 °\" (units: °, deg, rad, mrad)",
             Kind::AngularAcceleration => {
                 "an angular acceleration such as \"5000 rpm/s\" (units: rad/s², rad/s^2, rpm/s, krpm/s)"
             }
+            Kind::Transresistance => "a current-sensor gain such as \"51.8 mV/A\" (units: V/A, mV/A)",
+            Kind::BitRate => "a bit rate such as \"500 kbit/s\" (units: bit/s, kbit/s, Mbit/s)",
         }
     }
 }
@@ -170,6 +188,8 @@ fn normalise(unit: &str) -> String {
         ("Ohm", "Ω"),
         ("ohms", "Ω"),
         ("ohm", "Ω"),
+        ("N·cm", "N · cm"),
+        ("Ncm", "N · cm"),
         ("N·m", "N · m"),
         ("N*m", "N · m"),
         ("N.m", "N · m"),
@@ -179,6 +199,7 @@ fn normalise(unit: &str) -> String {
         ("kg·m²", "kg · m²"),
         ("kg m^2", "kg · m²"),
         ("kg·m^2", "kg · m²"),
+        ("^2", "²"),
         ("r/min", "rpm"),
         ("RPM", "rpm"),
     ] {
@@ -194,6 +215,48 @@ fn normalise(unit: &str) -> String {
         u = format!("µ{rest}");
     }
     u
+}
+
+/// Where a compound unit `a/b` is split: at its first `/` (`V/rad/s` is V per rad/s)
+/// or its last (`rad/s/V` is rad/s per V).
+#[derive(Clone, Copy)]
+enum Split {
+    First,
+    Last,
+}
+
+/// The SI value of one `num/den` unit, each side parsed as its own kind (so every unit uom
+/// knows for that dimension is accepted): `mN · m/A` → 1 mN·m / 1 A = 1e-3. A side may
+/// carry its own number (`V/1000 rpm`) and parentheses (`V/(rad/s)`).
+fn ratio(unit: &str, num: Kind, den: Kind, at: Split) -> Option<f64> {
+    let (n, d) = match at {
+        Split::First => unit.split_once('/')?,
+        Split::Last => unit.rsplit_once('/')?,
+    };
+    let side = |kind: Kind, text: &str| {
+        let t = text.trim().trim_start_matches('(').trim_end_matches(')').trim();
+        let with_number = if t.starts_with(|c: char| c.is_ascii_digit()) {
+            t.to_string()
+        } else {
+            format!("1 {t}")
+        };
+        parse(kind, &with_number).ok().filter(|x| *x != 0.0)
+    };
+    Some(side(num, n)? / side(den, d)?)
+}
+
+/// kg·m² per unit of `unit` written as a mass unit times an area unit (`g · cm²`, `kgcm²`),
+/// both parsed by uom: the first split of the unit (separators removed) into a mass and an
+/// area that both parse.
+fn mass_times_area(unit: &str) -> Option<f64> {
+    use uom::si::{area::square_meter, mass::kilogram};
+    let compact: String = unit.chars().filter(|c| !matches!(c, ' ' | '·' | '*' | '.')).collect();
+    compact.char_indices().skip(1).find_map(|(i, _)| {
+        let (m, a) = compact.split_at(i);
+        let mass = via_uom::<q::Mass>(1.0, m)?.get::<kilogram>();
+        let area = via_uom::<q::Area>(1.0, a)?.get::<square_meter>();
+        Some(mass * area)
+    })
 }
 
 fn via_uom<Q: FromStr>(value: f64, unit: &str) -> Option<Q> {
@@ -242,7 +305,9 @@ pub fn parse(kind: Kind, text: &str) -> Result<f64, UnitError> {
         Kind::Energy => via_uom::<q::Energy>(value, &unit).map(|v| v.get::<joule>()),
         Kind::Power => via_uom::<q::Power>(value, &unit).map(|v| v.get::<watt>()),
         Kind::Time => via_uom::<q::Time>(value, &unit).map(|v| v.get::<second>()),
-        Kind::Inertia => via_uom::<q::MomentOfInertia>(value, &unit).map(|v| v.get::<kilogram_square_meter>()),
+        Kind::Inertia => via_uom::<q::MomentOfInertia>(value, &unit)
+            .map(|v| v.get::<kilogram_square_meter>())
+            .or_else(|| mass_times_area(&unit).map(|k| value * k)),
         Kind::Decibel => (unit == "dB").then_some(value),
         Kind::ViscousFriction => {
             matches!(unit.as_str(), "N · m·s/rad" | "N · m s/rad" | "N · ms/rad" | "N · m·s").then_some(value)
@@ -259,10 +324,19 @@ pub fn parse(kind: Kind, text: &str) -> Result<f64, UnitError> {
             "krpm/s" => Some(value * 1e3 * std::f64::consts::PI / 30.0),
             _ => None,
         },
-        Kind::TorqueConstant => match unit.as_str() {
-            "N · m/A" | "N · m / A" => Some(value),
+        Kind::Transresistance => match unit.as_str() {
+            "V/A" => Some(value),
+            "mV/A" => Some(value * 1e-3),
             _ => None,
         },
+        Kind::BitRate => match unit.as_str() {
+            "bit/s" | "bps" => Some(value),
+            "kbit/s" | "kbps" => Some(value * 1e3),
+            "Mbit/s" | "Mbps" => Some(value * 1e6),
+            _ => None,
+        },
+        Kind::TorqueConstant => ratio(&unit, Kind::Torque, Kind::Current, Split::Last).map(|k| value * k),
+        Kind::SpeedConstant => ratio(&unit, Kind::Speed, Kind::Voltage, Split::Last).map(|k| value * k),
         Kind::BackEmfConstant => {
             let rpm = std::f64::consts::PI / 30.0; // rad/s per rpm
             match unit.as_str() {
@@ -271,7 +345,7 @@ pub fn parse(kind: Kind, text: &str) -> Result<f64, UnitError> {
                 "V/krpm" | "V/kRPM" => Some(value / (1e3 * rpm)),
                 "V/rpm" => Some(value / rpm),
                 "mV/rpm" => Some(value * 1e-3 / rpm),
-                _ => None,
+                _ => ratio(&unit, Kind::Voltage, Kind::Speed, Split::First).map(|k| value * k),
             }
         }
     };
@@ -332,6 +406,16 @@ mod tests {
         assert!(close(parse(Kind::Voltage, "1.2e2 V").unwrap(), 120.0));
     }
 
+    /// Board quantities: 10 mΩ shunt × gain 5.18 = 51.8 mV/A; 500 kbit/s.
+    #[test]
+    fn sensor_gains_and_bit_rates() {
+        assert!(close(parse(Kind::Transresistance, "51.8 mV/A").unwrap(), 0.0518));
+        assert!(close(parse(Kind::Transresistance, "0.02 V/A").unwrap(), 0.02));
+        assert!(close(parse(Kind::BitRate, "500 kbit/s").unwrap(), 500e3));
+        assert!(close(parse(Kind::BitRate, "1 Mbit/s").unwrap(), 1e6));
+        assert!(parse(Kind::Transresistance, "5 mV").is_err());
+    }
+
     #[test]
     fn speeds_convert_rpm_to_rad_per_second() {
         // 20000 rpm = 20000·2π/60 = 2094.3951 rad/s (hand calculation).
@@ -356,6 +440,39 @@ mod tests {
         // 31 V/krpm = 31 V / (1000·π/30 rad/s) = 0.296028 V·s/rad (hand calculation).
         let k = parse(Kind::BackEmfConstant, "31 V/krpm").unwrap();
         assert!((k - 0.296_028_194_6).abs() < 1e-9, "{k}");
+    }
+
+    /// The forms datasheets print, each converted by hand:
+    /// 36.9 mN·m/A = 0.0369 N·m/A; 259 rpm/V = 259·π/30 = 27.1224 rad/s per V;
+    /// 181 g·cm² = 181·1e-3 kg·1e-4 m² = 1.81e-5 kg·m²; 2.56 kg·cm² = 2.56e-4 kg·m²;
+    /// 50 N·cm/A = 0.5 N·m/A; 31 V/1000 rpm = 31 V/krpm = 0.296028 V·s/rad;
+    /// 1 rad/s/V = 1 rad/s per V; 84.3 mNm = 0.0843 N·m.
+    #[test]
+    fn datasheet_compound_units() {
+        assert!(close(parse(Kind::TorqueConstant, "36.9 mN·m/A").unwrap(), 0.0369));
+        assert!(close(parse(Kind::TorqueConstant, "36.9 mNm/A").unwrap(), 0.0369));
+        assert!(close(parse(Kind::TorqueConstant, "50 N·cm/A").unwrap(), 0.5));
+        assert!(close(parse(Kind::TorqueConstant, "0.5 N·m/mA").unwrap(), 500.0));
+        let kn = parse(Kind::SpeedConstant, "259 rpm/V").unwrap();
+        assert!((kn - 27.122_417_1).abs() < 1e-6, "{kn}");
+        assert!(close(parse(Kind::SpeedConstant, "0.259 krpm/V").unwrap(), kn));
+        assert!(close(parse(Kind::SpeedConstant, "27 rad/s/V").unwrap(), 27.0));
+        assert!(close(parse(Kind::SpeedConstant, "27 (rad/s)/V").unwrap(), 27.0));
+        assert!(close(parse(Kind::Inertia, "181 g·cm²").unwrap(), 1.81e-5));
+        assert!(close(parse(Kind::Inertia, "181 gcm²").unwrap(), 1.81e-5));
+        assert!(close(parse(Kind::Inertia, "181 g cm^2").unwrap(), 1.81e-5));
+        assert!(close(parse(Kind::Inertia, "2.56 kg·cm²").unwrap(), 2.56e-4));
+        assert!(close(parse(Kind::Inertia, "0.01 kg·m²").unwrap(), 0.01));
+        let ke = parse(Kind::BackEmfConstant, "31 V/1000 rpm").unwrap();
+        assert!((ke - 0.296_028_194_6).abs() < 1e-9, "{ke}");
+        assert!(close(parse(Kind::BackEmfConstant, "31 V/krpm").unwrap(), ke));
+        assert!(close(parse(Kind::Torque, "84.3 mNm").unwrap(), 0.0843));
+        assert!(close(parse(Kind::Torque, "84.3 mN·m").unwrap(), 0.0843));
+        // Wrong dimension on either side is refused.
+        assert!(parse(Kind::TorqueConstant, "36.9 mN·m/V").is_err());
+        assert!(parse(Kind::SpeedConstant, "259 rpm/A").is_err());
+        assert!(parse(Kind::Inertia, "181 g·cm").is_err());
+        assert!(parse(Kind::TorqueConstant, "36.9 mN·m/0 A").is_err());
     }
 
     #[test]

@@ -32,6 +32,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const D_ANTI_WINDUP: f32 = 3.628194;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    pub const D_PREFILTER: f32 = 1.0;
     /// 0.671673 V/A: `k_p = α_c·L`, thesis B (2.38), (2.39).
     ///
     /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
@@ -56,6 +60,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const Q_ANTI_WINDUP: f32 = 1.4888188;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    pub const Q_PREFILTER: f32 = 1.0;
     /// 0.00023 H: `L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)`, thesis A (5.3).
     ///
     /// Inputs: L_d = 0.00023 H (datasheet).
@@ -90,12 +98,20 @@ pub mod observer {
     pub const MOTOR_POLE_PAIRS: u32 = 2;
     /// 1: `n_r`, thesis A (4.5).
     ///
-    /// Inputs: n_r (datasheet).
+    /// Inputs: n_r (spec [resolver]).
     pub const RESOLVER_POLE_PAIRS: u32 = 1;
     /// 1.5 samples: `k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16`, thesis A (4.19), (4.23).
     ///
-    /// Inputs: k = 1.5 samples (spec).
+    /// Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6).
     pub const LEAD_Q16: i32 = 98304;
+    /// 0 rad = 0°: `θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9))`, thesis A (4.5), (6.9).
+    ///
+    /// Inputs: θ_off not in the spec: 0.
+    pub const RESOLVER_OFFSET: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(0);
+    /// 0: trig identity: `error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π`, thesis A (4.8)–(4.10), (4.22).
+    ///
+    /// Inputs: angle_observer.error (spec).
+    pub const ERROR_FORM: u8 = 0;
 }
 
 /// Per-unit fixed-point scalings (full scale A and SI per LSB).
@@ -420,11 +436,11 @@ pub mod sensorless {
     ///
     /// Inputs: 5α_c = 7350 rad/s, ω_sw/10 = 6283.19 rad/s.
     pub const INJECTION_FREQUENCY: f32 = 3141.5928;
-    /// 27.7451 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
+    /// 27.7451 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·|ΔL|) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
     ///
     /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, minimum 27.7451 V.
     pub const INJECTION_VOLTAGE: f32 = 27.74513;
-    /// 5.65685 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q)`, thesis B (4.19).
+    /// 5.65685 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q), ΔL = L_q − L_d signed (negative for inverse saliency; e = e_si/(2K̂_e) (4.20) either way)`, thesis B (4.19).
     ///
     /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb.
     pub const INJECTION_GAIN: f32 = 5.656854;
@@ -436,9 +452,9 @@ pub mod sensorless {
     ///
     /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
     pub const LOWPASS: f32 = 735.0;
-    /// 246.269 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
+    /// 246.269 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at the MTPA i_d (3.10) of I_base`, thesis B (4.59), (4.69), Table 4.1.
     ///
-    /// Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 65.8568 rad/s (θ̃ = 10.0°), I_max = 316.784 A.
+    /// Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 65.8568 rad/s (θ̃ = 10.0°, i_d = -99.5588 A), I_max = 316.784 A, I_base = 226.274 A.
     pub const LOW_SPEED: f32 = 246.26897;
     /// 492.538 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
     ///
@@ -452,11 +468,11 @@ pub mod sensorless {
     ///
     /// Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18).
     pub const RESET_UPPER: f32 = 294.0;
-    /// 18.433 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
+    /// 18.433 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·|ΔL|) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
     ///
     /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, ω_max = 2513.27 rad/s.
     pub const IQ_LIMIT_RESETTING_A: f32 = 18.433037;
-    /// 315.152 A: `|i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
+    /// 315.152 A: `|i_q| ≤ ψ_m/|ΔL|: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
     ///
     /// Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb.
     pub const IQ_LIMIT_BIFURCATION_A: f32 = 315.15152;

@@ -32,6 +32,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const D_ANTI_WINDUP: f32 = 25.681744;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    pub const D_PREFILTER: f32 = 1.0;
     /// 0.0389382 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
     /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
@@ -56,6 +60,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const Q_ANTI_WINDUP: f32 = 25.681744;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    pub const Q_PREFILTER: f32 = 1.0;
     /// 0.000393 H: `L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)`, thesis A (5.3).
     ///
     /// Inputs: L_d = 0.000393 H (datasheet).
@@ -90,12 +98,20 @@ pub mod observer {
     pub const MOTOR_POLE_PAIRS: u32 = 4;
     /// 1: `n_r`, thesis A (4.5).
     ///
-    /// Inputs: n_r (datasheet).
+    /// Inputs: n_r (spec [resolver]).
     pub const RESOLVER_POLE_PAIRS: u32 = 1;
     /// 1.5 samples: `k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16`, thesis A (4.19), (4.23).
     ///
-    /// Inputs: k = 1.5 samples (spec).
+    /// Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6).
     pub const LEAD_Q16: i32 = 98304;
+    /// 0 rad = 0°: `θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9))`, thesis A (4.5), (6.9).
+    ///
+    /// Inputs: θ_off not in the spec: 0.
+    pub const RESOLVER_OFFSET: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(0);
+    /// 0: trig identity: `error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π`, thesis A (4.8)–(4.10), (4.22).
+    ///
+    /// Inputs: angle_observer.error (spec).
+    pub const ERROR_FORM: u8 = 0;
 }
 
 /// Per-unit fixed-point scalings (full scale A and SI per LSB).
@@ -219,18 +235,18 @@ pub mod field_weakening {
     ///
     /// Inputs: α_fw = 10·α_s, α_s = α_c/100 = 1 rad/s (no speed loop or J, b in the spec: thesis B Fig. 2.15), α_c = 100 rad/s.
     pub const BANDWIDTH: f32 = 10.0;
-    /// 4499.96 rad/s: `ω_base (electrical): ω_fw = max(ω_base, |ω_r|)`, thesis B (2.60).
+    /// 4362.49 rad/s: `ω_base (electrical): ω_fw = max(ω_base, |ω_r|)`, thesis B (2.60).
     ///
-    /// Inputs: no f_n: ω_base = the speed where the full-current MTPA point reaches V'_max (2.53).
-    pub const BASE_SPEED: f32 = 4499.9644;
+    /// Inputs: no f_n: ω_base = the corner speed where the full-current MTPA point reaches V'_max, R_s included (2.26), (2.27), (2.53).
+    pub const BASE_SPEED: f32 = 4362.4883;
     /// 0.000393 H: `L̂_d in γ = α_fw/(2·ω_fw·L̂_d·V'_max)`, thesis B (2.60).
     ///
     /// Inputs: L_d = 0.000393 H.
     pub const LD: f32 = 0.000393;
-    /// 0.0090685 A/(V²·s): `γ = α_fw/(2·ω_base·L̂_d·V'_max) at ω_fw = ω_base and the nominal V'_max`, thesis B (2.60).
+    /// 0.00935427 A/(V²·s): `γ = α_fw/(2·ω_base·L̂_d·V'_max) at ω_fw = ω_base and the nominal V'_max`, thesis B (2.60).
     ///
     /// Inputs: α_fw, ω_base, L̂_d, V'_max above.
-    pub const GAIN_AT_BASE_SPEED: f32 = 0.009068496;
+    pub const GAIN_AT_BASE_SPEED: f32 = 0.009354274;
     /// 86.267 A: `I_max: current circle, −I_max ≤ i_d^ref, i_q^ref = √(I_max² − (i_d^ref)²) in Mode B`, thesis B (2.50), (2.56), (2.57).
     ///
     /// Inputs: I_max = √2·I_peak,rms = √2·61 A.
@@ -271,57 +287,57 @@ pub mod field_weakening {
 pub mod sensorless {
     /// 0 rad/s: `ρ: estimator bandwidth, ρ ≤ α_c/10`, thesis B (4.74), Table 4.1.
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const RHO: f32 = 0.0;
     /// 0 1/s²: `γ1 = ρ²`, thesis B (4.7).
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const GAMMA1: f32 = 0.0;
     /// 0 1/s: `γ2 = 2ρ`, thesis B (4.7).
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const GAMMA2: f32 = 0.0;
     /// 0 rad/s: `ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10)`, thesis B (4.34).
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const INJECTION_FREQUENCY: f32 = 0.0;
-    /// 0 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
+    /// 0 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·|ΔL|) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const INJECTION_VOLTAGE: f32 = 0.0;
-    /// 0 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q)`, thesis B (4.19).
+    /// 0 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q), ΔL = L_q − L_d signed (negative for inverse saliency; e = e_si/(2K̂_e) (4.20) either way)`, thesis B (4.19).
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const INJECTION_GAIN: f32 = 0.0;
     /// 0 rad/s: `ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base)`, thesis B §4.3, Table 4.1.
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const HIGHPASS: f32 = 0.0;
     /// 0 rad/s: `ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ)`, thesis B Table 4.1.
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const LOWPASS: f32 = 0.0;
-    /// 0 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
+    /// 0 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at the MTPA i_d (3.10) of I_base`, thesis B (4.59), (4.69), Table 4.1.
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const LOW_SPEED: f32 = 0.0;
     /// 0 rad/s: `ω_hs = 2·ω_ls`, thesis B Table 4.1.
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const HIGH_SPEED: f32 = 0.0;
     /// 0 rad/s: `Δω1 = ρ: γ0 = 0 below`, thesis B (4.83), §4.6.
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const RESET_LOWER: f32 = 0.0;
     /// 0 rad/s: `Δω2 = 2ρ: γ0 = ρ above`, thesis B (4.83), §4.6.
     ///
-    /// Inputs: ψ_M unknown → 0 (sensorless off).
+    /// Inputs: sensorless off → 0.
     pub const RESET_UPPER: f32 = 0.0;
-    /// 0 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
+    /// 0 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·|ΔL|) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
     ///
     /// Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb, ω_max = 8377.58 rad/s.
     pub const IQ_LIMIT_RESETTING_A: f32 = 0.0;
-    /// 0 A: `|i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
+    /// 0 A: `|i_q| ≤ ψ_m/|ΔL|: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
     ///
     /// Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb.
     pub const IQ_LIMIT_BIFURCATION_A: f32 = 0.0;

@@ -98,12 +98,20 @@ pub mod observer {
     pub const MOTOR_POLE_PAIRS: u32 = 5;
     /// 1: `n_r`, thesis A (4.5).
     ///
-    /// Inputs: n_r (datasheet).
+    /// Inputs: n_r (spec [resolver]).
     pub const RESOLVER_POLE_PAIRS: u32 = 1;
     /// 1.5 samples: `k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16`, thesis A (4.19), (4.23).
     ///
-    /// Inputs: k = 1.5 samples (spec).
+    /// Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6).
     pub const LEAD_Q16: i32 = 98304;
+    /// 0 rad = 0°: `θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9))`, thesis A (4.5), (6.9).
+    ///
+    /// Inputs: θ_off not in the spec: 0.
+    pub const RESOLVER_OFFSET: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(0);
+    /// 1: atan2: `error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π`, thesis A (4.8)–(4.10), (4.22).
+    ///
+    /// Inputs: angle_observer.error (spec).
+    pub const ERROR_FORM: u8 = 1;
 }
 
 /// Per-unit fixed-point scalings (full scale A and SI per LSB).
@@ -263,11 +271,11 @@ pub mod sensorless {
     ///
     /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const INJECTION_FREQUENCY: f32 = 0.0;
-    /// 0 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
+    /// 0 V: `V_e ≥ I_base·ω_e·L_d·L_q/(10·|ΔL|) (spec sensorless.injection_voltage, default the minimum)`, thesis B (4.35).
     ///
     /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const INJECTION_VOLTAGE: f32 = 0.0;
-    /// 0 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q)`, thesis B (4.19).
+    /// 0 A: `K_e = V_e·ΔL/(4·ω_e·L_d·L_q), ΔL = L_q − L_d signed (negative for inverse saliency; e = e_si/(2K̂_e) (4.20) either way)`, thesis B (4.19).
     ///
     /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const INJECTION_GAIN: f32 = 0.0;
@@ -279,7 +287,7 @@ pub mod sensorless {
     ///
     /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const LOWPASS: f32 = 0.0;
-    /// 0 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max`, thesis B (4.59), (4.69), Table 4.1.
+    /// 0 rad/s: `ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at the MTPA i_d (3.10) of I_base`, thesis B (4.59), (4.69), Table 4.1.
     ///
     /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const LOW_SPEED: f32 = 0.0;
@@ -295,11 +303,11 @@ pub mod sensorless {
     ///
     /// Inputs: ψ_M unknown → 0 (sensorless off).
     pub const RESET_UPPER: f32 = 0.0;
-    /// 0 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
+    /// 0 A: `|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·|ΔL|) with γ0 = ρ, while the resetting term acts (0: no limit needed)`, thesis B (4.92).
     ///
     /// Inputs: L_d = 0.0054 H, L_q = 0.0076 H, ψ_M = 0 Wb, ω_max = 1570.8 rad/s.
     pub const IQ_LIMIT_RESETTING_A: f32 = 0.0;
-    /// 0 A: `|i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
+    /// 0 A: `|i_q| ≤ ψ_m/|ΔL|: no unwanted equilibria of the back-EMF estimator (0: no saliency)`, thesis B (4.66).
     ///
     /// Inputs: L_d = 0.0054 H, L_q = 0.0076 H, ψ_M = 0 Wb.
     pub const IQ_LIMIT_BIFURCATION_A: f32 = 0.0;

@@ -17,7 +17,7 @@ fn f32_array(v: &[f64]) -> Value {
         rust_type: format!("[f32; {}]", v.len()),
         rust_expr: format!("[{rust}]"),
         c_type: "float".into(),
-        c_array: format!("[{}]", v.len()),
+        c_len: Some(v.len()),
         c_expr: format!("{{{cexpr}}}"),
         number: serde_json::json!(v.iter().map(|&x| x as f32).collect::<Vec<_>>()),
     }
@@ -85,9 +85,9 @@ pub fn group(d: &Design) -> Group {
             phys(fw.speed_loop_bandwidth_rad_s.unwrap_or(0.0), "rad/s")
         ),
     };
-    let base_in = match &d.per_unit {
+    let base_in = match d.per_unit.bases.angular_frequency_rad_s {
         Some(_) => "ω_base = 2π·f_n (per-unit base, thesis B App. A)".to_string(),
-        None => "no f_n: ω_base = the speed where the full-current MTPA point reaches V'_max (2.53)".to_string(),
+        None => "no f_n: ω_base = the corner speed where the full-current MTPA point reaches V'_max, R_s included (2.26), (2.27), (2.53)".to_string(),
     };
     let imax_in = format!("I_max = √2·I_peak,rms = √2·{}", phys(m.peak_current_a_rms, "A"));
     let mtpa_in = format!(

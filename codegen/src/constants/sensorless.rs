@@ -7,15 +7,22 @@ use crate::design::sensorless::RhoRule;
 /// One entry: name, value, unit, formula, equation, inputs, JSON field below `/sensorless`.
 type Row<'a> = (&'a str, f64, &'a str, &'a str, &'a str, String, &'a str);
 
-/// The group; with ψ_M unknown the rules cannot be evaluated and every entry is 0
-/// (sensorless operation off), as for the field-weakening group. Without saliency the
-/// injection entries are 0 (no signal injection, thesis B (4.17)).
+/// The group; with ψ_M (or I_base) unknown the rules cannot be evaluated and every entry
+/// is 0 (sensorless operation off), as for the field-weakening group. Without injection
+/// (no saliency, or too little for the carrier rule) the injection entries are 0, with
+/// the reason the design gives.
 pub fn group(d: &Design) -> Group {
     let title = "Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4)";
     let s = d.sensorless.as_ref();
-    let off = |why: &str| why.to_string();
+    let off_why = if d.motor.flux_linkage_wb.is_none() {
+        "ψ_M unknown → 0 (sensorless off)"
+    } else if d.per_unit.bases.current_a.is_none() {
+        "I_n unknown: no I_base = √2·I_n for (4.24), (4.35), (4.69) → 0 (sensorless off)"
+    } else {
+        "sensorless off → 0"
+    };
     let rho_in = s.map_or_else(
-        || off("ψ_M unknown → 0 (sensorless off)"),
+        || off_why.to_string(),
         |s| match s.rho_rule {
             RhoRule::Given => "ρ = sensorless.bandwidth (spec)".into(),
             RhoRule::Acceleration => format!(
@@ -32,8 +39,11 @@ pub fn group(d: &Design) -> Group {
     let inj = s.and_then(|s| s.injection.as_ref());
     let get_inj = |f: fn(&crate::design::sensorless::InjectionOut) -> f64| inj.map_or(0.0, f);
     let inj_in = |detail: String| match (s, inj) {
-        (None, _) => off("ψ_M unknown → 0 (sensorless off)"),
-        (Some(_), None) => off("L_q ≤ L_d: no saliency, no signal injection → 0"),
+        (None, _) => off_why.to_string(),
+        (Some(s), None) => format!(
+            "no signal injection → 0: {}",
+            s.no_injection.as_ref().map_or_else(String::new, ToString::to_string)
+        ),
         (Some(_), Some(_)) => detail,
     };
     let m = &d.motor;
@@ -89,7 +99,7 @@ pub fn group(d: &Design) -> Group {
             "INJECTION_VOLTAGE",
             get_inj(|i| i.voltage_v),
             "V",
-            "V_e ≥ I_base·ω_e·L_d·L_q/(10·ΔL) (spec sensorless.injection_voltage, default the minimum)",
+            "V_e ≥ I_base·ω_e·L_d·L_q/(10·|ΔL|) (spec sensorless.injection_voltage, default the minimum)",
             "thesis B (4.35)",
             inj_in(format!(
                 "{motor_in}, minimum {}",
@@ -101,7 +111,7 @@ pub fn group(d: &Design) -> Group {
             "INJECTION_GAIN",
             get_inj(|i| i.gain_ke_a),
             "A",
-            "K_e = V_e·ΔL/(4·ω_e·L_d·L_q)",
+            "K_e = V_e·ΔL/(4·ω_e·L_d·L_q), ΔL = L_q − L_d signed (negative for inverse saliency; e = e_si/(2K̂_e) (4.20) either way)",
             "thesis B (4.19)",
             inj_in(motor_in.clone()),
             "injection/gain_ke_a",
@@ -128,16 +138,18 @@ pub fn group(d: &Design) -> Group {
             "LOW_SPEED",
             get(|s| s.omega_ls_rad_s),
             "rad/s",
-            "ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·ΔL·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at i_d = −I_max",
+            "ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at the MTPA i_d (3.10) of I_base",
             "thesis B (4.59), (4.69), Table 4.1",
             s.map_or_else(
-                || off("ψ_M unknown → 0 (sensorless off)"),
+                || off_why.to_string(),
                 |s| {
                     format!(
-                        "ω_min1 = {}, ω_min2 = {} (θ̃ = {:.1}°), {imax_in}",
+                        "ω_min1 = {}, ω_min2 = {} (θ̃ = {:.1}°, i_d = {}), {imax_in}, I_base = {}",
                         phys(s.omega_min1_rad_s, "rad/s"),
                         phys(s.omega_min2_rad_s, "rad/s"),
-                        s.angle_error_rad.to_degrees()
+                        s.angle_error_rad.to_degrees(),
+                        phys(s.id_at_base_current_a, "A"),
+                        phys(d.per_unit.bases.current_a.unwrap_or(0.0), "A")
                     )
                 },
             ),
@@ -174,7 +186,7 @@ pub fn group(d: &Design) -> Group {
             "IQ_LIMIT_RESETTING_A",
             s.and_then(|s| s.iq_limit_resetting_a).unwrap_or(0.0),
             "A",
-            "|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·ΔL) with γ0 = ρ, while the resetting term acts (0: no limit needed)",
+            "|i_q^ref| < ρ²·ψ_m/(γ0·ω_max·|ΔL|) with γ0 = ρ, while the resetting term acts (0: no limit needed)",
             "thesis B (4.92)",
             format!("{motor_in}, ω_max = {}", phys(m.max_electrical_speed_rad_s, "rad/s")),
             "iq_limit_resetting_a",
@@ -183,7 +195,7 @@ pub fn group(d: &Design) -> Group {
             "IQ_LIMIT_BIFURCATION_A",
             s.and_then(|s| s.iq_limit_bifurcation_a).unwrap_or(0.0),
             "A",
-            "|i_q| ≤ ψ_m/ΔL: no unwanted equilibria of the back-EMF estimator (0: no saliency)",
+            "|i_q| ≤ ψ_m/|ΔL|: no unwanted equilibria of the back-EMF estimator (0: no saliency)",
             "thesis B (4.66)",
             motor_in.clone(),
             "iq_limit_bifurcation_a",

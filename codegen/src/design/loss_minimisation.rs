@@ -1,6 +1,8 @@
 //! Max torque per ampere and loss-minimising d-current, thesis B chapter 3.
 //!
 //! * MTPA (3.10): `i_d = ψ_m/(2ΔL) − √((ψ_m/(2ΔL))² + i_q²)`, ΔL = L_q − L_d.
+//!   Written for ΔL > 0; for inverse saliency (ΔL < 0) the torque maximum is the other
+//!   root, `ψ_m/(2ΔL) + √(…)` ≥ 0 (see [`mtpa_id`]).
 //! * Losses: resistive (3.3), core losses in the parallel resistance R_c of Fig. 2.7
 //!   (3.4), and optionally the inverter (3.11)–(3.14). The loss-minimising point at a
 //!   given torque and speed is the minimum of these along the constant-torque curve —
@@ -17,8 +19,16 @@
 
 use std::f64::consts::{PI, SQRT_2};
 
-/// i_d,MTPA(i_q) [A] of (3.10), in the cancellation-free form
-/// `−2ΔL·i_q²/(ψ_m + √(ψ_m² + 4ΔL²·i_q²))` (algebraically identical; 0 for ΔL = 0).
+/// i_d,MTPA(i_q) \[A\] of (3.10), in the cancellation-free form
+/// `−2ΔL·i_q²/(ψ_m + √(ψ_m² + 4ΔL²·i_q²))` (0 for ΔL = 0).
+///
+/// Derivation for either sign of ΔL: at |i| = I, T ∝ i_q·(ψ_m − ΔL·i_d) (3.7) with
+/// i_q² = I² − i_d²; dT/di_d = 0 gives ΔL·i_d² − ψ_m·i_d − ΔL·i_q² = 0, roots
+/// i_d = ψ_m/(2ΔL) ± √((ψ_m/(2ΔL))² + i_q²). The product of the roots is −i_q² < 0: one
+/// root on each side of 0. The torque maximum is the root where ψ_m − ΔL·i_d > 0 (the
+/// other lies beyond i_d = ψ_m/ΔL, where the torque has turned negative): the `−` root
+/// for ΔL > 0 (i_d ≤ 0, thesis B's (3.10)) and the `+` root for ΔL < 0 (i_d ≥ 0). Both are
+/// (ψ_m − √(ψ_m² + 4ΔL²·i_q²))/(2ΔL) — multiply by the conjugate for the form used here.
 pub fn mtpa_id(psi: f64, delta_l: f64, iq: f64) -> f64 {
     let den = psi + (psi * psi + 4.0 * delta_l * delta_l * iq * iq).sqrt();
     // `+ 0.0` turns −0 into +0 (the generated tables hold no negative zeros).
@@ -29,9 +39,10 @@ pub fn mtpa_id(psi: f64, delta_l: f64, iq: f64) -> f64 {
     }
 }
 
-/// The MTPA point (i_d, i_q) [A] on the current circle |i| = `i_max` (the largest torque
+/// The MTPA point (i_d, i_q) \[A\] on the current circle |i| = `i_max` (the largest torque
 /// per (2.50)): (3.10) with i_d² + i_q² = I², i.e. `2i_d² − ψ/ΔL·i_d − I² = 0`, in the
-/// cancellation-free form `i_d = −2ΔL·I²/(ψ_m + √(ψ_m² + 8ΔL²·I²))`.
+/// cancellation-free form `i_d = −2ΔL·I²/(ψ_m + √(ψ_m² + 8ΔL²·I²))` — the torque-maximising
+/// root for either sign of ΔL, as in [`mtpa_id`].
 pub fn mtpa_corner(psi: f64, delta_l: f64, i_max: f64) -> (f64, f64) {
     let den = psi + (psi * psi + 8.0 * delta_l * delta_l * i_max * i_max).sqrt();
     let id = if den > 0.0 {
@@ -47,22 +58,22 @@ pub fn mtpa_corner(psi: f64, delta_l: f64, i_max: f64) -> (f64, f64) {
 /// r = r_CE ≈ r_T).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InverterLoss {
-    /// On-state voltage V [V].
+    /// On-state voltage V \[V\].
     pub threshold_v: f64,
-    /// Lead resistance r [Ω].
+    /// Lead resistance r \[Ω\].
     pub resistance_ohm: f64,
-    /// E_on + E_off [J].
+    /// E_on + E_off \[J\].
     pub switching_energy_j: f64,
-    /// E_rr [J].
+    /// E_rr \[J\].
     pub recovery_energy_j: f64,
-    /// I_c,nom [A].
+    /// I_c,nom \[A\].
     pub nominal_current_a: f64,
-    /// f_sw [Hz].
+    /// f_sw \[Hz\].
     pub switching_frequency_hz: f64,
 }
 
 impl InverterLoss {
-    /// P_loss,inv [W] (3.14) at the current amplitude `i` [A] (I_rms = i/√2).
+    /// P_loss,inv \[W\] (3.14) at the current amplitude `i` \[A\] (I_rms = i/√2).
     pub fn loss(&self, i: f64) -> f64 {
         let irms = i / SQRT_2;
         let cond = 2.0 * SQRT_2 * self.threshold_v * irms / PI + self.resistance_ohm * irms * irms; // (3.11)
@@ -78,19 +89,19 @@ impl InverterLoss {
 pub struct LossModel {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub rs: f64,
-    /// L_d [H].
+    /// L_d \[H\].
     pub ld: f64,
-    /// L_q [H].
+    /// L_q \[H\].
     pub lq: f64,
-    /// ψ_m [Wb].
+    /// ψ_m \[Wb\].
     pub psi: f64,
-    /// R_c [Ω]; `None` = no core losses (R_c → ∞).
+    /// R_c \[Ω\]; `None` = no core losses (R_c → ∞).
     pub rc: Option<f64>,
     /// Inverter losses, if included.
     pub inverter: Option<InverterLoss>,
-    /// Search range: i_d0 ∈ [−i_max, 0] [A].
+    /// Current-circle radius I_max \[A\]; bounds the search (see [`LossModel::search_range`]).
     pub i_max: f64,
 }
 
@@ -100,7 +111,7 @@ const GOLDEN_STEPS: usize = 100;
 const BISECTION_STEPS: usize = 100;
 
 impl LossModel {
-    /// Terminal currents (i_d, i_q) [A] of the magnetising currents at electrical speed `w` (Fig. 2.7).
+    /// Terminal currents (i_d, i_q) \[A\] of the magnetising currents at electrical speed `w` (Fig. 2.7).
     pub fn terminal(&self, w: f64, id0: f64, iq0: f64) -> (f64, f64) {
         match self.rc {
             Some(rc) => (id0 - w * self.lq * iq0 / rc, iq0 + w * (self.ld * id0 + self.psi) / rc),
@@ -113,7 +124,7 @@ impl LossModel {
         1.5 * f64::from(self.pole_pairs) * iq0 * (self.psi - (self.lq - self.ld) * id0)
     }
 
-    /// P_res (3.3) + P_co (3.4) + P_loss,inv (3.14) [W].
+    /// P_res (3.3) + P_co (3.4) + P_loss,inv (3.14) \[W\].
     pub fn loss(&self, w: f64, id0: f64, iq0: f64) -> f64 {
         let (id, iq) = self.terminal(w, id0, iq0);
         let res = 1.5 * self.rs * (id * id + iq * iq);
@@ -131,12 +142,28 @@ impl LossModel {
         if k.abs() > 0.0 { t / k } else { 0.0 }
     }
 
-    /// The loss-minimising terminal (i_d, i_q) [A] at torque `t` and speed `w`:
-    /// golden-section search over i_d0 ∈ [−i_max, 0] along the constant-torque curve.
+    /// The interval of i_d0 \[A\] the loss minimum lies in. For ΔL ≥ 0: [−I_max, 0] — the
+    /// MTPA point (3.10) is ≤ 0, the core losses (3.4) fall with the flux L_d·i_d + ψ_m
+    /// and the inverter losses (3.14) pull back towards MTPA, so nothing favours i_d0 > 0.
+    /// For inverse saliency (ΔL < 0) the MTPA point is ≥ 0 and the core losses pull it
+    /// down: [max(−I_max, ψ_m/ΔL), I_max], stopping where the torque factor ψ_m − ΔL·i_d0
+    /// of (3.7) changes sign (beyond it no i_q0 gives the torque with that sign).
+    pub fn search_range(&self) -> (f64, f64) {
+        let dl = self.lq - self.ld;
+        if dl >= 0.0 {
+            (-self.i_max, 0.0)
+        } else {
+            ((self.psi / dl).max(-self.i_max), self.i_max)
+        }
+    }
+
+    /// The loss-minimising terminal (i_d, i_q) \[A\] at torque `t` and speed `w`:
+    /// golden-section search over i_d0 in [`LossModel::search_range`] along the
+    /// constant-torque curve.
     pub fn optimum(&self, w: f64, t: f64) -> (f64, f64) {
         let f = |id0: f64| self.loss(w, id0, self.iq0_for(t, id0));
         let g = (5f64.sqrt() - 1.0) / 2.0;
-        let (mut a, mut b) = (-self.i_max, 0.0);
+        let (mut a, mut b) = self.search_range();
         let (mut c, mut d) = (b - g * (b - a), a + g * (b - a));
         let (mut fc, mut fd) = (f(c), f(d));
         for _ in 0..GOLDEN_STEPS {
@@ -158,13 +185,13 @@ impl LossModel {
         self.terminal(w, id0, self.iq0_for(t, id0))
     }
 
-    /// The loss-minimising i_d [A] at terminal `iq` [A] ≥ 0 and speed `w` ≥ 0: bisection on
+    /// The loss-minimising i_d \[A\] at terminal `iq` \[A\] ≥ 0 and speed `w` ≥ 0: bisection on
     /// the torque until the optimum's terminal i_q is `iq`, then kept inside the current
     /// circle (2.50) — losses fall monotonically towards the unconstrained optimum along
     /// the constant-torque curve, so the constrained optimum lies on the circle.
     pub fn id_at(&self, w: f64, iq: f64) -> f64 {
         let circle = (self.i_max * self.i_max - iq * iq).max(0.0).sqrt();
-        self.unconstrained_id_at(w, iq).max(-circle)
+        self.unconstrained_id_at(w, iq).clamp(-circle, circle)
     }
 
     fn unconstrained_id_at(&self, w: f64, iq: f64) -> f64 {
@@ -205,11 +232,11 @@ pub fn midpoint_error(xs: &[f64], ys: &[f64], exact: impl Fn(f64) -> f64) -> f64
 pub struct LossTable {
     /// Electrical speeds ω [rad/s] (rows).
     pub speeds_rad_s: Vec<f64>,
-    /// |i_q| grid [A] (columns), the MTPA grid.
+    /// |i_q| grid \[A\] (columns), the MTPA grid.
     pub iq_a: Vec<f64>,
-    /// i_d [A], row-major: `id_a[k·iq_a.len() + j]` at `speeds_rad_s[k]`, `iq_a[j]`.
+    /// i_d \[A\], row-major: `id_a[k·iq_a.len() + j]` at `speeds_rad_s[k]`, `iq_a[j]`.
     pub id_a: Vec<f64>,
-    /// Largest bilinear-interpolation error [A] against the numeric optimum at the cell
+    /// Largest bilinear-interpolation error \[A\] against the numeric optimum at the cell
     /// centres and edge midpoints.
     pub max_interpolation_error_a: f64,
 }
@@ -357,6 +384,82 @@ mod tests {
     fn inverter_loss_by_hand() {
         let p = chalmers(None, true).inverter.unwrap().loss(300.0);
         assert!((p - 4221.56).abs() < 0.05, "{p}");
+    }
+
+    /// An inverse-saliency variant of the thesis B motor (L_d = 0.70 mH > L_q = 0.56 mH,
+    /// ΔL = −0.14 mH; ψ, R_s, n_p of Table B.2) — a labelled variant, no public data.
+    fn inverse(rc: Option<f64>) -> LossModel {
+        LossModel {
+            ld: 0.70e-3,
+            lq: 0.56e-3,
+            ..chalmers(rc, false)
+        }
+    }
+
+    /// (3.10) for inverse saliency, by hand: a = ψ/(2ΔL) = 0.104/(−0.28e-3) = −371.429 A;
+    /// at i_q = 226.27 A the roots a ± √(a² + i_q²) = −371.429 ± 434.923 are +63.494 A and
+    /// −806.351 A. The torque maximum is the + root (ψ − ΔL·i_d = 0.104 + 0.14e-3·63.49 > 0;
+    /// the other root lies beyond i_d = ψ/ΔL = −742.9 A where the torque is negative).
+    /// On the circle I = 316.8 A: i_d = (ψ − √(ψ² + 8ΔL²I²))/(4ΔL)
+    /// = (0.104 − 0.162950)/(−0.56e-3) = +105.268 A, i_q = 298.799 A, T = 106.44 N·m
+    /// (98.84 N·m at i_d = 0).
+    #[test]
+    fn mtpa_inverse_saliency_by_hand() {
+        let id = mtpa_id(0.104, -0.14e-3, 226.27);
+        assert!((id - 63.494).abs() < 1e-3, "{id}");
+        let (id, iq) = mtpa_corner(0.104, -0.14e-3, 316.8);
+        assert!((id - 105.268).abs() < 1e-3 && (iq - 298.799).abs() < 1e-3, "{id} {iq}");
+        let m = inverse(None);
+        assert!((m.torque(id, iq) - 106.436).abs() < 1e-3);
+        // Independent check: a scan of the circle finds no larger torque.
+        let best = (0..=20_000)
+            .map(|k| {
+                let x = -316.8 + 633.6 * f64::from(k) / 20_000.0;
+                m.torque(x, (316.8f64 * 316.8 - x * x).max(0.0).sqrt())
+            })
+            .fold(f64::MIN, f64::max);
+        assert!(
+            best <= m.torque(id, iq) + 1e-9 && best > m.torque(id, iq) - 1e-3,
+            "{best}"
+        );
+    }
+
+    /// The loss-minimising search for inverse saliency: at ω = 0 (and without R_c) it
+    /// returns the positive MTPA i_d, not the i_d ≤ 0 bound; with R_c = 24.5 Ω more speed
+    /// asks for less i_d (Fig. 3.1's trend, the core losses fall with L_d·i_d + ψ_m); every
+    /// point beats a 4001-point brute-force scan of its constant-torque curve over
+    /// [−I_max, I_max].
+    #[test]
+    fn loss_minimum_for_inverse_saliency() {
+        for iq in [0.0, 50.0, 150.0, 270.0] {
+            let want = mtpa_id(0.104, -0.14e-3, iq);
+            for (m, w) in [(inverse(None), 1256.6), (inverse(Some(24.5)), 0.0)] {
+                let id = m.id_at(w, iq);
+                assert!((id - want).abs() < 1e-6 * m.i_max, "{iq} A: {id} vs {want}");
+            }
+        }
+        let m = inverse(Some(24.5));
+        let iq = 0.5 * 226.27;
+        let ids: Vec<f64> = [0.0, 628.3, 1256.6].iter().map(|&w| m.id_at(w, iq)).collect();
+        assert!(ids[0] > 0.0 && ids[0] > ids[1] && ids[1] > ids[2], "{ids:?}");
+        for (w, id) in [(628.3, ids[1]), (1256.6, ids[2])] {
+            let rc = 24.5;
+            let (a12, a21) = (-w * m.lq / rc, w * m.ld / rc);
+            let b2 = iq - w * m.psi / rc;
+            let det = 1.0 - a12 * a21;
+            let id0 = (id - a12 * b2) / det;
+            let iq0 = (b2 - a21 * id) / det;
+            let t = m.torque(id0, iq0);
+            let best = m.loss(w, id0, iq0);
+            for k in 0..=4000 {
+                let x = -m.i_max + 2.0 * m.i_max * f64::from(k) / 4000.0;
+                let y = t / (1.5 * 2.0 * (m.psi - (m.lq - m.ld) * x));
+                assert!(
+                    m.loss(w, x, y) >= best - 1e-9 * best,
+                    "ω = {w}: i_d0 = {x} beats the optimum"
+                );
+            }
+        }
     }
 
     #[test]

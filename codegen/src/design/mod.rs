@@ -7,8 +7,10 @@
 pub mod acceleration;
 pub mod adc;
 pub mod angle_observer;
+pub mod cross_check;
 pub mod current_loop;
 pub mod designed_response;
+pub mod dead_time;
 pub mod discrete_loop;
 pub mod sampled_loop;
 
@@ -37,9 +39,16 @@ pub use step::motor::{MotorOut, Origin};
 pub use step::per_unit::PerUnitOut;
 pub use step::scaling::ScalingsOut;
 
+/// Version of the design's JSON form (`motorgen design --format json`): raised whenever
+/// a key is removed or renamed or changes meaning or unit, so that a consumer can refuse
+/// a form it does not know. New keys do not raise it.
+pub const SCHEMA_VERSION: u32 = 1;
+
 /// Every constant of one motor.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Design {
+    /// [`SCHEMA_VERSION`] of this form (the first key of the JSON).
+    pub schema_version: u32,
     /// Spec file as given.
     pub spec_file: String,
     /// Motor name.
@@ -54,8 +63,8 @@ pub struct Design {
     pub angle_observer: ObserverOut,
     /// Fixed-point scalings.
     pub scaling: ScalingsOut,
-    /// Thesis-B per-unit system, if rated current and frequency are known.
-    pub per_unit: Option<PerUnitOut>,
+    /// Thesis-B per-unit system: every base the spec determines (Appendix A).
+    pub per_unit: PerUnitOut,
     /// FIR low-pass for identification.
     pub fir: fir::FirDesign,
     /// Modulator.
@@ -66,6 +75,9 @@ pub struct Design {
     pub field_weakening: Option<field_weakening::FieldWeakeningOut>,
     /// Sensorless estimator (thesis B chapter 4), when ψ_M is known.
     pub sensorless: Option<sensorless::SensorlessOut>,
+    /// The inverter board's values with this motor (`crate::design_with_board`); `None`
+    /// for a motor designed on its own.
+    pub board: Option<crate::board::design::BoardOut>,
     /// Non-fatal observations.
     pub warnings: Vec<String>,
 }
@@ -91,15 +103,15 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     };
     let motor = step::motor::motor(&mut cx, current_loop.hot.as_ref().map(|h| h.phase_resistance_ohm));
     let per_unit = step::per_unit::per_unit(spec);
-    let sensorless = match step::sensorless::sensorless(&cx, per_unit.as_ref()) {
-        Ok(Some((out, notes))) => {
+    let sensorless = match step::sensorless::sensorless(&cx, &per_unit) {
+        Ok((out, notes)) => {
             cx.warnings.extend(notes);
-            Some(out)
+            out
         }
-        Ok(None) => None,
         Err(e) => return Err(Diagnostics(vec![*e])),
     };
     Ok(Design {
+        schema_version: SCHEMA_VERSION,
         spec_file: src.file.to_string(),
         name: spec.name.clone(),
         motor,
@@ -113,6 +125,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         adc,
         field_weakening,
         sensorless,
+        board: None,
         warnings: cx.warnings,
     })
 }

@@ -6,23 +6,40 @@
 //!
 //! All speeds here are electrical [rad/s] (thesis B writes ω_r for the electrical rotor
 //! speed).
+//!
+//! Saliency of either sign. Thesis B's motor has ΔL = L_q − L_d > 0, but its rules hold
+//! for inverse saliency (L_d > L_q) too, with the sign kept where it matters:
+//! * (4.17)–(4.19): the carrier current carries ΔL·sin 2θ̃, so any ΔL ≠ 0 gives position
+//!   information ("provided that the machine possesses saliency, i.e., ΔL ≠ 0"). K_e (4.19)
+//!   keeps the sign of ΔL; the error e = e_si/(2K̂_e) (4.20) is then ≈ sin θ̃ for either
+//!   sign, so the estimator dynamics (4.25), (4.26) are unchanged.
+//! * (4.35), (4.24): derived from the carrier current's amplitude 2|K_e| (4.21) — |ΔL|.
+//! * (4.59), (4.66), (4.92): bounds on |β|, |ψ_m/(ΔL·i_q)| and |i_q| over both signs of
+//!   i_q — |ΔL|.
+//! * (4.51), (4.69): ψ_m − ΔL·i_d, signed; at the MTPA point (3.10) i_d has the sign of
+//!   −ΔL (positive for inverse saliency), so the term stays above ψ_m either way. With
+//!   ΔL < 0 it vanishes at i_d = ψ_m/ΔL < 0, which a field-weakening i_d reaches when
+//!   I_max ≥ ψ_m/|ΔL|: (4.51) is singular there and the design warns.
 
 use serde::Serialize;
+
+use super::loss_minimisation::mtpa_corner;
 
 /// Everything the rules need, in SI units.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Inputs {
-    /// R̂_s [Ω].
+    /// R̂_s \[Ω\].
     pub resistance: f64,
-    /// L̂_d [H].
+    /// L̂_d \[H\].
     pub ld: f64,
-    /// L̂_q [H].
+    /// L̂_q \[H\].
     pub lq: f64,
-    /// ψ̂_m [Wb].
+    /// ψ̂_m \[Wb\].
     pub psi: f64,
-    /// I_max, the peak phase current [A].
+    /// I_max, the peak phase current \[A\].
     pub current_max: f64,
-    /// I_base of (4.35) [A]: the per-unit base √2·I_n (thesis B App. A), else I_max.
+    /// I_base = √2·I_n \[A\], the per-unit base current (thesis B App. A) of (4.24), (4.35)
+    /// and of the ω_min2 (4.69) operating point.
     pub current_base: f64,
     /// ω_max, the largest electrical speed [rad/s] (4.92).
     pub speed_max: f64,
@@ -30,7 +47,7 @@ pub struct Inputs {
     pub current_bandwidth: f64,
     /// ω_sw = 2π·f_sw [rad/s].
     pub switching: f64,
-    /// V_max = U_dc/√3, the largest phase-voltage amplitude [V].
+    /// V_max = U_dc/√3, the largest phase-voltage amplitude \[V\].
     pub voltage_max: f64,
     /// ω_base of the per-unit system [rad/s], if the spec defines one.
     pub speed_base: Option<f64>,
@@ -47,11 +64,11 @@ pub struct Choices {
     pub bandwidth: Option<f64>,
     /// Largest shaft acceleration [rad/s², mechanical].
     pub max_acceleration: Option<f64>,
-    /// θ̃_max [rad].
+    /// θ̃_max \[rad\].
     pub angle_error: f64,
     /// ω_e [rad/s].
     pub injection_frequency: Option<f64>,
-    /// V_e [V].
+    /// V_e \[V\].
     pub injection_voltage: Option<f64>,
     /// ω_hp [rad/s].
     pub highpass: Option<f64>,
@@ -75,7 +92,63 @@ pub enum RhoRule {
     CurrentLoopBound,
 }
 
-/// Signal-injection constants (salient motors only).
+/// Why the design has no signal injection.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case", tag = "reason")]
+pub enum NoInjection {
+    /// L_d = L_q: the carrier current holds no position information (4.17).
+    NoSaliency,
+    /// Salient, but |ΔL| is too small for the carrier rule: (4.35) with V_e ≤ 0.2·V_max
+    /// needs ω_e ≤ `frequency_limit_rad_s`, below 5α_c (4.34).
+    SaliencyTooSmall {
+        /// |ΔL|/max(L_d, L_q).
+        saliency: f64,
+        /// The largest ω_e at which (4.35) stays within 0.2·V_max [rad/s].
+        frequency_limit_rad_s: f64,
+        /// 5α_c [rad/s].
+        frequency_min_rad_s: f64,
+    },
+    /// ω_sw/10 (4.34) is below 5α_c: no carrier fits between the switching frequency and
+    /// the current loop.
+    SwitchingTooSlow {
+        /// ω_sw/10 [rad/s].
+        frequency_max_rad_s: f64,
+        /// 5α_c [rad/s].
+        frequency_min_rad_s: f64,
+    },
+}
+
+impl std::fmt::Display for NoInjection {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            NoInjection::NoSaliency => write!(
+                f,
+                "L_q = L_d: no saliency, the carrier current holds no position information (thesis B (4.17))"
+            ),
+            NoInjection::SaliencyTooSmall {
+                saliency,
+                frequency_limit_rad_s,
+                frequency_min_rad_s,
+            } => write!(
+                f,
+                "saliency |L_q − L_d|/L = {:.1} % too small for the carrier rule: V_e (4.35) ≤ {:.0} % of V_max needs \
+                 ω_e ≤ {frequency_limit_rad_s:.0} rad/s, below 5α_c = {frequency_min_rad_s:.0} rad/s (4.34)",
+                saliency * 100.0,
+                MAX_INJECTION_SHARE * 100.0
+            ),
+            NoInjection::SwitchingTooSlow {
+                frequency_max_rad_s,
+                frequency_min_rad_s,
+            } => write!(
+                f,
+                "no carrier between 5α_c = {frequency_min_rad_s:.0} rad/s and ω_sw/10 = {frequency_max_rad_s:.0} rad/s (4.34): \
+                 the switching frequency is too low for the current-loop bandwidth"
+            ),
+        }
+    }
+}
+
+/// Signal-injection constants (motors with ΔL ≠ 0).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct InjectionOut {
     /// ω_e [rad/s].
@@ -84,11 +157,11 @@ pub struct InjectionOut {
     pub frequency_min_rad_s: f64,
     /// Upper end of (4.34): ω_sw/10 [rad/s].
     pub frequency_max_rad_s: f64,
-    /// V_e [V].
+    /// V_e \[V\].
     pub voltage_v: f64,
-    /// Smallest V_e of (4.35) [V].
+    /// Smallest V_e of (4.35) \[V\].
     pub voltage_min_v: f64,
-    /// K_e = V_e·ΔL/(4·ω_e·L_d·L_q) (4.19) [A].
+    /// K_e = V_e·ΔL/(4·ω_e·L_d·L_q) (4.19) \[A\], with the sign of ΔL = L_q − L_d.
     pub gain_ke_a: f64,
     /// ω_hp [rad/s].
     pub highpass_rad_s: f64,
@@ -113,12 +186,14 @@ pub struct SensorlessOut {
     pub gamma1: f64,
     /// γ2 = 2ρ (4.7) [1/s].
     pub gamma2: f64,
-    /// θ̃_max [rad].
+    /// θ̃_max \[rad\].
     pub angle_error_rad: f64,
     /// Electrical acceleration tracked within θ̃_max: ρ²·sin θ̃max (4.74) [rad/s²].
     pub acceleration_tracked_rad_s2: f64,
-    /// Injection, for a salient motor (ΔL = L_q − L_d > 0).
+    /// Injection, for a salient motor (ΔL = L_q − L_d ≠ 0).
     pub injection: Option<InjectionOut>,
+    /// Why there is no injection, when there is none.
+    pub no_injection: Option<NoInjection>,
     /// ω_min1 (4.59) [rad/s].
     pub omega_min1_rad_s: f64,
     /// ω_min2 (4.69) [rad/s].
@@ -131,9 +206,11 @@ pub struct SensorlessOut {
     pub resetting_lower_rad_s: f64,
     /// Δω2 = 2ρ (§4.6) [rad/s].
     pub resetting_upper_rad_s: f64,
-    /// |i_q^ref| limit while the resetting term acts (4.92) with γ0 = ρ [A] (salient).
+    /// i_d of the MTPA point (3.10) at I_base: the operating point of ω_min2 (4.69) \[A\].
+    pub id_at_base_current_a: f64,
+    /// |i_q^ref| limit while the resetting term acts (4.92) with γ0 = ρ \[A\] (salient).
     pub iq_limit_resetting_a: Option<f64>,
-    /// |i_q| ≤ ψ_m/ΔL, no bifurcation (4.66) [A] (salient).
+    /// |i_q| ≤ ψ_m/|ΔL|, no bifurcation (4.66) \[A\] (salient).
     pub iq_limit_bifurcation_a: Option<f64>,
 }
 
@@ -143,50 +220,42 @@ pub fn rho_from_acceleration(acceleration: f64, angle_error: f64) -> f64 {
     (acceleration / angle_error.sin()).sqrt()
 }
 
-/// Smallest carrier amplitude (4.35): V_e = I_base·ω_e·L_d·L_q/(10·ΔL).
+/// Smallest carrier amplitude (4.35): V_e = I_base·ω_e·L_d·L_q/(10·|ΔL|) (the carrier
+/// current 2|K_e| of (4.21) at 5 % of I_base).
 pub fn injection_voltage_min(current_base: f64, omega_e: f64, ld: f64, lq: f64) -> f64 {
-    current_base * omega_e * ld * lq / (10.0 * (lq - ld))
+    current_base * omega_e * ld * lq / (10.0 * (lq - ld).abs())
 }
 
-/// K_e = V_e·ΔL/(4·ω_e·L_d·L_q) (4.19).
+/// K_e = V_e·ΔL/(4·ω_e·L_d·L_q) (4.19), signed: negative for inverse saliency.
 pub fn injection_gain(voltage: f64, omega_e: f64, ld: f64, lq: f64) -> f64 {
     voltage * (lq - ld) / (4.0 * omega_e * ld * lq)
 }
 
 /// The largest ρ without low- and high-pass filters (4.24):
-/// ρ ≤ √(ω_ν·ΔL·V_e/(2·L_d·L_q·I_base)).
+/// ρ ≤ √(ω_ν·|ΔL|·V_e/(2·L_d·L_q·I_base)).
 pub fn rho_max_without_filters(speed_noise: f64, voltage: f64, ld: f64, lq: f64, current_base: f64) -> f64 {
-    (speed_noise * (lq - ld) * voltage / (2.0 * ld * lq * current_base)).sqrt()
+    (speed_noise * (lq - ld).abs() * voltage / (2.0 * ld * lq * current_base)).sqrt()
 }
 
-/// ω_min1 = 5ρ·ΔL·I_max/(3ψ_m) (4.59): below it the back-EMF error's poles leave the
-/// 45° sector (β > −0.3).
+/// ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m) (4.59): below it the back-EMF error's poles leave the
+/// 45° sector (|β| > 0.3 for some sign of i_q).
 pub fn omega_min1(rho: f64, delta_l: f64, current_max: f64, psi: f64) -> f64 {
-    5.0 * rho * delta_l * current_max / (3.0 * psi)
+    5.0 * rho * delta_l.abs() * current_max / (3.0 * psi)
 }
 
-/// ω_min2 = |R̃_s·i_d/(θ̃·(ψ_m − ΔL·i_d))| (4.69).
+/// ω_min2 = |R̃_s·i_d/(θ̃·(ψ_m − ΔL·i_d))| (4.69), ΔL signed.
 pub fn omega_min2(resistance_error: f64, id: f64, angle_error: f64, psi: f64, delta_l: f64) -> f64 {
     (resistance_error * id / (angle_error * (psi - delta_l * id))).abs()
 }
 
-/// The MTPA d-current at current magnitude `current` (thesis B (3.10) on the circle
-/// i_d² + i_q² = I²): i_d = (ψ_m − √(ψ_m² + 8·ΔL²·I²))/(4·ΔL); 0 without saliency.
-pub fn mtpa_id(current: f64, psi: f64, delta_l: f64) -> f64 {
-    if delta_l <= 0.0 {
-        return 0.0;
-    }
-    (psi - (psi * psi + 8.0 * delta_l * delta_l * current * current).sqrt()) / (4.0 * delta_l)
-}
-
-/// |i_q| ≤ ψ_m/ΔL (4.66).
+/// |i_q| ≤ ψ_m/|ΔL| (4.66).
 pub fn iq_limit_bifurcation(psi: f64, delta_l: f64) -> f64 {
-    psi / delta_l
+    psi / delta_l.abs()
 }
 
-/// |i_q^ref| < ρ²·ψ̂_m/(γ0·ω_max·ΔL̂) (4.92).
+/// |i_q^ref| < ρ²·ψ̂_m/(γ0·ω_max·|ΔL̂|) (4.92).
 pub fn iq_limit_resetting(rho: f64, psi: f64, gamma0: f64, speed_max: f64, delta_l: f64) -> f64 {
-    rho * rho * psi / (gamma0 * speed_max * delta_l)
+    rho * rho * psi / (gamma0 * speed_max * delta_l.abs())
 }
 
 /// The largest share of V_max the carrier may take by default: thesis B §4.3.1 allows
@@ -209,31 +278,43 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
         (None, None) => (rho_max, RhoRule::CurrentLoopBound),
     };
     let delta_l = inp.lq - inp.ld;
-    let salient = delta_l > 0.0;
+    let salient = delta_l != 0.0;
     // Default carrier: as high as (4.34) allows, ω_sw/10, but no higher than the ω_e at
     // which (4.35) takes MAX_INJECTION_SHARE of V_max. A default must meet (4.34)'s lower
     // bound 5α_c too; where it cannot, injection is left to the spec
     // (`injection_frequency`, `injection_voltage`), as the thesis does for its own motor.
     let lo = 5.0 * inp.current_bandwidth;
+    let hi = inp.switching / 10.0;
     let voltage_limited = if salient {
-        MAX_INJECTION_SHARE * inp.voltage_max * 10.0 * delta_l / (inp.current_base * inp.ld * inp.lq)
+        MAX_INJECTION_SHARE * inp.voltage_max * 10.0 * delta_l.abs() / (inp.current_base * inp.ld * inp.lq)
     } else {
         0.0
     };
-    let we_default = (inp.switching / 10.0).min(voltage_limited);
+    let we_default = hi.min(voltage_limited);
     let chosen = c.injection_frequency.is_some() || c.injection_voltage.is_some();
-    let injectable = salient && (chosen || we_default >= lo);
-    if salient && !injectable {
+    let no_injection = if !salient {
+        Some(NoInjection::NoSaliency)
+    } else if chosen || we_default >= lo {
+        None
+    } else if voltage_limited < lo {
+        Some(NoInjection::SaliencyTooSmall {
+            saliency: delta_l.abs() / inp.ld.max(inp.lq),
+            frequency_limit_rad_s: voltage_limited,
+            frequency_min_rad_s: lo,
+        })
+    } else {
+        Some(NoInjection::SwitchingTooSlow {
+            frequency_max_rad_s: hi,
+            frequency_min_rad_s: lo,
+        })
+    };
+    if let Some(why @ (NoInjection::SaliencyTooSmall { .. } | NoInjection::SwitchingTooSlow { .. })) = &no_injection {
         warnings.push(format!(
-            "sensorless: no signal injection by default: ω_e ≥ 5α_c = {lo:.0} rad/s (4.34) with V_e ≤ {:.0} % of V_max \
-             (4.35) needs ω_e ≤ {voltage_limited:.0} rad/s and ω_e ≤ ω_sw/10 = {:.0} rad/s; set \
-             sensorless.injection_frequency (and injection_voltage) to inject below 5α_c (thesis B §4.3.5)",
-            MAX_INJECTION_SHARE * 100.0,
-            inp.switching / 10.0
+            "sensorless: no signal injection by default: {why}; set sensorless.injection_frequency (and \
+             injection_voltage) to inject below 5α_c (thesis B §4.3.5)"
         ));
     }
-    let injection = injectable.then(|| {
-        let hi = inp.switching / 10.0;
+    let injection = no_injection.is_none().then(|| {
         let we = c.injection_frequency.unwrap_or(we_default);
         if we < lo || we > hi {
             warnings.push(format!(
@@ -245,8 +326,16 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
         let ve = c.injection_voltage.unwrap_or(v_min);
         if ve < v_min {
             warnings.push(format!(
-                "sensorless: carrier amplitude V_e = {ve:.2} V is below I_base·ω_e·L_d·L_q/(10·ΔL) = {v_min:.2} V \
+                "sensorless: carrier amplitude V_e = {ve:.2} V is below I_base·ω_e·L_d·L_q/(10·|ΔL|) = {v_min:.2} V \
                  (thesis B (4.35)): the carrier current stays under 5 % of I_base"
+            ));
+        }
+        if ve > MAX_INJECTION_SHARE * inp.voltage_max * (1.0 + 1e-9) {
+            warnings.push(format!(
+                "sensorless: the carrier takes V_e = {ve:.1} V = {:.0} % of V_max (thesis B §4.3.1 allows {:.0} %): \
+                 less voltage is left for the fundamental currents",
+                100.0 * ve / inp.voltage_max,
+                100.0 * MAX_INJECTION_SHARE
             ));
         }
         let lowpass = c.lowpass.unwrap_or(5.0 * rho);
@@ -281,11 +370,13 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
     } else {
         0.0
     };
-    // (4.69) at the MTPA d-current of base current: with R̃ = 2R and θ̃ = 10° this is
-    // thesis B's "ω_min2 ≈ 0.05 pu" for its motor (i_d = −0.44 pu).
+    // (4.69) at the MTPA d-current (3.10) of base current: with R̃ = 2R and θ̃ = 10° this
+    // is thesis B's "ω_min2 ≈ 0.05 pu" for its motor (i_d = −0.44 pu). For inverse saliency
+    // the MTPA i_d is positive (the branch of (3.10) that maximises the torque).
+    let (id_base, _) = mtpa_corner(inp.psi, delta_l, inp.current_base);
     let w2 = omega_min2(
         c.resistance_error * inp.resistance,
-        mtpa_id(inp.current_base, inp.psi, delta_l),
+        id_base,
         c.angle_error,
         inp.psi,
         delta_l,
@@ -293,7 +384,7 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
     let ls = w1.max(w2);
     if !salient {
         warnings.push(format!(
-            "sensorless: L_q ≤ L_d, no saliency for signal injection (thesis B (4.17)): the estimator has no \
+            "sensorless: L_q = L_d, no saliency for signal injection (thesis B (4.17)): the estimator has no \
              position information below ω_ls = {ls:.1} rad/s"
         ));
     }
@@ -302,9 +393,18 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
         && inp.current_max > b
     {
         warnings.push(format!(
-            "sensorless: the peak current {:.1} A exceeds ψ_m/ΔL = {b:.1} A (thesis B (4.66)): above it the \
+            "sensorless: the peak current {:.1} A exceeds ψ_m/|ΔL| = {b:.1} A (thesis B (4.66)): above it the \
              back-EMF estimator has unwanted equilibria; limit |i_q| in sensorless operation",
             inp.current_max
+        ));
+    }
+    if delta_l < 0.0 && inp.current_max >= inp.psi / -delta_l {
+        warnings.push(format!(
+            "sensorless: inverse saliency (L_d > L_q): ψ_m − ΔL·i_d in the back-EMF error (thesis B (4.51)) vanishes \
+             at i_d = ψ_m/ΔL = {:.1} A, inside the current circle (−I_max = {:.1} A): the error is singular if field \
+             weakening drives i_d there (thesis B derives (4.51) for ΔL > 0, where i_d < 0 only strengthens the term)",
+            inp.psi / delta_l,
+            -inp.current_max
         ));
     }
     let out = SensorlessOut {
@@ -316,12 +416,14 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
         angle_error_rad: c.angle_error,
         acceleration_tracked_rad_s2: rho * rho * c.angle_error.sin(),
         injection,
+        no_injection,
         omega_min1_rad_s: w1,
         omega_min2_rad_s: w2,
         omega_ls_rad_s: ls,
         omega_hs_rad_s: 2.0 * ls,
         resetting_lower_rad_s: rho,
         resetting_upper_rad_s: 2.0 * rho,
+        id_at_base_current_a: id_base,
         iq_limit_resetting_a: salient.then(|| iq_limit_resetting(rho, inp.psi, rho, inp.speed_max, delta_l)),
         iq_limit_bifurcation_a: bifurcation,
     };
@@ -410,7 +512,7 @@ mod tests {
     /// d-current of base current.
     #[test]
     fn omega_min2_is_0_05_pu() {
-        let id = mtpa_id(i_base(), PSI, LQ - LD);
+        let (id, _) = mtpa_corner(PSI, LQ - LD, i_base());
         // Hand: (0.104 − √(0.010816 + 0.044603))/(1.32e-3) = (0.104 − 0.235413)/1.32e-3
         // = −99.56 A = −0.44 pu.
         assert!((id + 99.56).abs() < 0.01, "{id}");
@@ -505,6 +607,75 @@ mod tests {
         assert!((inj.voltage_v - 0.2 * v_base()).abs() < 1e-9);
     }
 
+    /// Inverse saliency, a labelled variant of the thesis B motor with L_d = 0.70 mH >
+    /// L_q = 0.56 mH (ΔL = −0.14 mH), carrier at 100 Hz (ω_e = 628.32 rad/s). By hand:
+    /// (4.35) with |ΔL|: V_e = 226.274·628.32·0.70e-3·0.56e-3/(10·0.14e-3) = 39.808 V;
+    /// (4.19) keeps the sign: K_e = 39.808·(−0.14e-3)/(4·628.32·3.92e-7) = −5.657 A = −I_base/40;
+    /// (4.66): ψ/|ΔL| = 742.86 A; (4.59): 5·147·0.14e-3·316.78/(3·0.104) = 104.48 rad/s;
+    /// (4.69) at the MTPA point of I_base, now on the positive branch: i_d = 2·0.14e-3·51200
+    /// /(0.104 + √(0.010816 + 8·1.96e-8·51200)) = +59.418 A, ω_min2 = 0.0158·59.418/
+    /// (0.174533·(0.104 + 0.14e-3·59.418)) = 47.890 rad/s; (4.92): 147·0.104/(2513.27·0.14e-3)
+    /// = 43.449 A. The default carrier rule: (4.35) ≤ 0.2·V_max allows only ω_e ≤
+    /// 0.2·184.75·10·0.14e-3/(226.27·3.92e-7) = 583.2 rad/s < 5α_c: saliency too small.
+    #[test]
+    fn inverse_saliency_by_hand() {
+        let mut inp = chalmers(Choices {
+            injection_frequency: Some(2.0 * PI * 100.0),
+            ..choices()
+        });
+        inp.ld = 0.70e-3;
+        let (out, warnings) = design(&inp);
+        let inj = out.injection.as_ref().unwrap();
+        assert!((inj.voltage_v - 39.808).abs() < 1e-3, "{}", inj.voltage_v);
+        assert!((inj.gain_ke_a + i_base() / 40.0).abs() < 1e-9, "{}", inj.gain_ke_a);
+        assert!((out.iq_limit_bifurcation_a.unwrap() - 742.857).abs() < 1e-3);
+        assert!(
+            (out.omega_min1_rad_s - 104.478).abs() < 1e-3,
+            "{}",
+            out.omega_min1_rad_s
+        );
+        assert!(
+            (out.id_at_base_current_a - 59.418).abs() < 1e-3,
+            "{}",
+            out.id_at_base_current_a
+        );
+        assert!((out.omega_min2_rad_s - 47.890).abs() < 1e-3, "{}", out.omega_min2_rad_s);
+        assert!((out.iq_limit_resetting_a.unwrap() - 43.449).abs() < 1e-3);
+        // ψ/|ΔL| = 742.9 A lies outside I_max = 316.8 A: (4.51) is not singular in the circle.
+        assert!(!warnings.iter().any(|w| w.contains("(4.51)")), "{warnings:?}");
+        let (out, warnings) = design(&Inputs {
+            choices: choices(),
+            ..inp.clone()
+        });
+        match out.no_injection {
+            Some(NoInjection::SaliencyTooSmall {
+                frequency_limit_rad_s, ..
+            }) => assert!((frequency_limit_rad_s - 583.21).abs() < 0.01),
+            other => panic!("{other:?}"),
+        }
+        assert!(warnings.iter().any(|w| w.contains("too small for the carrier rule")));
+        // A stronger inverse saliency puts ψ/|ΔL| inside the current circle: warned.
+        inp.ld = 1.0e-3;
+        let (_, warnings) = design(&inp);
+        assert!(warnings.iter().any(|w| w.contains("(4.51)")), "{warnings:?}");
+    }
+
+    /// The real reason for no injection: L_q = 130 µH > L_d = 125 µH is salient, but
+    /// |ΔL| = 5 µH is too small for the carrier rule — not "L_q ≤ L_d".
+    #[test]
+    fn small_saliency_is_not_reported_as_none() {
+        let mut inp = chalmers(choices());
+        inp.ld = 125e-6;
+        inp.lq = 130e-6;
+        let (out, warnings) = design(&inp);
+        assert!(matches!(out.no_injection, Some(NoInjection::SaliencyTooSmall { .. })));
+        let why = out.no_injection.unwrap().to_string();
+        assert!(why.contains("3.8 % too small for the carrier rule"), "{why}");
+        assert!(!warnings.iter().any(|w| w.contains("no saliency")), "{warnings:?}");
+        // The bifurcation and resetting limits exist for any ΔL ≠ 0.
+        assert!(out.iq_limit_bifurcation_a.is_some() && out.iq_limit_resetting_a.is_some());
+    }
+
     /// A non-salient motor has no injection and no ω_min1; its ω_ls comes from (4.69).
     #[test]
     fn non_salient_motor_has_no_injection() {
@@ -512,6 +683,7 @@ mod tests {
         inp.lq = inp.ld;
         let (out, warnings) = design(&inp);
         assert!(out.injection.is_none() && out.iq_limit_bifurcation_a.is_none());
+        assert_eq!(out.no_injection, Some(NoInjection::NoSaliency));
         assert_eq!(out.omega_min1_rad_s, 0.0);
         assert_eq!(out.omega_ls_rad_s, out.omega_min2_rad_s);
         assert!(warnings.iter().any(|w| w.contains("no saliency")));

@@ -4,7 +4,7 @@
 use super::raw::RawMotor;
 use super::resolve::Resolver_;
 use super::{Param, Provenance};
-use crate::units::{self, Kind};
+use crate::units::Kind;
 
 impl Resolver_<'_> {
     /// At most one inductance form per section, and both axes where d/q is used.
@@ -49,8 +49,10 @@ impl Resolver_<'_> {
         }
     }
 
-    /// L_d (`d = true`) or L_q: identified d/q, identified L, datasheet d/q, datasheet L.
+    /// L_d (`d = true`) or L_q: identified d/q, identified L, datasheet d/q, datasheet L;
+    /// each as a phase value or a measured terminal/winding value ([`super::winding`]).
     pub(super) fn inductance(&mut self, m: &RawMotor, d: bool) -> Option<Param> {
+        let connection = m.connection.as_ref().map(|c| *c.get_ref());
         for (section, prov, name) in [
             (&m.identified, Provenance::Identified, "identified"),
             (&m.datasheet, Provenance::Datasheet, "datasheet"),
@@ -60,28 +62,17 @@ impl Resolver_<'_> {
             let axis = if d { &p.d_inductance } else { &p.q_inductance };
             if let Some(v) = axis {
                 let key = format!("motor.{name}.{}_inductance", if d { "d" } else { "q" });
-                return self.quantity(&key, v, Kind::Inductance, prov, true);
+                return self.phase_value(&key, v, Kind::Inductance, prov, connection);
             }
             if let Some(v) = &p.inductance {
-                // Report a bad `inductance` once (for L_d), not twice.
                 let key = format!("motor.{name}.inductance");
-                if d {
-                    return self.quantity(&key, v, Kind::Inductance, prov, true);
+                // Report a bad `inductance` once (for L_d), not twice.
+                let reported = self.errors.len();
+                let l = self.phase_value(&key, v, Kind::Inductance, prov, connection);
+                if !d {
+                    self.errors.truncate(reported);
                 }
-                let text = match v.get_ref() {
-                    toml::Value::String(s) => s.clone(),
-                    _ => return None,
-                };
-                return units::parse(Kind::Inductance, &text)
-                    .ok()
-                    .filter(|x| *x > 0.0)
-                    .map(|value| Param {
-                        value,
-                        source: prov,
-                        key,
-                        span: v.span(),
-                        note: None,
-                    });
+                return l;
             }
         }
         None

@@ -5,7 +5,7 @@
 
 use std::ops::Range;
 
-use super::flux_linkage::FluxCrossCheck;
+use super::flux_linkage::FluxSource;
 use super::raw::{Connection, RawHarmonics, RawMotor, RawParams, RawSpec, Val};
 use super::resolve::Resolver_;
 use super::{Param, Provenance};
@@ -14,15 +14,15 @@ use crate::units::Kind;
 /// Optional harmonic data (thesis B 2.14–2.16, 2.23), SI.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Harmonics {
-    /// ψ_d,6 [Wb].
+    /// ψ_d,6 \[Wb\].
     pub d_flux_6: Option<Param>,
-    /// ψ_d,12 [Wb].
+    /// ψ_d,12 \[Wb\].
     pub d_flux_12: Option<Param>,
-    /// ψ_q,6 [Wb].
+    /// ψ_q,6 \[Wb\].
     pub q_flux_6: Option<Param>,
-    /// ψ_q,12 [Wb].
+    /// ψ_q,12 \[Wb\].
     pub q_flux_12: Option<Param>,
-    /// L_6 [H].
+    /// L_6 \[H\].
     pub inductance_6: Option<Param>,
 }
 
@@ -31,19 +31,19 @@ pub struct Harmonics {
 pub struct Motor {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub phase_resistance: Param,
-    /// L_d [H].
+    /// L_d \[H\].
     pub d_inductance: Param,
-    /// L_q [H].
+    /// L_q \[H\].
     pub q_inductance: Param,
-    /// ψ_M [Wb], if known or derivable.
+    /// ψ_M \[Wb\], if known or derivable.
     pub flux_linkage: Option<Param>,
-    /// Both derivations of ψ_M when both constants are given.
-    pub flux_cross_check: Option<FluxCrossCheck>,
-    /// Rated current, rms [A].
+    /// Every form in which the spec gives ψ_M (directly, K_t, K_e, k_n), for the cross-check.
+    pub flux_sources: Vec<FluxSource>,
+    /// Rated current, rms \[A\].
     pub nominal_current: Option<Param>,
-    /// Peak current, rms [A].
+    /// Peak current, rms \[A\].
     pub peak_current: Param,
     /// Maximum mechanical speed [rad/s].
     pub max_speed: Param,
@@ -51,9 +51,11 @@ pub struct Motor {
     pub nominal_torque: Option<Param>,
     /// Peak torque [N·m].
     pub peak_torque: Option<Param>,
-    /// Rated electrical frequency f_n [Hz] (given, or from the nominal speed).
+    /// Rated electrical frequency f_n \[Hz\] (given, or from the nominal speed).
     pub rated_frequency: Option<Param>,
-    /// Rated power [W].
+    /// Nominal shaft speed [rad/s], if given (f_n comes from it when `rated_frequency` is not).
+    pub nominal_speed: Option<Param>,
+    /// Rated power \[W\].
     pub rated_power: Option<Param>,
     /// Rotor inertia J [kg·m²].
     pub inertia: Option<Param>,
@@ -61,12 +63,14 @@ pub struct Motor {
     pub viscous_friction: Option<Param>,
     /// Harmonic data.
     pub harmonics: Harmonics,
-    /// L_q(|i_q|) curve points ([A], [H]), sorted by current.
+    /// L_q(|i_q|) curve points (\[A\], \[H\]), sorted by current.
     pub q_saturation: Vec<(f64, f64)>,
     /// Winding connection, if stated.
     pub connection: Option<Connection>,
     /// When and from what the identified values were obtained (`date`, `source`).
     pub identification: Option<String>,
+    /// Byte span of the `[motor]` table: where a missing motor key is reported.
+    pub span: Range<usize>,
 }
 
 /// "identified on <date> from <source>", from `[motor.identified]`'s `date` and `source`.
@@ -104,14 +108,15 @@ impl Resolver_<'_> {
             return None;
         }
         self.inductance_forms(m);
-        let phase_resistance = self.required_motor_key(
-            m,
-            &motor_span,
-            "phase_resistance",
-            |p| p.phase_resistance.as_ref(),
-            Kind::Resistance,
-            "the phase (star-equivalent) resistance, e.g. phase_resistance = \"0.126 Ω\"",
-        );
+        let phase_resistance =
+            self.phase_motor_key(m, "phase_resistance", |p| p.phase_resistance.as_ref(), Kind::Resistance);
+        if phase_resistance.is_none() && !has(m, |p| p.phase_resistance.is_some()) {
+            self.missing_motor_key(
+                &motor_span,
+                "phase_resistance",
+                "the phase (star-equivalent) resistance, e.g. phase_resistance = \"0.126 Ω\", or a terminal value { value = \"0.252 Ω\", measured = \"line_to_line\" }",
+            );
+        }
         let d_inductance = self.inductance(m, true);
         let q_inductance = self.inductance(m, false);
         if d_inductance.is_none() && !has(m, |p| p.inductance.is_some() || p.d_inductance.is_some()) {
@@ -155,14 +160,16 @@ impl Resolver_<'_> {
             Kind::ViscousFriction,
             true,
         );
-        let rated_frequency = self.rated_frequency(m, pole_pairs);
-        let (flux_linkage, flux_cross_check) = match pole_pairs {
+        let nominal_speed = self.motor_key(m, "nominal_speed", |p| p.nominal_speed.as_ref(), Kind::Speed, true);
+        let rated_frequency = self.rated_frequency(m, pole_pairs, nominal_speed.as_ref());
+        let (flux_linkage, flux_sources) = match pole_pairs {
             Some(np) => self.flux(m, np),
-            None => (None, None),
+            None => (None, Vec::new()),
         };
         let harmonics = m.harmonics.as_ref().map(|h| self.harmonics(h.get_ref()));
         let q_saturation = self.saturation(m);
         Some(Motor {
+            span: motor_span,
             connection: m.connection.as_ref().map(|c| *c.get_ref()),
             identification: identification(m),
             pole_pairs: pole_pairs?,
@@ -170,13 +177,14 @@ impl Resolver_<'_> {
             d_inductance: d_inductance?,
             q_inductance: q_inductance?,
             flux_linkage,
-            flux_cross_check,
+            flux_sources,
             nominal_current,
             peak_current: peak_current?,
             max_speed: max_speed?,
             nominal_torque,
             peak_torque,
             rated_frequency,
+            nominal_speed,
             rated_power,
             inertia,
             viscous_friction,
@@ -238,7 +246,12 @@ impl Resolver_<'_> {
     }
 
     /// f_n: given, or n_p·ω_m,n/(2π) (2.19) from the nominal speed.
-    fn rated_frequency(&mut self, m: &RawMotor, pole_pairs: Option<u32>) -> Option<Param> {
+    fn rated_frequency(
+        &mut self,
+        m: &RawMotor,
+        pole_pairs: Option<u32>,
+        nominal_speed: Option<&Param>,
+    ) -> Option<Param> {
         let rated_frequency = self.motor_key(
             m,
             "rated_frequency",
@@ -246,7 +259,6 @@ impl Resolver_<'_> {
             Kind::Frequency,
             true,
         );
-        let nominal_speed = self.motor_key(m, "nominal_speed", |p| p.nominal_speed.as_ref(), Kind::Speed, true);
         match (rated_frequency, nominal_speed, pole_pairs) {
             (Some(f), _, _) => Some(f),
             (None, Some(n), Some(np)) => Some(Param {

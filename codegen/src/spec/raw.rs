@@ -55,7 +55,9 @@ pub struct RawMotor {
     pub saturation: Option<Spanned<RawSaturation>>,
 }
 
-/// Winding connection (informative; phase values are what the spec holds).
+/// Winding connection. Values written as plain strings are star-equivalent phase values
+/// whatever the connection; it matters for values given `measured = "winding"` (one delta
+/// winding is not a star-equivalent phase).
 #[derive(Debug, Clone, Copy, Deserialize, serde::Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Connection {
@@ -76,6 +78,7 @@ pub struct RawParams {
     pub flux_linkage: Option<Val>,
     pub torque_constant: Option<Spanned<RawTorqueConstant>>,
     pub back_emf_constant: Option<Spanned<RawBackEmfConstant>>,
+    pub speed_constant: Option<Spanned<RawSpeedConstant>>,
     pub nominal_current: Option<Val>,
     pub peak_current: Option<Val>,
     pub nominal_torque: Option<Val>,
@@ -101,34 +104,56 @@ pub struct RawTorqueConstant {
     pub current: Spanned<Amplitude>,
 }
 
-/// `back_emf_constant = { value = "0.296 V·s/rad", voltage = "rms", measured = "line_to_line", speed = "mechanical" }`.
+/// `back_emf_constant = { value = "0.296 V·s/rad", voltage = "rms", measured = "line_to_line", speed = "mechanical" }`;
+/// `measured` is required for rms and peak voltages and implied for `block_commutation`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawBackEmfConstant {
     pub value: Val,
     pub voltage: Spanned<Amplitude>,
-    pub measured: Spanned<Between>,
+    #[serde(default)]
+    pub measured: Option<Spanned<Between>>,
     pub speed: Spanned<SpeedAxis>,
 }
 
-/// Whether a datasheet figure refers to rms or peak sinusoidal amplitude.
+/// `speed_constant = { value = "259 rpm/V", voltage = "block_commutation" }`: the speed per
+/// volt of induced voltage, the reciprocal of a back-EMF constant (maxon's k_n). `speed`
+/// defaults to mechanical (a shaft speed, as rpm is).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSpeedConstant {
+    pub value: Val,
+    pub voltage: Spanned<Amplitude>,
+    #[serde(default)]
+    pub measured: Option<Spanned<Between>>,
+    #[serde(default)]
+    pub speed: Option<Spanned<SpeedAxis>>,
+}
+
+/// Which current or voltage a datasheet motor constant refers to.
 #[derive(Debug, Clone, Copy, Deserialize, serde::Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Amplitude {
-    /// Root mean square.
+    /// Root mean square of the sinusoidal phase quantity.
     Rms,
-    /// Peak (amplitude).
+    /// Peak (amplitude) of the sinusoidal phase quantity.
     Peak,
+    /// The DC supply current / induced DC voltage of 120° block commutation (maxon's k_M,
+    /// k_n): two phases conduct, the supply sees the line-to-line back EMF.
+    BlockCommutation,
 }
 
-/// Whether a voltage is measured line to line or line to neutral.
+/// Between which terminals a value is measured.
 #[derive(Debug, Clone, Copy, Deserialize, serde::Serialize, PartialEq, Eq)]
 #[serde(rename_all = "snake_case")]
 pub enum Between {
-    /// Line to line.
+    /// Line to line (terminal to terminal).
     LineToLine,
-    /// Phase (line to neutral).
+    /// Phase: line to neutral, the star-equivalent phase.
     Phase,
+    /// Across one winding: the phase in star, line to line in delta (needs `[motor]
+    /// connection`).
+    Winding,
 }
 
 /// Whether a per-speed constant refers to mechanical or electrical rad/s.

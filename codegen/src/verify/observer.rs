@@ -16,10 +16,11 @@ use std::f64::consts::PI;
 use motor_control::ato::AtoState;
 use motor_control::step::Demand;
 
-use super::figures::settling_time;
-use super::plant::{SpeedProfile, wrap};
 use super::scenarios::{check, samples, series, trace};
-use super::sim::{Bench, angle_q31, q31_angle};
+use motor_control::angle::from_radians_f64;
+use motor_sim::bench::{Bench, q31_angle};
+use motor_sim::figures::settling_time;
+use motor_sim::plant::{SpeedProfile, wrap};
 use super::{ScenarioResult, Setup, format_value};
 use crate::design::angle_observer::ramp_lag;
 use crate::spec::ObserverError;
@@ -58,7 +59,7 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
     let o = &s.design.angle_observer;
     let ts = s.design.drive.sample_period_s;
     let mut b = s.bench(0.0);
-    b.state.observer = AtoState::locked(angle_q31(b.plant.theta_r() - LOCK_INITIAL_ERROR), 0);
+    b.state.observer = AtoState::locked(from_radians_f64(b.plant.theta_r() - LOCK_INITIAL_ERROR), 0);
     let wn = o.natural_frequency_rad_s;
     let n = samples(s, 25.0 / (o.damping.min(1.0) * wn));
     let mut e = Vec::with_capacity(n);

@@ -14,11 +14,12 @@
 
 use motor_control::step::Demand;
 
-use super::figures::{designed_rise_time, designed_step, step_figures};
-use super::sim::Bench;
+use super::figures::{designed_rise_time, designed_step};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use crate::design::sampled_loop::{OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
 use crate::spec::Method;
+use motor_sim::bench::Bench;
+use motor_sim::figures::step_figures;
 
 /// Most points kept per trace (the report plots them; more adds bytes, not information).
 const TRACE_POINTS: usize = 1500;
@@ -81,7 +82,7 @@ pub(super) fn samples(s: &Setup<'_>, seconds: f64) -> usize {
     (seconds / s.design.drive.sample_period_s).ceil() as usize
 }
 
-/// Current step height [A]: a quarter of the current-circle radius √2·I_peak, kept so
+/// Current step height \[A\]: a quarter of the current-circle radius √2·I_peak, kept so
 /// that the proportional kick k_p·Δi stays within half the voltage circle (so the
 /// linear design is what is measured, not the voltage limit).
 pub fn step_amplitude(s: &Setup<'_>) -> f64 {

@@ -25,7 +25,7 @@
 //! carrier `V_e·cos ω_e t` (4.15) is returned for the d axis while |ω̂| ≤ 1.1·ω_hs (as in
 //! Appendix D) and is added by [`crate::step::ControllerConfig::process_at_angle`].
 
-use crate::angle::RADIANS_PER_LSB;
+use crate::angle::from_radians;
 use crate::transforms::Dq;
 use crate::trig::Trig;
 
@@ -39,7 +39,8 @@ pub struct InjectionConfig {
     pub amplitude: f32,
     /// Carrier frequency ω_e \[rad/s\] (4.34).
     pub frequency: f32,
-    /// K̂_e = V_e·ΔL̂/(4ω_e·L̂_d·L̂_q) \[A\] (4.19), with the saturated L̂_q (§4.3.2).
+    /// K̂_e = V_e·ΔL̂/(4ω_e·L̂_d·L̂_q) \[A\] (4.19), with the saturated L̂_q (§4.3.2); signed
+    /// like ΔL̂ = L̂_q − L̂_d (negative for inverse saliency), 0 = no injection.
     pub gain: f32,
     /// High-pass cut-off ω_hp \[rad/s\] (a few Hz, Table 4.1).
     pub highpass: f32,
@@ -167,11 +168,6 @@ pub struct EstimatorOutput {
     pub error: f32,
 }
 
-/// Radians → π-scaled Q1.31 (saturating cast; only increments, |x| < π, pass through).
-fn to_q31(rad: f32) -> i32 {
-    (rad / RADIANS_PER_LSB) as i32
-}
-
 impl EstimatorConfig {
     /// f_tr(ω̂) (Fig. 4.9): 1 up to ω_ls, linear to 0 at ω_hs, 0 above; 0 without injection.
     pub fn blend(&self, omega: f32) -> f32 {
@@ -226,16 +222,18 @@ impl EstimatorConfig {
         // Signal injection (4.15)–(4.20).
         let (e_si, injection) = match self.injection {
             Some(inj) => {
-                state.carrier = state.carrier.wrapping_add(to_q31(inj.frequency * ts));
+                state.carrier = state.carrier.wrapping_add(from_radians(inj.frequency * ts));
                 let carrier = trig.sin_cos(state.carrier).to_f32();
                 let demod = trig
-                    .sin_cos(state.carrier.wrapping_sub(to_q31(inj.delay * inj.frequency * ts)))
+                    .sin_cos(state.carrier.wrapping_sub(from_radians(inj.delay * inj.frequency * ts)))
                     .to_f32();
                 let (_, iq_high) = state.highpass.process(inj.highpass, ts, input.current.q);
                 let (e_si, _) = state.lowpass.process(inj.lowpass, ts, iq_high * demod.sin);
                 let on = libm::fabsf(wh) <= 1.1 * inj.high_speed;
                 let ud = if on { inj.amplitude * carrier.cos } else { 0.0 };
-                let e = if inj.gain > 0.0 { e_si / (2.0 * inj.gain) } else { 0.0 };
+                // K̂_e carries the sign of ΔL (negative for inverse saliency, L_d > L_q), as
+                // e_si does: e ≈ sin θ̃ (4.20) for either sign.
+                let e = if inj.gain != 0.0 { e_si / (2.0 * inj.gain) } else { 0.0 };
                 (e, Dq { d: ud, q: 0.0 })
             }
             None => (0.0, Dq::default()),
@@ -272,12 +270,12 @@ impl EstimatorConfig {
         state.omega = if omega.is_finite() { omega } else { 0.0 };
         state.theta = state
             .theta
-            .wrapping_add(to_q31(ts * (state.omega + 2.0 * self.rho * e)));
+            .wrapping_add(from_radians(ts * (state.omega + 2.0 * self.rho * e)));
 
         EstimatorOutput {
             theta: state.theta,
             omega: state.omega,
-            omega_increment: to_q31(state.omega * ts),
+            omega_increment: from_radians(state.omega * ts),
             injection,
             iq_limit: self.iq_limit(gamma0),
             gamma0,
@@ -331,7 +329,7 @@ mod tests {
     fn track(c: &EstimatorConfig, w: f32, theta_err0: f32, omega_err0: f32, seconds: f32) -> (Vec<(f32, f32)>, i32) {
         let ts = c.sample_period;
         let mut st = EstimatorState {
-            theta: to_q31(-theta_err0),
+            theta: from_radians(-theta_err0),
             omega: w - omega_err0,
             ..EstimatorState::default()
         };
@@ -453,11 +451,22 @@ mod tests {
     }
 
     /// Demodulation (4.18)/(4.19): i_q̂ = 2K_e·sin(ω_e t)·sin 2θ̃ + i_q0 (4.21) gives
-    /// e = e_si/(2K_e) → sin(2θ̃)/2 (4.20) with the DC i_q0 removed, at standstill.
+    /// e = e_si/(2K_e) → sin(2θ̃)/2 (4.20) with the DC i_q0 removed, at standstill — for
+    /// K_e > 0 (L_q > L_d) and K_e < 0 (inverse saliency, L_d > L_q: the carrier current's
+    /// sin 2θ̃ term changes sign with ΔL (4.17), and so does K̂_e).
     #[test]
     fn injection_error_signal() {
+        for ke in [2.0f32, -2.0] {
+            let e = demodulated_error(ke, 0.2);
+            let want = libm::sinf(2.0 * 0.2) / 2.0;
+            // LPF ripple at 2ω_e attenuated by (ω_lp/2ω_e)² ≈ 2e-4.
+            assert!((e - want).abs() < 0.01 * want, "K_e = {ke}: {e} vs {want}");
+        }
+    }
+
+    /// The error e after 4 s of a carrier current with gain `ke` at angle error `err`.
+    fn demodulated_error(ke: f32, err: f32) -> f32 {
         let ts = 1e-4f32;
-        let ke = 2.0f32;
         let inj = InjectionConfig {
             amplitude: 28.0,
             frequency: 2.0 * PI * 500.0,
@@ -474,11 +483,10 @@ mod tests {
             ..config(false)
         };
         let mut st = EstimatorState::default();
-        let err = 0.2f32;
         let mut e = 0.0;
         for n in 0..40_000u32 {
             // The carrier phase the estimator will use at this step.
-            let phase = to_radians(st.carrier.wrapping_add(to_q31(inj.frequency * ts)));
+            let phase = to_radians(st.carrier.wrapping_add(from_radians(inj.frequency * ts)));
             let iq = 2.0 * ke * libm::sinf(phase) * libm::sinf(2.0 * err) + 30.0;
             let out = c.process(
                 &mut st,
@@ -494,9 +502,7 @@ mod tests {
             }
             e = out.error;
         }
-        let want = libm::sinf(2.0 * err) / 2.0;
-        // LPF ripple at 2ω_e attenuated by (ω_lp/2ω_e)² ≈ 2e-4.
-        assert!((e - want).abs() < 0.01 * want, "{e} vs {want}");
+        e
     }
 
     /// Non-finite inputs do not poison the state.

@@ -1,12 +1,15 @@
-//! `motorgen firmware <stem>` / `motorgen firmware --all`: the STM32G474 image of one
-//! motor or of every motor in `motors/`.
+//! `motorgen firmware <stem> [--board <board>]` / `motorgen firmware --all`: the
+//! STM32G474 image of one motor or of every motor in `motors/`, on a board of `boards/`
+//! (default `motorgen-reference`).
 //!
-//! Per motor: designs the spec first (a bad spec stops here with its located
-//! diagnostic), runs
+//! Per motor: designs the spec on the board first (a bad spec or board file stops here
+//! with its located diagnostic; what does not fit between them is printed as warnings
+//! on stderr), runs
 //! `cargo build --release --target thumbv7em-none-eabihf -p motor-firmware` in
-//! `firmware/` with `MOTOR=<stem>` and `MOTORS_DIR=<motors folder>` (one shared target
-//! directory, so only the app crate rebuilds per motor), copies the ELF to
-//! `target/firmware/<stem>.elf` under the repository root, writes `<stem>.bin` (the
+//! `firmware/` with `MOTOR=<stem>`, `MOTORS_DIR`, `BOARD=<board>` and `BOARDS_DIR` (one
+//! shared target directory, so only the app crate rebuilds per motor), copies the ELF to
+//! `target/firmware/<stem>.elf` under the repository root (`target/firmware/<board>/`
+//! for another board), writes `<stem>.bin` (the
 //! ELF's loadable segments placed by load address, gaps filled with the erased-flash
 //! byte 0xFF) and prints flash and static RAM use; for one motor it first prints the
 //! constants summary of the design the image is built from. An image over 64 KiB of flash is an
@@ -17,14 +20,16 @@
 //! else the repository `motorgen` was built from.
 
 use std::fmt::Write as _;
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode, Stdio};
+use std::process::{Command, Stdio};
 
 use object::elf;
 use object::read::elf::{ElfFile32, FileHeader, ProgramHeader, SectionHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol};
 
-use crate::output::{err, errln, out};
+use crate::exit::{Exit, Failure};
+use crate::output::{errln, out};
 
 /// The firmware's target triple.
 const TARGET: &str = "thumbv7em-none-eabihf";
@@ -214,10 +219,10 @@ fn repo_root(motors: &Path) -> Result<PathBuf, String> {
         })
 }
 
-/// Motor stems in `dir`, sorted.
-fn stems(dir: &Path) -> Result<Vec<String>, String> {
+/// The `*.toml` stems (motors or boards) in `dir`, sorted.
+fn stems(dir: &Path, what: &str) -> Result<Vec<String>, String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| format!("cannot read the motors folder {}: {e}", dir.display()))?
+        .map_err(|e| format!("cannot read the {what} folder {}: {e}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
@@ -226,42 +231,92 @@ fn stems(dir: &Path) -> Result<Vec<String>, String> {
     Ok(v)
 }
 
-/// Runs cargo for `stem`; returns the built ELF's path (from cargo's JSON messages).
-fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String> {
+/// The "accepted:" list of an unknown stem: the stems that exist.
+fn accepted(known: &[String]) -> String {
+    if known.is_empty() {
+        "none: the folder holds no *.toml".to_string()
+    } else {
+        known.join(", ")
+    }
+}
+
+/// The motor and board an image is built for, with their folders.
+pub struct Target<'a> {
+    /// Motor specs folder.
+    pub motors: &'a Path,
+    /// Board stem.
+    pub board: &'a str,
+    /// Board files folder.
+    pub boards: &'a Path,
+}
+
+/// Runs cargo for `stem` on the board, relaying its progress (stderr) line by line as it
+/// comes; returns the built ELF's path (from cargo's JSON messages on stdout).
+fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, Failure> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let command = format!(
+        "MOTOR={stem} BOARD={} cargo build --release --target {TARGET} -p {PACKAGE}",
+        t.board
+    );
+    errln!("{stem}: {command} (in firmware/; a first build takes minutes)");
     let child = Command::new(&cargo)
         .args(["build", "--release", "--target", TARGET, "-p", PACKAGE])
         .args(["--message-format=json-render-diagnostics"])
         .current_dir(root.join("firmware"))
         .env("MOTOR", stem)
-        .env("MOTORS_DIR", motors)
+        .env("MOTORS_DIR", t.motors)
+        .env("BOARD", t.board)
+        .env("BOARDS_DIR", t.boards)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn();
-    let output = match child.and_then(|c| c.wait_with_output()) {
-        Ok(o) => o,
+    let io = |what: String| Failure::new(Exit::Io, what);
+    let mut child = match child {
+        Ok(c) => c,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(format!(
-                "`{}` was not found: install Rust with rustup (https://rustup.rs), then \
+            return Err(io(format!(
+                "error: `{}` was not found: install Rust with rustup (https://rustup.rs), then \
                  `rustup target add {TARGET}`",
                 cargo.to_string_lossy()
-            ));
+            )));
         }
-        Err(e) => return Err(format!("cannot run {}: {e}", cargo.to_string_lossy())),
+        Err(e) => return Err(io(format!("error: cannot run {}: {e}", cargo.to_string_lossy()))),
     };
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if !output.status.success() {
+    let (Some(out), Some(err)) = (child.stdout.take(), child.stderr.take()) else {
+        return Err(io(format!(
+            "error: cannot read the output of {}",
+            cargo.to_string_lossy()
+        )));
+    };
+    // Progress and rendered diagnostics go to our stderr as they come; a copy is kept
+    // for the hint below. The JSON messages on stdout are read meanwhile.
+    let relay = std::thread::spawn(move || {
+        let mut seen = String::new();
+        for line in BufReader::new(err).lines().map_while(Result::ok) {
+            errln!("{line}");
+            seen.push_str(&line);
+            seen.push('\n');
+        }
+        seen
+    });
+    let mut stdout = String::new();
+    let read = BufReader::new(out).read_to_string(&mut stdout);
+    let status = child.wait();
+    let stderr = relay.join().unwrap_or_default();
+    let status = status
+        .and_then(|s| read.map(|_| s))
+        .map_err(|e| io(format!("error: {command}: {e}")))?;
+    if !status.success() {
         let hint = if stderr.contains("target may not be installed") || stderr.contains("can't find crate for `core`") {
             format!("\n  the {TARGET} target is missing: install it with `rustup target add {TARGET}`")
         } else {
             String::new()
         };
-        return Err(format!(
-            "MOTOR={stem} cargo build --release --target {TARGET} -p {PACKAGE} failed ({}):\n{stderr}{hint}",
-            output.status
+        return Err(Failure::new(
+            Exit::BuildFailed,
+            format!("error: {command} failed ({status}; its messages are above){hint}"),
         ));
     }
-    let stdout = String::from_utf8_lossy(&output.stdout);
     stdout
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
@@ -269,29 +324,41 @@ fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String
             m["reason"] == "compiler-artifact" && m["target"]["name"] == PACKAGE && m["target"]["kind"][0] == "bin"
         })
         .find_map(|m| m["executable"].as_str().map(PathBuf::from))
-        .ok_or_else(|| format!("cargo built no `{PACKAGE}` executable (is firmware/app a binary crate?)"))
+        .ok_or_else(|| {
+            Failure::new(
+                Exit::BuildFailed,
+                format!("error: cargo built no `{PACKAGE}` executable (is firmware/app a binary crate?)"),
+            )
+        })
 }
 
 /// Builds, checks and writes one motor's image (its spec designs); returns its report.
-fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
-    let elf_path = cargo_build(root, motors, stem)?;
-    let bytes = std::fs::read(&elf_path).map_err(|e| format!("cannot read {}: {e}", elf_path.display()))?;
-    let image = image(&bytes).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, Failure> {
+    let elf_path = cargo_build(root, t, stem)?;
+    let io = |what: String| Failure::new(Exit::Io, what);
+    let bytes = std::fs::read(&elf_path).map_err(|e| io(format!("error: cannot read {}: {e}", elf_path.display())))?;
+    let image =
+        image(&bytes).map_err(|e| Failure::new(Exit::BuildFailed, format!("error: {}: {e}", elf_path.display())))?;
     let mut report = report(stem, &image.usage);
     if image.usage.flash > FLASH_LIMIT {
-        return Err(format!(
-            "{report}{stem}: the image needs {} bytes of flash, more than the 64 KiB ({FLASH_LIMIT} bytes) \
-             allowed; nothing written (the ELF is {})",
-            image.usage.flash,
-            elf_path.display()
+        return Err(Failure::new(
+            Exit::VerificationFailed,
+            format!(
+                "{report}error: {stem}: the image needs {} bytes of flash, more than the 64 KiB ({FLASH_LIMIT} \
+                 bytes) budget; nothing written (the ELF is {})",
+                image.usage.flash,
+                elf_path.display()
+            ),
         ));
     }
-    let out = root.join("target").join("firmware");
+    let mut out = root.join("target").join("firmware");
+    if t.board != codegen::board::DEFAULT_BOARD {
+        out = out.join(t.board);
+    }
     let elf_out = out.join(format!("{stem}.elf"));
     let bin_out = out.join(format!("{stem}.bin"));
     // The pair is replaced together or not at all.
-    crate::atomic::write_set(&out, &[(elf_out.clone(), bytes), (bin_out.clone(), image.bin.clone())])
-        .map_err(|e| e.to_string())?;
+    crate::atomic::write_set(&out, &[(elf_out.clone(), bytes), (bin_out.clone(), image.bin.clone())])?;
     let _ = writeln!(
         report,
         "{stem}: wrote {} and {} (load address {:#010x})",
@@ -302,73 +369,92 @@ fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
     Ok(report)
 }
 
-/// The `firmware` subcommand.
-pub fn run(which: Which, motors: &Path) -> ExitCode {
-    let known = match stems(motors) {
-        Ok(k) => k,
-        Err(e) => {
-            errln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+/// The `firmware` subcommand. Every selected spec must design on the board before cargo
+/// runs; every motor is built even if one fails, and the exit code is the gravest failure's.
+pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<(), Failure> {
+    let known = stems(motors, "motors").map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
     let selected = match which {
         Which::All if known.is_empty() => {
-            errln!(
-                "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
-                motors.display()
-            );
-            return ExitCode::FAILURE;
+            return Err(Failure::new(
+                Exit::BadInput,
+                format!(
+                    "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
+                    motors.display()
+                ),
+            ));
         }
         Which::All => known,
         Which::One(stem) if known.contains(&stem) => vec![stem],
         Which::One(stem) => {
-            errln!(
-                "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
-                motors.display(),
-                if known.is_empty() {
-                    "none: the folder holds no *.toml".to_string()
-                } else {
-                    known.join(", ")
-                }
-            );
-            return ExitCode::FAILURE;
+            return Err(Failure::new(
+                Exit::BadInput,
+                format!(
+                    "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
+                    motors.display(),
+                    accepted(&known)
+                ),
+            ));
         }
     };
-    let root = match repo_root(motors) {
-        Ok(r) => r,
-        Err(e) => {
-            errln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+    let root = repo_root(motors).map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
     let motors = motors.canonicalize().unwrap_or_else(|_| motors.to_path_buf());
-    // Every selected spec must design before cargo runs (located diagnostics).
+    let gravest = |failed: &[Exit]| failed.iter().copied().max_by_key(|e| *e as u8);
+    let boards = boards.canonicalize().unwrap_or_else(|_| boards.to_path_buf());
+    let board_file = boards.join(format!("{board}.toml"));
+    if !board_file.is_file() {
+        return Err(Failure::new(
+            Exit::BadInput,
+            format!(
+                "error: no board `{board}` in {} (no {board}.toml)\n  accepted: {}",
+                boards.display(),
+                accepted(&stems(&boards, "boards").unwrap_or_default())
+            ),
+        ));
+    }
+    // Every selected spec must design on the board before cargo runs (located
+    // diagnostics); what does not fit is a warning.
     let mut designs = Vec::new();
+    let mut failed = Vec::new();
     for stem in &selected {
-        match super::design(&motors.join(format!("{stem}.toml"))) {
-            Ok(d) => designs.push(d),
-            Err(d) => err!("{d}"),
+        match super::design_on(&motors.join(format!("{stem}.toml")), Some(&board_file)) {
+            Ok(d) => {
+                for w in d.board.iter().flat_map(|b| &b.warnings) {
+                    crate::output::warn(format_args!("{stem} on {board}: {w}"));
+                }
+                designs.push(d);
+            }
+            Err(f) => {
+                failed.push(f.exit);
+                f.report();
+            }
         }
     }
-    if designs.len() != selected.len() {
-        return ExitCode::FAILURE;
+    if let Some(exit) = gravest(&failed) {
+        return Err(Failure::new(exit, "firmware: nothing built (a spec has problems)"));
     }
+    let target = Target {
+        motors: &motors,
+        board,
+        boards: &boards,
+    };
     // One motor: the constants the image is built from, as `motorgen design` prints them.
     if let [d] = designs.as_slice() {
         out!("{}", codegen::summary::summary(d));
     }
-    let mut ok = true;
     for stem in &selected {
-        match build_one(&root, &motors, stem) {
+        match build_one(&root, &target, stem) {
             Ok(report) => out!("{report}"),
-            Err(e) => {
-                ok = false;
-                err!("error: {e}");
-                if !e.ends_with('\n') {
-                    errln!();
-                }
+            Err(f) => {
+                failed.push(f.exit);
+                f.report();
             }
         }
     }
-    if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+    match gravest(&failed) {
+        None => Ok(()),
+        Some(exit) => Err(Failure::new(
+            exit,
+            format!("firmware: {} of {} images not built", failed.len(), selected.len()),
+        )),
+    }
 }

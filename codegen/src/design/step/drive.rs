@@ -4,23 +4,25 @@ use serde::Serialize;
 
 use super::Context;
 use crate::design::acceleration::AccelerationRule;
-use crate::design::sampling;
+use crate::design::{dead_time, sampling};
 
 /// Inverter operating point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DriveOut {
-    /// f_s [Hz].
+    /// f_s \[Hz\].
     pub switching_frequency_hz: f64,
-    /// T_s = 1/f_s [s].
+    /// T_s = 1/f_s \[s\].
     pub sample_period_s: f64,
-    /// 12·f_e,max [Hz] (1.1).
+    /// 12·f_e,max \[Hz\] (1.1).
     pub min_switching_frequency_hz: f64,
-    /// U_dc [V].
+    /// U_dc \[V\].
     pub dc_link_voltage_v: f64,
-    /// Lowest U_dc [V].
+    /// Lowest U_dc \[V\].
     pub dc_link_voltage_min_v: f64,
-    /// Dead time [s].
+    /// Dead time \[s\] (`drive.dead_time`).
     pub dead_time_s: Option<f64>,
+    /// Its average voltage error U_dc·t_d·f_s \[V\] (see [`dead_time`]).
+    pub dead_time_voltage_error_v: Option<f64>,
     /// Largest shaft acceleration the drive must follow [rad/s², mechanical]
     /// (`design::acceleration`).
     pub max_acceleration_rad_s2: f64,
@@ -56,5 +58,10 @@ pub(in crate::design) fn drive(cx: &mut Context<'_>) -> DriveOut {
         dead_time_s: spec.drive.dead_time.as_ref().map(|p| p.value),
         max_acceleration_rad_s2: acceleration,
         max_acceleration_rule: rule,
+        dead_time_voltage_error_v: spec
+            .drive
+            .dead_time
+            .as_ref()
+            .map(|p| dead_time::voltage_error(spec.drive.dc_link_voltage.value, p.value, fs)),
     }
 }

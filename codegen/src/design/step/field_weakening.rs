@@ -84,7 +84,24 @@ pub(in crate::design) fn field_weakening(
         ));
         return None;
     }
-    let mut out = field_weakening::design(&inp);
+    if !within_circle_speed_limit(cx, &inp, psi) {
+        return None;
+    }
+    let Some(mut out) = field_weakening::design(&inp) else {
+        let p = &spec.drive.dc_link_voltage;
+        cx.errors.push(cx.src.error(
+            p.span.clone(),
+            &p.key,
+            format!(
+                "R_s·I_max = {:.2} V reaches V'_max = {:.2} V: the peak current cannot be driven at any speed, so \
+                 there is no corner speed for ω_base (2.60) (no motor.datasheet.rated_frequency given)",
+                inp.model.rs * inp.model.i_max,
+                inp.voltage_fraction * inp.voltage_max
+            ),
+            "a DC link with U_dc/√3·field_weakening.voltage_fraction above R_s·√2·I_peak, a lower peak_current, or the motor's rated_frequency",
+        ));
+        return None;
+    };
     // |v| must stay within half the margin V_max − V'_max while the shaft accelerates at the
     // drive's largest rate (`motorgen verify` holds the field-weakening run to it).
     let lag = current_loop?.ramp_lag_s;
@@ -157,4 +174,48 @@ pub(in crate::design) fn field_weakening(
         return None;
     }
     Some(out)
+}
+
+/// Whether thesis B's field weakening (2.55)–(2.57), which holds the current on the circle
+/// |i| = I_max, still gives the largest torque the limits allow at the top speed; if not,
+/// an error at `motor.datasheet.max_speed` with the highest speed where it does
+/// ([`field_weakening::circle_speed_limit`]).
+fn within_circle_speed_limit(cx: &mut Context<'_>, inp: &field_weakening::Inputs, psi: f64) -> bool {
+    let Some((limit, why)) = field_weakening::circle_speed_limit(inp) else {
+        return true;
+    };
+    if inp.max_speed <= limit * (1.0 + 1e-9) {
+        return true;
+    }
+    let m = &cx.spec.motor;
+    let p = &m.max_speed;
+    let rpm = 30.0 / PI / f64::from(m.pole_pairs);
+    let (i_max, v) = (inp.model.i_max, inp.voltage_fraction * inp.voltage_max);
+    let what = match why {
+        field_weakening::CircleLimit::MaxTorquePerVolt => format!(
+            "above {:.0} rpm (ω_e = {limit:.0} rad/s) the largest torque within |i| ≤ I_max = {i_max:.1} A and |v| ≤ V'_max = {v:.1} V (R_s included) lies inside the current circle (maximum torque per volt{}), which the field weakening of thesis B (2.55)–(2.57) does not reach: it holds the current on the circle, so up to the top speed {:.0} rpm it would give less torque than the drive can",
+            limit * rpm,
+            if psi < inp.model.ld * i_max {
+                format!("; ψ_m = {psi:.4} Wb < L_d·I_max = {:.4} Wb", inp.model.ld * i_max)
+            } else {
+                String::new()
+            },
+            inp.max_speed * rpm,
+        ),
+        field_weakening::CircleLimit::Voltage => format!(
+            "above {:.0} rpm (ω_e = {limit:.0} rad/s) no point of the current circle |i| = I_max = {i_max:.1} A meets V'_max = {v:.1} V (2.50), (2.53), R_s included: the field weakening of thesis B (2.55)–(2.57) keeps the current on that circle, so at the top speed {:.0} rpm the loop saturates",
+            limit * rpm,
+            inp.max_speed * rpm,
+        ),
+    };
+    cx.errors.push(cx.src.error(
+        p.span.clone(),
+        &p.key,
+        what,
+        format!(
+            "a maximum speed of at most {:.0} rpm, a higher DC link, or a lower peak current",
+            (limit * rpm).floor()
+        ),
+    ));
+    false
 }

@@ -1,5 +1,5 @@
-//! The motor section: the values the design used, their provenance, and the warnings
-//! about ψ_M (K_t and K_e disagreeing, or ψ_M unknown).
+//! The motor section: the values the design used, their provenance, the cross-checks of
+//! every redundant pair the spec gives ([`cross_check`]) and the warnings about them.
 
 use std::collections::BTreeMap;
 use std::f64::consts::{PI, SQRT_2};
@@ -7,7 +7,8 @@ use std::f64::consts::{PI, SQRT_2};
 use serde::Serialize;
 
 use super::Context;
-use crate::spec::{FluxCrossCheck, Param, Provenance};
+use crate::design::cross_check::{self, CrossCheck};
+use crate::spec::{Motor, Param, Provenance};
 
 /// A value with where it came from, for the JSON provenance table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -36,35 +37,35 @@ impl From<&Param> for Origin {
 pub struct MotorOut {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub phase_resistance_ohm: f64,
-    /// R_s at the maximum winding temperature [Ω] (thesis B 2.24), if `[thermal]` is given.
+    /// R_s at the maximum winding temperature \[Ω\] (thesis B 2.24), if `[thermal]` is given.
     pub phase_resistance_hot_ohm: Option<f64>,
-    /// L_d [H].
+    /// L_d \[H\].
     pub d_inductance_h: f64,
-    /// L_q [H].
+    /// L_q \[H\].
     pub q_inductance_h: f64,
-    /// ψ_M [Wb], null if unknown.
+    /// ψ_M \[Wb\], null if unknown.
     pub flux_linkage_wb: Option<f64>,
-    /// ψ_M from K_t and from K_e, when both are given.
-    pub flux_cross_check: Option<FluxCrossCheck>,
-    /// τ_d = L_d/R [s].
+    /// Every redundant pair the spec gives, compared (tolerance 5 %).
+    pub cross_checks: Vec<CrossCheck>,
+    /// τ_d = L_d/R \[s\].
     pub d_time_constant_s: f64,
-    /// τ_q = L_q/R [s].
+    /// τ_q = L_q/R \[s\].
     pub q_time_constant_s: f64,
-    /// Peak phase current, rms [A].
+    /// Peak phase current, rms \[A\].
     pub peak_current_a_rms: f64,
-    /// Nominal phase current, rms [A].
+    /// Nominal phase current, rms \[A\].
     pub nominal_current_a_rms: Option<f64>,
     /// Maximum shaft speed [rad/s].
     pub max_speed_rad_s: f64,
-    /// Maximum shaft speed [rpm].
+    /// Maximum shaft speed \[rpm\].
     pub max_speed_rpm: f64,
-    /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).
+    /// f_e,max = n_p·n_max/60 \[Hz\] (Table 1.2).
     pub max_electrical_frequency_hz: f64,
     /// ω_e,max = 2π·f_e,max [rad/s] (2.19).
     pub max_electrical_speed_rad_s: f64,
-    /// Peak phase-current amplitude √2·I_peak,rms [A] (current-circle radius, thesis B 2.51).
+    /// Peak phase-current amplitude √2·I_peak,rms \[A\] (current-circle radius, thesis B 2.51).
     pub peak_current_a: f64,
     /// Where each value came from.
     pub provenance: BTreeMap<&'static str, Origin>,
@@ -75,13 +76,9 @@ pub struct MotorOut {
 pub(in crate::design) fn motor(cx: &mut Context<'_>, hot_resistance: Option<f64>) -> MotorOut {
     let spec = cx.spec;
     let m = &spec.motor;
-    if let Some(check) = &m.flux_cross_check
-        && check.disagreement_percent > 10.0
-    {
-        cx.warnings.push(format!(
-            "ψ_M from K_t ({:.4} Wb) and from K_e ({:.4} Wb) disagree by {:.1} %",
-            check.from_torque_constant_wb, check.from_back_emf_constant_wb, check.disagreement_percent
-        ));
+    let checks = cross_checks(m);
+    for c in checks.iter().filter(|c| c.fails()) {
+        cx.warnings.push(format!("cross-check: {c}"));
     }
     if m.flux_linkage.is_none() {
         cx.warnings
@@ -96,7 +93,7 @@ pub(in crate::design) fn motor(cx: &mut Context<'_>, hot_resistance: Option<f64>
         d_inductance_h: m.d_inductance.value,
         q_inductance_h: m.q_inductance.value,
         flux_linkage_wb: m.flux_linkage.as_ref().map(|p| p.value),
-        flux_cross_check: m.flux_cross_check.clone(),
+        cross_checks: checks,
         d_time_constant_s: m.d_inductance.value / r,
         q_time_constant_s: m.q_inductance.value / r,
         peak_current_a_rms: m.peak_current.value,
@@ -126,10 +123,95 @@ fn provenance(cx: &Context<'_>) -> BTreeMap<&'static str, Origin> {
     if let Some(p) = &cx.spec.resolver.offset {
         provenance.insert("resolver_offset", Origin::from(p));
     }
+    for (name, p) in [
+        ("nominal_current", &m.nominal_current),
+        ("nominal_torque", &m.nominal_torque),
+        ("peak_torque", &m.peak_torque),
+        ("rated_frequency", &m.rated_frequency),
+        ("nominal_speed", &m.nominal_speed),
+        ("rated_power", &m.rated_power),
+        ("inertia", &m.inertia),
+        ("viscous_friction", &m.viscous_friction),
+    ] {
+        if let Some(p) = p {
+            provenance.insert(name, Origin::from(p));
+        }
+    }
     if let Some(note) = &m.identification {
         for o in provenance.values_mut().filter(|o| o.source == Provenance::Identified) {
             o.note = Some(note.clone());
         }
     }
     provenance
+}
+
+/// The redundant pairs of `m`: every two forms of ψ_M; with ψ_M, the peak and rated torques
+/// against the MTPA torque (3.7), (3.10) at the peak and rated currents; the rated power
+/// against T_n·ω_m,n; a given rated frequency against the nominal speed (2.19).
+fn cross_checks(m: &Motor) -> Vec<CrossCheck> {
+    let mut out = Vec::new();
+    let from = |p: &Param| p.key.clone();
+    for (i, a) in m.flux_sources.iter().enumerate() {
+        for b in &m.flux_sources[i + 1..] {
+            out.push(CrossCheck::new(
+                "ψ_M [Wb]",
+                (a.flux_wb, format!("{} ({})", a.key, a.written)),
+                (b.flux_wb, format!("{} ({})", b.key, b.written)),
+            ));
+        }
+    }
+    if let Some(psi) = &m.flux_linkage {
+        let torque = |i_rms: f64| {
+            cross_check::mtpa_torque(
+                m.pole_pairs,
+                psi.value,
+                m.d_inductance.value,
+                m.q_inductance.value,
+                SQRT_2 * i_rms,
+            )
+        };
+        for (t, i, what) in [
+            (&m.peak_torque, Some(&m.peak_current), "peak"),
+            (&m.nominal_torque, m.nominal_current.as_ref(), "rated"),
+        ] {
+            if let (Some(t), Some(i)) = (t, i) {
+                out.push(CrossCheck::new(
+                    &format!("{what} torque [N·m]"),
+                    (t.value, from(t)),
+                    (
+                        torque(i.value),
+                        format!(
+                            "(3.7) at the MTPA point (3.10) of {} = {:.4} A rms with ψ_M = {:.6} Wb",
+                            i.key, i.value, psi.value
+                        ),
+                    ),
+                ));
+            }
+        }
+    }
+    let speed = m.nominal_speed.as_ref().map(|n| (n.value, n.key.clone())).or_else(|| {
+        m.rated_frequency
+            .as_ref()
+            .map(|f| (2.0 * PI * f.value / f64::from(m.pole_pairs), format!("{} / n_p", f.key)))
+    });
+    if let (Some(p), Some(t), Some((w, w_from))) = (&m.rated_power, &m.nominal_torque, speed) {
+        out.push(CrossCheck::new(
+            "rated power [W]",
+            (p.value, from(p)),
+            (t.value * w, format!("T_n·ω_m,n from {} and {w_from}", t.key)),
+        ));
+    }
+    if let (Some(f), Some(n)) = (&m.rated_frequency, &m.nominal_speed)
+        && f.source != Provenance::Derived
+    {
+        out.push(CrossCheck::new(
+            "rated frequency [Hz]",
+            (f.value, from(f)),
+            (
+                n.value * f64::from(m.pole_pairs) / (2.0 * PI),
+                format!("n_p·ω_m,n/(2π) (2.19) from {}", n.key),
+            ),
+        ));
+    }
+    out
 }

@@ -1,6 +1,7 @@
 //! The sensorless section (thesis B chapter 4) for a spec with a `[sensorless]` section
 //! and a motor with known ψ_M: the estimator design, with ρ above α_c/10 (Table 4.1) an
-//! error at the `[sensorless]` key that set it.
+//! error at the `[sensorless]` key that set it, and I_base (4.24), (4.35), (4.69)
+//! required from the key that provides it.
 
 use std::f64::consts::{PI, SQRT_2};
 
@@ -10,18 +11,18 @@ use crate::design::sensorless;
 use crate::diagnostic::Diagnostic;
 use crate::spec::{DEFAULT_RESISTANCE_ERROR, Param, angle_error_rad};
 
-/// The estimator design and its notes (warnings), `None` without a `[sensorless]`
-/// section or without ψ_M (an error then, at the section: the rules need ψ_M).
+/// The estimator design and its notes (warnings); `None` without a `[sensorless]`
+/// section. Without ψ_M or I_n the section is an error (the rules need both).
 pub(in crate::design) fn sensorless(
     cx: &Context<'_>,
-    per_unit: Option<&PerUnitOut>,
-) -> Result<Option<(sensorless::SensorlessOut, Vec<String>)>, Box<Diagnostic>> {
+    per_unit: &PerUnitOut,
+) -> Result<(Option<sensorless::SensorlessOut>, Vec<String>), Box<Diagnostic>> {
     let spec = cx.spec;
     let src = &cx.src;
     let speed_max = 2.0 * PI * cx.max_electrical_frequency();
     let m = &spec.motor;
     let Some(s) = spec.sensorless.as_ref() else {
-        return Ok(None);
+        return Ok((None, Vec::new()));
     };
     let Some(psi) = m.flux_linkage.as_ref().map(|p| p.value) else {
         return Err(Box::new(src.error(
@@ -31,6 +32,9 @@ pub(in crate::design) fn sensorless(
             "motor.datasheet.flux_linkage (or torque_constant / back_emf_constant), or remove [sensorless]",
         )));
     };
+    let Some(current_base) = per_unit.bases.current_a else {
+        return Err(missing_base_current(cx));
+    };
     let i_max = SQRT_2 * m.peak_current.value;
     let value = |p: &Option<Param>| p.as_ref().map(|p| p.value);
     let inp = sensorless::Inputs {
@@ -39,12 +43,12 @@ pub(in crate::design) fn sensorless(
         lq: m.q_inductance.value,
         psi,
         current_max: i_max,
-        current_base: per_unit.map_or(i_max, |p| p.bases.current_a),
+        current_base,
         speed_max,
         current_bandwidth: spec.current_loop.bandwidth.value,
         switching: 2.0 * PI * spec.drive.switching_frequency.value,
-        voltage_max: spec.drive.dc_link_voltage.value / 3f64.sqrt(),
-        speed_base: per_unit.map(|p| p.bases.angular_frequency_rad_s),
+        voltage_max: per_unit.bases.voltage_v,
+        speed_base: per_unit.bases.angular_frequency_rad_s,
         pole_pairs: f64::from(m.pole_pairs),
         choices: sensorless::Choices {
             bandwidth: value(&s.bandwidth),
@@ -127,5 +131,35 @@ pub(in crate::design) fn sensorless(
         };
         return Err(Box::new(src.error(span, key, what, accepted)));
     }
-    Ok(Some((out, notes)))
+    if let Some(inj) = &out.injection
+        && inj.voltage_v >= inp.voltage_max
+        && let Some(p) = s.injection_voltage.as_ref().or(s.injection_frequency.as_ref())
+    {
+        return Err(Box::new(src.error(
+            p.span.clone(),
+            &p.key,
+            format!(
+                "the carrier amplitude V_e = {:.1} V (thesis B (4.35) at ω_e = {:.0} rad/s) reaches V_max = U_dc/√3 = {:.1} V: the inverter cannot produce it",
+                inj.voltage_v, inj.frequency_rad_s, inp.voltage_max
+            ),
+            format!(
+                "a carrier amplitude below V_max, e.g. at most {:.1} V (0.2·V_max, thesis B §4.3.1): a lower sensorless.injection_frequency (V_e ∝ ω_e) or injection_voltage",
+                0.2 * inp.voltage_max
+            ),
+        )));
+    }
+    Ok((Some(out), notes))
+}
+
+/// What the rules (4.24), (4.35) and the ω_min2 (4.69) operating point need and the spec
+/// lacks: I_base = √2·I_n (thesis B Table A.1), an error at the key that provides I_n.
+/// No other current stands in for I_base.
+fn missing_base_current(cx: &Context<'_>) -> Box<Diagnostic> {
+    let why = "I_base = √2·I_n (thesis B Table A.1), which sets the carrier amplitude (4.35), the filterless ρ bound (4.24) and the MTPA operating point of ω_min2 (4.69)";
+    Box::new(cx.src.error(
+        cx.spec.motor.span.clone(),
+        "motor.datasheet.nominal_current",
+        format!("the sensorless estimator ([sensorless]) needs {why}; the spec gives no rated current"),
+        "nominal_current = \"<rated rms phase current>\" in [motor.datasheet], e.g. nominal_current = \"160 A\"",
+    ))
 }
