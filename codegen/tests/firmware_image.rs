@@ -53,7 +53,8 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
     // cargo's progress is relayed on stderr as it comes: the command, then cargo's own
     // lines, at least the closing "Finished" (also when nothing needs compiling).
     assert!(
-        stderr.contains("fischer-ti085: MOTOR=fischer-ti085 BOARD=motorgen-reference cargo build --release") && stderr.contains("Finished"),
+        stderr.contains("fischer-ti085: MOTOR=fischer-ti085 BOARD=motorgen-reference cargo build --release")
+            && stderr.contains("Finished"),
         "no build progress on stderr:\n{stderr}"
     );
 

@@ -9,8 +9,8 @@ pub mod adc;
 pub mod angle_observer;
 pub mod cross_check;
 pub mod current_loop;
-pub mod designed_response;
 pub mod dead_time;
+pub mod designed_response;
 pub mod discrete_loop;
 pub mod sampled_loop;
 

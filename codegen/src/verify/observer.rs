@@ -17,13 +17,13 @@ use motor_control::ato::AtoState;
 use motor_control::step::Demand;
 
 use super::scenarios::{check, samples, series, trace};
+use super::{ScenarioResult, Setup, format_value};
+use crate::design::angle_observer::ramp_lag;
+use crate::spec::ObserverError;
 use motor_control::angle::from_radians_f64;
 use motor_sim::bench::{Bench, q31_angle};
 use motor_sim::figures::settling_time;
 use motor_sim::plant::{SpeedProfile, wrap};
-use super::{ScenarioResult, Setup, format_value};
-use crate::design::angle_observer::ramp_lag;
-use crate::spec::ObserverError;
 
 /// Time [s] for the continuous ATO (thesis A (4.12)–(4.14)) started `e0` rad off at rest
 /// to stay within `threshold`: ë + K_p·ė + K_i·e = 0, e(0) = e0, ė(0) = −K_p·e0.
