@@ -8,6 +8,7 @@
 pub mod constants;
 pub mod design;
 pub mod diagnostic;
+pub mod escape;
 #[cfg(feature = "identify")]
 pub mod identify;
 pub mod render;
