@@ -5,6 +5,7 @@
 //! constant cannot differ between them. Every entry carries its physical value
 //! with unit, its formula, the source equation and the provenance of its inputs.
 
+mod board;
 mod field_weakening;
 mod sensorless;
 
@@ -146,6 +147,18 @@ fn q31v(bits: i32) -> Value {
         c_array: String::new(),
         c_expr: bits.to_string(),
         number: serde_json::json!(bits),
+    }
+}
+
+fn u8_array(v: &[u8]) -> Value {
+    let list = v.iter().map(u8::to_string).collect::<Vec<_>>().join(", ");
+    Value {
+        rust_type: format!("[u8; {}]", v.len()),
+        rust_expr: format!("[{list}]"),
+        c_type: "uint8_t".into(),
+        c_array: format!("[{}]", v.len()),
+        c_expr: format!("{{{list}}}"),
+        number: serde_json::json!(v),
     }
 }
 
@@ -452,19 +465,35 @@ pub fn constants(d: &Design) -> Vec<Group> {
         )
         .at("/angle_observer/lead_q16"),
     ];
-    if let (Some(rad), Some(bits)) = (o.resolver_offset_rad, o.resolver_offset_q31) {
-        observer.push(
-            c(
-                "RESOLVER_OFFSET",
-                q31v(bits),
-                phys(rad, "rad"),
-                "θ_off/π, Q1.31 (wrapping)",
-                "thesis A (4.5), (6.9)",
-                format!("θ_off ({})", prov(m.provenance.get("resolver_offset"))),
-            )
-            .at("/angle_observer/resolver_offset_q31"),
-        );
-    }
+    let offset_rad = o.resolver_offset_rad.unwrap_or(0.0);
+    observer.push(
+        c(
+            "RESOLVER_OFFSET",
+            q31v(o.resolver_offset_q31.unwrap_or(0)),
+            format!("{} = {}°", phys(offset_rad, "rad"), phys(offset_rad.to_degrees(), "")),
+            "θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9))",
+            "thesis A (4.5), (6.9)",
+            match o.resolver_offset_rad {
+                Some(_) => format!("θ_off ({})", prov(m.provenance.get("resolver_offset"))),
+                None => "θ_off not in the spec: 0".into(),
+            },
+        )
+        .at("/angle_observer/resolver_offset_q31"),
+    );
+    observer.push(
+        c(
+            "ERROR_FORM",
+            intv(i64::from(o.error_form), "u8", "uint8_t"),
+            match o.error {
+                crate::spec::ObserverError::TrigIdentity => "0: trig identity".into(),
+                crate::spec::ObserverError::Atan2 => "1: atan2".into(),
+            },
+            "error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π",
+            "thesis A (4.8)–(4.10), (4.22)",
+            "angle_observer.error (spec)".into(),
+        )
+        .at("/angle_observer/error_form"),
+    );
 
     let s = &d.scaling;
     let mut scalings = Vec::new();
@@ -662,6 +691,9 @@ pub fn constants(d: &Design) -> Vec<Group> {
         field_weakening::group(d),
         sensorless::group(d),
     ]
+    .into_iter()
+    .chain(board::group(d))
+    .collect()
 }
 
 #[cfg(test)]

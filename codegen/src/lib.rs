@@ -5,6 +5,7 @@
 //! CLI, the firmware's build script and the proc-macros all call it, so a
 //! constant cannot differ between the three paths.
 
+pub mod board;
 pub mod constants;
 pub mod design;
 pub mod diagnostic;
@@ -22,6 +23,31 @@ pub mod verify;
 
 pub use design::Design;
 pub use diagnostic::{Diagnostic, Diagnostics, Source};
+
+/// Parses and checks one board file. `file` is only used in messages.
+pub fn board_source(file: &str, text: &str) -> Result<board::Board, Diagnostics> {
+    board::parse(Source { file, text })
+}
+
+/// Designs a motor on a board: the motor's design ([`design_source`]) with the board's
+/// constants and the checks that need both (warnings at the board key, see
+/// [`board::design`]).
+pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &str) -> Result<Design, Diagnostics> {
+    let board = board_source(board_file, board_text);
+    let design = design_source(file, text);
+    let (board, mut design) = match (board, design) {
+        (Ok(b), Ok(d)) => (b, d),
+        (Err(mut a), Err(b)) => {
+            a.0.extend(b.0);
+            return Err(a);
+        }
+        (Err(e), _) | (_, Err(e)) => return Err(e),
+    };
+    let (out, warnings) = board::design::design(&board, board_text, &design);
+    design.warnings.extend(warnings);
+    design.board = Some(out);
+    Ok(design)
+}
 
 /// Parses, resolves and designs one spec. `file` is only used in messages.
 pub fn design_source(file: &str, text: &str) -> Result<Design, Diagnostics> {

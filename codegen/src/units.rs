@@ -55,6 +55,10 @@ pub enum Kind {
     Angle,
     /// rad/s² or rpm/s, returned in rad/s².
     AngularAcceleration,
+    /// V/A (a current sensor's output voltage per ampere), returned in V/A.
+    Transresistance,
+    /// bit/s (a bus bit rate), returned in bit/s.
+    BitRate,
 }
 
 impl Kind {
@@ -83,6 +87,8 @@ impl Kind {
             Kind::ViscousFriction => "a viscous friction coefficient",
             Kind::Angle => "an angle",
             Kind::AngularAcceleration => "an angular acceleration",
+            Kind::Transresistance => "a current-sensor gain",
+            Kind::BitRate => "a bit rate",
         }
     }
 
@@ -123,6 +129,8 @@ impl Kind {
             Kind::AngularAcceleration => {
                 "an angular acceleration such as \"5000 rpm/s\" (units: rad/s², rad/s^2, rpm/s, krpm/s)"
             }
+            Kind::Transresistance => "a current-sensor gain such as \"51.8 mV/A\" (units: V/A, mV/A)",
+            Kind::BitRate => "a bit rate such as \"500 kbit/s\" (units: bit/s, kbit/s, Mbit/s)",
         }
     }
 }
@@ -316,6 +324,17 @@ pub fn parse(kind: Kind, text: &str) -> Result<f64, UnitError> {
             "krpm/s" => Some(value * 1e3 * std::f64::consts::PI / 30.0),
             _ => None,
         },
+        Kind::Transresistance => match unit.as_str() {
+            "V/A" => Some(value),
+            "mV/A" => Some(value * 1e-3),
+            _ => None,
+        },
+        Kind::BitRate => match unit.as_str() {
+            "bit/s" | "bps" => Some(value),
+            "kbit/s" | "kbps" => Some(value * 1e3),
+            "Mbit/s" | "Mbps" => Some(value * 1e6),
+            _ => None,
+        },
         Kind::TorqueConstant => ratio(&unit, Kind::Torque, Kind::Current, Split::Last).map(|k| value * k),
         Kind::SpeedConstant => ratio(&unit, Kind::Speed, Kind::Voltage, Split::Last).map(|k| value * k),
         Kind::BackEmfConstant => {
@@ -385,6 +404,16 @@ mod tests {
         assert!(close(parse(Kind::TemperatureCelsius, "130 °C").unwrap(), 130.0));
         assert!((parse(Kind::TemperatureCelsius, "293.15 K").unwrap() - 20.0).abs() < 1e-9);
         assert!(close(parse(Kind::Voltage, "1.2e2 V").unwrap(), 120.0));
+    }
+
+    /// Board quantities: 10 mΩ shunt × gain 5.18 = 51.8 mV/A; 500 kbit/s.
+    #[test]
+    fn sensor_gains_and_bit_rates() {
+        assert!(close(parse(Kind::Transresistance, "51.8 mV/A").unwrap(), 0.0518));
+        assert!(close(parse(Kind::Transresistance, "0.02 V/A").unwrap(), 0.02));
+        assert!(close(parse(Kind::BitRate, "500 kbit/s").unwrap(), 500e3));
+        assert!(close(parse(Kind::BitRate, "1 Mbit/s").unwrap(), 1e6));
+        assert!(parse(Kind::Transresistance, "5 mV").is_err());
     }
 
     #[test]

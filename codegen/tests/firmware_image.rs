@@ -1,6 +1,7 @@
 //! `motorgen firmware` as a user runs it: the fischer-ti085 image is built into
 //! `target/firmware/`, is a valid STM32G474 flash image and fits in 64 KiB; an unknown
-//! stem and a bad spec are refused before anything is built or written.
+//! stem and a bad spec are refused before anything is built or written; `--all` builds
+//! every motor on the default board and on the NUCLEO-G474RE + X-NUCLEO-IHM08M1 board.
 //!
 //! The image builds in the firmware workspace's own target directory, `firmware/target`,
 //! where `motorgen firmware` builds it for a user and where `tests/firmware.rs` builds the
@@ -31,6 +32,8 @@ fn firmware(args: &[&str]) -> Output {
         .env("CARGO_TARGET_DIR", repo.join("firmware").join("target"))
         .env_remove("MOTOR")
         .env_remove("MOTORS_DIR")
+        .env_remove("BOARD")
+        .env_remove("BOARDS_DIR")
         .output()
         .expect("motorgen runs")
 }
@@ -75,6 +78,88 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
     assert!(
         (FLASH_START..flash_end).contains(&(reset & !1)),
         "reset vector {reset:#010x} outside the image {FLASH_START:#010x}..{flash_end:#010x}"
+    );
+}
+
+/// `motorgen firmware --all [--board <board>]`: every motor's image is written into `dir`
+/// (relative to `target/firmware/`), under 64 KiB with the G474's stack pointer, and a
+/// flash line is printed for each; returns stderr (the board warnings).
+fn every_motor_builds(board: Option<&str>) -> String {
+    let mut args = vec!["--all"];
+    args.extend(board.iter().flat_map(|b| ["--board", *b]));
+    let out = firmware(&args);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        out.status.success(),
+        "motorgen firmware {args:?} failed:\n{stdout}\n{stderr}"
+    );
+    println!("{stdout}{stderr}");
+    let mut dir = repo().join("target").join("firmware");
+    if let Some(b) = board {
+        dir = dir.join(b);
+    }
+    for stem in common::motor_stems() {
+        let bin = std::fs::read(dir.join(format!("{stem}.bin"))).expect("the .bin is written");
+        assert!(bin.len() < 64 * 1024, "{stem}: {} bytes", bin.len());
+        assert_eq!(word(&bin, 0), RAM_END, "{stem}: initial stack pointer");
+        assert!(
+            stdout.contains(&format!("{stem}: flash {} bytes", bin.len())),
+            "{stem}: no flash line for {} bytes in\n{stdout}",
+            bin.len()
+        );
+    }
+    stderr.into_owned()
+}
+
+/// `firmware --all` builds every motor on the default board into `target/firmware/`.
+#[test]
+fn every_motor_builds_on_the_default_board() {
+    every_motor_builds(None);
+}
+
+/// Every motor builds on the second board, the NUCLEO-G474RE + X-NUCLEO-IHM08M1, into
+/// `target/firmware/nucleo-g474re-ihm08m1/`; the motors its ±30.7 A / 63.2 V sensing
+/// cannot serve are warned about at the board key (stderr), not refused.
+#[test]
+fn every_motor_builds_on_the_nucleo_ihm08m1_board() {
+    let stderr = every_motor_builds(Some("nucleo-g474re-ihm08m1"));
+    // Fischer's 600 V DC link is beyond the divider's 63.2 V: a warning at the key.
+    assert!(
+        stderr.contains("warning: fischer-ti085 on nucleo-g474re-ihm08m1:")
+            && stderr.contains("`sensing.dc_link_divider`: the divider measures up to 63.2 V"),
+        "{stderr}"
+    );
+}
+
+/// A bad board file is refused with its location before cargo runs.
+#[test]
+fn bad_board_fails_with_its_location_before_cargo_runs() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("firmware-bad-boards");
+    std::fs::create_dir_all(&dir).unwrap();
+    let good = std::fs::read_to_string(repo().join("boards/motorgen-reference.toml")).unwrap();
+    let bad = good.replacen("gate_u_low = \"PB13\"", "gate_u_low = \"PA5\" ", 1);
+    assert_ne!(bad, good);
+    let line = bad[..bad.find("gate_u_low = \"PA5\"").unwrap()].matches('\n').count() + 1;
+    std::fs::write(dir.join("bad.toml"), bad).unwrap();
+    let out = firmware(&["fischer-ti085", "--board", "bad", "--boards-dir", dir.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    for expected in [
+        format!("bad.toml:{line}:14"),
+        "`pins.gate_u_low`".into(),
+        "PA5 has no TIM1_CH1N".into(),
+    ] {
+        assert!(stderr.contains(&expected), "expected {expected:?} in\n{stderr}");
+    }
+    assert!(!stderr.contains("Compiling"), "cargo ran for a bad board:\n{stderr}");
+    // An unknown board lists the boards that exist.
+    let out = firmware(&["fischer-ti085", "--board", "no-such-board"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("no board `no-such-board`") && stderr.contains("nucleo-g474re-ihm08m1"),
+        "{stderr}"
     );
 }
 

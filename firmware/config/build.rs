@@ -1,7 +1,11 @@
 //! Generates `$OUT_DIR/motor.rs` for the motor named by `MOTOR` (a file stem in
-//! `motors/`, default `fischer-ti085`) through the same `codegen` functions as
-//! `motorgen`. `MOTORS_DIR` overrides the spec directory. A bad spec fails the
-//! build with the CLI's located message, not a panic.
+//! `motors/`, default `fischer-ti085`) on the board named by `BOARD` (a file stem in
+//! `boards/`, default `motorgen-reference`) through the same `codegen` functions as
+//! `motorgen` (`codegen::design_with_board` → the Rust template): the motor's constants
+//! and the `board` group. `MOTORS_DIR` and `BOARDS_DIR` override the folders. A bad
+//! spec or board file fails the build with the CLI's located message, not a panic; the
+//! board's warnings for this motor (a current range below its peak current, …) are
+//! printed as cargo warnings.
 //! (Linker setup for the image is in `../app/build.rs`.)
 
 use std::path::{Path, PathBuf};
@@ -14,70 +18,93 @@ fn fail(message: &str) {
     }
 }
 
+/// The `*.toml` stems of `dir`, sorted and comma-separated (for "accepted:" lines).
+fn stems(dir: &Path) -> String {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|rd| {
+            rd.flatten()
+                .filter_map(|e| {
+                    let p = e.path();
+                    (p.extension().is_some_and(|x| x == "toml"))
+                        .then(|| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
+                        .flatten()
+                })
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v.join(", ")
+}
+
+/// The text of `<dir>/<stem>.toml` named by the variable `var`, or a located failure.
+fn read(var: &str, dir: &Path, stem: &str) -> Option<String> {
+    let path = dir.join(format!("{stem}.toml"));
+    println!("cargo::rerun-if-changed={}", path.display());
+    match std::fs::read(&path) {
+        Ok(bytes) => match String::from_utf8(bytes) {
+            Ok(t) => Some(t),
+            Err(e) => {
+                fail(&format!(
+                    "{}: the file is not valid UTF-8 (byte {})",
+                    path.display(),
+                    e.utf8_error().valid_up_to()
+                ));
+                None
+            }
+        },
+        Err(e) => {
+            fail(&format!(
+                "{var}={stem}: cannot read {}: {e}\n  accepted: {var} set to one of: {}",
+                path.display(),
+                stems(dir)
+            ));
+            None
+        }
+    }
+}
+
 fn main() {
     let out_dir = PathBuf::from(std::env::var("OUT_DIR").unwrap_or_default());
     let manifest = PathBuf::from(std::env::var("CARGO_MANIFEST_DIR").unwrap_or_default());
     let repo = manifest.join("../..");
-    println!("cargo::rerun-if-env-changed=MOTOR");
-    println!("cargo::rerun-if-env-changed=MOTORS_DIR");
+    for var in ["MOTOR", "MOTORS_DIR", "BOARD", "BOARDS_DIR"] {
+        println!("cargo::rerun-if-env-changed={var}");
+    }
     let motors = std::env::var_os("MOTORS_DIR").map_or_else(|| repo.join("motors"), PathBuf::from);
+    let boards = std::env::var_os("BOARDS_DIR").map_or_else(|| repo.join("boards"), PathBuf::from);
     let templates = repo.join("templates");
-    println!("cargo::rerun-if-changed={}", motors.display());
-    println!("cargo::rerun-if-changed={}", templates.display());
+    for dir in [&motors, &boards, &templates] {
+        println!("cargo::rerun-if-changed={}", dir.display());
+    }
     if let Ok(entries) = std::fs::read_dir(&templates) {
         for e in entries.flatten() {
             println!("cargo::rerun-if-changed={}", e.path().display());
         }
     }
-    let stem = std::env::var("MOTOR").unwrap_or_else(|_| DEFAULT_MOTOR.to_string());
-    let spec = motors.join(format!("{stem}.toml"));
-    println!("cargo::rerun-if-changed={}", spec.display());
-    let known = || {
-        let mut v: Vec<String> = std::fs::read_dir(&motors)
-            .map(|rd| {
-                rd.flatten()
-                    .filter_map(|e| {
-                        let p = e.path();
-                        (p.extension().is_some_and(|x| x == "toml"))
-                            .then(|| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-                    })
-                    .flatten()
-                    .collect()
-            })
-            .unwrap_or_default();
-        v.sort();
-        v.join(", ")
+    let motor = std::env::var("MOTOR").unwrap_or_else(|_| DEFAULT_MOTOR.to_string());
+    let board = std::env::var("BOARD").unwrap_or_else(|_| codegen::board::DEFAULT_BOARD.to_string());
+    let (Some(spec), Some(board_text)) = (read("MOTOR", &motors, &motor), read("BOARD", &boards, &board)) else {
+        return;
     };
-    let text = match std::fs::read(&spec) {
-        Ok(bytes) => match String::from_utf8(bytes) {
-            Ok(t) => t,
-            Err(e) => {
-                return fail(&format!(
-                    "{}: the file is not valid UTF-8 (byte {})",
-                    spec.display(),
-                    e.utf8_error().valid_up_to()
-                ));
-            }
-        },
-        Err(e) => {
-            return fail(&format!(
-                "MOTOR={stem}: cannot read {}: {e}\n  accepted: MOTOR set to one of: {}",
-                spec.display(),
-                known()
-            ));
-        }
-    };
-    let shown = format!("motors/{stem}.toml");
-    let design = match codegen::design_source(&shown, &text) {
+    let design = match codegen::design_with_board(
+        &format!("motors/{motor}.toml"),
+        &spec,
+        &format!("boards/{board}.toml"),
+        &board_text,
+    ) {
         Ok(d) => d,
         Err(e) => return fail(&e.to_string()),
     };
+    // What does not fit between the board and the motor (the motor's own design notes
+    // are `motorgen design`'s to print).
+    for w in design.board.iter().flat_map(|b| &b.warnings) {
+        println!("cargo::warning={w}");
+    }
     let code = match codegen::render::render(&design, codegen::render::Output::Rust) {
         Ok(c) => c,
         Err(e) => return fail(&e.to_string()),
     };
     write_if_changed(&out_dir.join("motor.rs"), &code);
-    write_if_changed(&out_dir.join("design_extra.rs"), &design_extra(&design));
 }
 
 /// Writes only when the bytes change, so an unchanged design causes no rebuild.
@@ -87,57 +114,4 @@ fn write_if_changed(out: &Path, code: &str) {
     {
         fail(&format!("cannot write {}: {e}", out.display()));
     }
-}
-
-/// Design values the board needs that codegen's constant list does not carry yet
-/// (reported to be added there): the observer error architecture the gains are
-/// scaled for, the resolver offset and dead time if the spec gives them, the ADC
-/// SMP code if the spec has an `[adc]` section.
-fn design_extra(d: &codegen::design::Design) -> String {
-    use codegen::spec::ObserverError;
-    let error = match d.angle_observer.error {
-        ObserverError::TrigIdentity => "TrigIdentity",
-        ObserverError::Atan2 => "Atan2",
-    };
-    // θ_off [rad] → π-scaled Q1.31 (4.20), wrapped into one turn.
-    let offset = d.angle_observer.resolver_offset_rad.map_or(0, |rad| {
-        let turns = rad / std::f64::consts::TAU;
-        let frac = turns - turns.round();
-        (frac * 4_294_967_296.0).round() as i64 as i32
-    });
-    let opt = |v: Option<String>| v.map_or_else(|| "None".to_string(), |v| format!("Some({v})"));
-    let offset_doc = d.angle_observer.resolver_offset_rad.map_or_else(
-        || "not in the spec: 0".to_string(),
-        |rad| format!("{rad:.6} rad = {:.4}°, wrapped into ±π, ·2^31/π", rad.to_degrees()),
-    );
-    let dead_ns = d.drive.dead_time_s.map(|s| (s * 1e9).round() as u32);
-    let dead = opt(dead_ns.map(|ns| ns.to_string()));
-    let dead_doc = dead_ns.map_or_else(|| "not in the spec".to_string(), |ns| format!("{ns} ns"));
-    let smp = opt(d.adc.sample_time.as_ref().map(|t| t.smp_code.to_string()));
-    let smp_doc = d.adc.sample_time.as_ref().map_or_else(
-        || "no `[adc]` section".to_string(),
-        |t| {
-            format!(
-                "{} ADC cycles = {:.1} ns ≥ the settling time {:.1} ns",
-                t.cycles,
-                t.sample_time_s * 1e9,
-                t.min_sample_time_s * 1e9
-            )
-        },
-    );
-    format!(
-        "// @generated by firmware/config/build.rs from {spec}. Do not edit.\n\
-         /// Observer error architecture the gains `motor::observer::KP`/`KI` are scaled for\n\
-         /// (spec `[angle_observer] error`), thesis A (4.8)–(4.10), (4.22).\n\
-         pub const OBSERVER_ERROR: motor_control::ato::ObserverError = motor_control::ato::ObserverError::{error};\n\
-         /// Resolver offset θ_off (4.5), π-scaled Q1.31: spec `[resolver] offset`, else 0\n\
-         /// (identified at commissioning, thesis A §6.3 (6.9)). θ_off = {offset_doc}.\n\
-         pub const RESOLVER_OFFSET_Q31: i32 = {offset};\n\
-         /// Inverter dead time \\[ns\\] from spec `[drive] dead_time`, if given: {dead_doc}.\n\
-         pub const DEAD_TIME_NS: Option<u32> = {dead};\n\
-         /// ADC_SMPR code chosen by the settling rule, thesis A (7.2), (7.4), if the spec has\n\
-         /// `[adc]`: {smp_doc}.\n\
-         pub const ADC_SMP_CODE: Option<u8> = {smp};\n",
-        spec = d.spec_file,
-    )
 }

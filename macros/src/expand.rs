@@ -15,32 +15,71 @@ use syn::{Expr, ExprLit, ExprUnary, Ident, Lit, LitStr, Token, UnOp};
 
 /// `motor_constants!("path")`.
 pub fn motor_constants(input: TokenStream) -> syn::Result<TokenStream> {
-    let lit: LitStr = syn::parse2(input)?;
-    let rel = lit.value();
+    // `"motor.toml"` or `"motor.toml", board = "board.toml"`.
+    let args = syn::parse::Parser::parse2(
+        |p: syn::parse::ParseStream<'_>| {
+            let spec: LitStr = p.parse()?;
+            let mut board = None;
+            if p.parse::<Option<syn::Token![,]>>()?.is_some() && !p.is_empty() {
+                let key: syn::Ident = p.parse()?;
+                if key != "board" {
+                    return Err(syn::Error::new(
+                        key.span(),
+                        "unknown argument; accepted: board = \"<board file>\"",
+                    ));
+                }
+                p.parse::<syn::Token![=]>()?;
+                board = Some(p.parse::<LitStr>()?);
+                let _ = p.parse::<Option<syn::Token![,]>>()?;
+            }
+            Ok((spec, board))
+        },
+        input,
+    )?;
+    let (lit, board) = args;
     let root = std::env::var("CARGO_MANIFEST_DIR")
         .map_err(|_| syn::Error::new(lit.span(), "CARGO_MANIFEST_DIR is not set"))?;
-    let path = PathBuf::from(root).join(&rel);
-    let text = std::fs::read_to_string(&path).map_err(|e| {
-        syn::Error::new(
-            lit.span(),
-            format!("cannot read `{rel}` (relative to CARGO_MANIFEST_DIR): {e}"),
-        )
-    })?;
-    let design = codegen::design_source(&rel, &text).map_err(|e| {
+    let read = |lit: &LitStr| {
+        let rel = lit.value();
+        let path = PathBuf::from(&root).join(&rel);
+        std::fs::read_to_string(&path)
+            .map(|text| (rel.clone(), path, text))
+            .map_err(|e| {
+                syn::Error::new(
+                    lit.span(),
+                    format!("cannot read `{rel}` (relative to CARGO_MANIFEST_DIR): {e}"),
+                )
+            })
+    };
+    let (rel, path, text) = read(&lit)?;
+    let located = |span: proc_macro2::Span, e: codegen::Diagnostics| {
         // compile_error! already says "error:".
         let msg = e.to_string();
-        syn::Error::new(
-            lit.span(),
-            msg.strip_prefix("error: ").unwrap_or(&msg).trim_end().to_string(),
-        )
-    })?;
+        syn::Error::new(span, msg.strip_prefix("error: ").unwrap_or(&msg).trim_end().to_string())
+    };
+    let (design, board_path) = match &board {
+        None => (
+            codegen::design_source(&rel, &text).map_err(|e| located(lit.span(), e))?,
+            None,
+        ),
+        Some(b) => {
+            let (brel, bpath, btext) = read(b)?;
+            let d = codegen::design_with_board(&rel, &text, &brel, &btext).map_err(|e| located(b.span(), e))?;
+            (d, Some(bpath))
+        }
+    };
     let code = render(&design, Output::Rust).map_err(|e| syn::Error::new(lit.span(), e.to_string()))?;
     let items: TokenStream = code
         .parse()
         .map_err(|e| syn::Error::new(lit.span(), format!("generated code does not parse: {e}")))?;
     let abs = path.canonicalize().unwrap_or(path).display().to_string();
+    let board_dep = board_path.map(|p| {
+        let abs = p.canonicalize().unwrap_or(p).display().to_string();
+        quote! { const _: &str = include_str!(#abs); }
+    });
     Ok(quote! {
         const _: &str = include_str!(#abs);
+        #board_dep
         #items
     })
 }

@@ -14,10 +14,14 @@ use proc_macro::TokenStream;
 
 /// Expands to the constant modules of a motor spec (path relative to `CARGO_MANIFEST_DIR`),
 /// identical to `motorgen design <spec> --format rust`; editing the spec recompiles.
+/// With `board = "<board file>"` the `board` module is added, as `motorgen design
+/// <spec> --board <board file> --format rust`.
 ///
 /// ```ignore
 /// motor_macros::motor_constants!("../motors/fischer-ti085.toml");
 /// let kp: f32 = current_loop::D_KP;
+/// motor_macros::motor_constants!("../motors/fischer-ti085.toml", board = "../boards/motorgen-reference.toml");
+/// let dead_ns: u32 = board::DEAD_TIME_NS;
 /// ```
 #[proc_macro]
 pub fn motor_constants(input: TokenStream) -> TokenStream {

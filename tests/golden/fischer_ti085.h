@@ -98,6 +98,14 @@ static const uint32_t OBSERVER_RESOLVER_POLE_PAIRS = 1;
  *  Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6). */
 static const int32_t OBSERVER_LEAD_Q16 = 98304;
 
+/** 0 rad = 0°: θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9)), thesis A (4.5), (6.9).
+ *  Inputs: θ_off not in the spec: 0. */
+static const int32_t OBSERVER_RESOLVER_OFFSET = 0;
+
+/** 0: trig identity: error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π, thesis A (4.8)–(4.10), (4.22).
+ *  Inputs: angle_observer.error (spec). */
+static const uint8_t OBSERVER_ERROR_FORM = 0;
+
 /* Per-unit fixed-point scalings (full scale A and SI per LSB). */
 
 /** 107.834 A: A of phase current: margin·√2·I_peak,rms = 1.25·√2·61 A, thesis A (4.16), (4.20), Table 4.1.

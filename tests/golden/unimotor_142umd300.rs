@@ -104,6 +104,14 @@ pub mod observer {
     ///
     /// Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6).
     pub const LEAD_Q16: i32 = 98304;
+    /// 0 rad = 0°: `θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9))`, thesis A (4.5), (6.9).
+    ///
+    /// Inputs: θ_off not in the spec: 0.
+    pub const RESOLVER_OFFSET: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(0);
+    /// 1: atan2: `error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π`, thesis A (4.8)–(4.10), (4.22).
+    ///
+    /// Inputs: angle_observer.error (spec).
+    pub const ERROR_FORM: u8 = 1;
 }
 
 /// Per-unit fixed-point scalings (full scale A and SI per LSB).

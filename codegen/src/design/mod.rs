@@ -65,6 +65,9 @@ pub struct Design {
     pub field_weakening: Option<field_weakening::FieldWeakeningOut>,
     /// Sensorless estimator (thesis B chapter 4), when ψ_M is known.
     pub sensorless: Option<sensorless::SensorlessOut>,
+    /// The inverter board's values with this motor (`crate::design_with_board`); `None`
+    /// for a motor designed on its own.
+    pub board: Option<crate::board::design::BoardOut>,
     /// Non-fatal observations.
     pub warnings: Vec<String>,
 }
@@ -111,6 +114,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         adc,
         field_weakening,
         sensorless,
+        board: None,
         warnings: cx.warnings,
     })
 }

@@ -39,8 +39,9 @@ pub use flux_linkage::FluxSource;
 pub use inverter::InverterSpec;
 pub use motor::{Harmonics, Motor};
 use raw::RawSpec;
+pub(crate) use raw::Val;
 pub use raw::{Amplitude, Between, Connection, Method, ObserverError, SpeedAxis};
-use resolve::Resolver_;
+pub(crate) use resolve::Resolver_;
 pub use resolver::Resolver;
 pub use sensorless::{DEFAULT_ANGLE_ERROR_DEG, DEFAULT_RESISTANCE_ERROR, SensorlessSpec, angle_error_rad};
 pub use thermal::ThermalSpec;
@@ -119,19 +120,24 @@ pub fn parse(source: Source<'_>) -> Result<Spec, Diagnostics> {
             )
             .into());
     }
-    let de = toml::Deserializer::parse(source.text).map_err(|e| syntax::syntax_error(source, &e))?;
-    let raw: RawSpec = serde_path_to_error::deserialize(de).map_err(|e| {
-        let path = e.path().to_string();
-        let inner = e.into_inner();
-        syntax::shape_error(source, &path, &inner)
-    })?;
-    let mut cx = Resolver_ {
-        src: source,
-        errors: Vec::new(),
-    };
+    let raw: RawSpec = deserialize(source, "motors/fischer-ti085.toml")?;
+    let mut cx = Resolver_::new(source);
     let spec = cx.spec(&raw);
     match spec {
         Some(spec) if cx.errors.is_empty() => Ok(spec),
         _ => Err(Diagnostics(cx.errors)),
     }
+}
+
+/// TOML text → the raw (spanned) structure `T`, every syntax or shape problem (unknown
+/// key, missing key, wrong type, unknown value) located at its key; `example` names a
+/// complete file of the same kind for the "accepted" line. Shared by motor specs and
+/// board files (`crate::board`).
+pub(crate) fn deserialize<T: serde::de::DeserializeOwned>(source: Source<'_>, example: &str) -> Result<T, Diagnostics> {
+    let de = toml::Deserializer::parse(source.text).map_err(|e| syntax::syntax_error(source, &e))?;
+    serde_path_to_error::deserialize(de).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        syntax::shape_error(source, &path, &inner, example)
+    })
 }

@@ -12,10 +12,11 @@ use super::{Param, Provenance, Spec};
 use crate::diagnostic::{Diagnostic, Source};
 use crate::units::{self, Kind};
 
-/// The second pass; collects every problem instead of stopping at the first.
-pub(super) struct Resolver_<'a> {
-    pub(super) src: Source<'a>,
-    pub(super) errors: Vec<Diagnostic>,
+/// The second pass; collects every problem instead of stopping at the first. Its value
+/// readers (`quantity`, `number`, `integer`) also read board files (`crate::board`).
+pub(crate) struct Resolver_<'a> {
+    pub(crate) src: Source<'a>,
+    pub(crate) errors: Vec<Diagnostic>,
 }
 
 fn kind_example(kind: Kind) -> &'static str {
@@ -23,7 +24,15 @@ fn kind_example(kind: Kind) -> &'static str {
 }
 
 impl<'a> Resolver_<'a> {
-    pub(super) fn err(
+    /// A resolver with no problems found yet.
+    pub(crate) fn new(src: Source<'a>) -> Self {
+        Resolver_ {
+            src,
+            errors: Vec::new(),
+        }
+    }
+
+    pub(crate) fn err(
         &mut self,
         span: Range<usize>,
         key: &str,
@@ -35,7 +44,7 @@ impl<'a> Resolver_<'a> {
     }
 
     /// A `"<value> <unit>"` string of `kind`; `positive` requires > 0.
-    pub(super) fn quantity(
+    pub(crate) fn quantity(
         &mut self,
         key: &str,
         v: &Val,
@@ -103,7 +112,7 @@ impl<'a> Resolver_<'a> {
     }
 
     /// A plain positive number (ratios, damping); integers are accepted as floats.
-    pub(super) fn number(
+    pub(crate) fn number(
         &mut self,
         key: &str,
         v: &Val,
@@ -148,7 +157,7 @@ impl<'a> Resolver_<'a> {
     }
 
     /// A whole number in `[lo, hi]`.
-    pub(super) fn integer(&mut self, key: &str, v: &Val, lo: i64, hi: i64, accepted: &str) -> Option<(i64, Param)> {
+    pub(crate) fn integer(&mut self, key: &str, v: &Val, lo: i64, hi: i64, accepted: &str) -> Option<(i64, Param)> {
         let span = v.span();
         match v.get_ref() {
             toml::Value::Integer(i) if (lo..=hi).contains(i) => Some((
@@ -181,7 +190,7 @@ impl<'a> Resolver_<'a> {
         }
     }
 
-    pub(super) fn opt_quantity(&mut self, key: &str, v: Option<&Val>, kind: Kind, positive: bool) -> Option<Param> {
+    pub(crate) fn opt_quantity(&mut self, key: &str, v: Option<&Val>, kind: Kind, positive: bool) -> Option<Param> {
         v.and_then(|v| self.quantity(key, v, kind, Provenance::Datasheet, positive))
     }
 

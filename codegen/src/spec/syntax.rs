@@ -16,7 +16,7 @@ pub(super) fn syntax_error(source: Source<'_>, e: &toml::de::Error) -> Diagnosti
 }
 
 /// A serde error (unknown key, missing key, wrong type, unknown variant) at its key path.
-pub(super) fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error) -> Diagnostics {
+pub(super) fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error, example: &str) -> Diagnostics {
     let span = e.span().unwrap_or(0..0);
     let message = e.message().trim().to_string();
     // serde_spanned wraps values in a private field; it is not part of the user's key.
@@ -46,7 +46,7 @@ pub(super) fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error) -
         };
         (
             format!("missing required key `{key}`"),
-            "the key with a value; see motors/fischer-ti085.toml for a complete spec".to_string(),
+            format!("the key with a value; see {example} for a complete file"),
         )
     } else if let Some(rest) = message.strip_prefix("unknown variant ") {
         let (value, expected) = rest.split_once(", expected ").unwrap_or((rest, "?"));
@@ -55,10 +55,7 @@ pub(super) fn shape_error(source: Source<'_>, path: &str, e: &toml::de::Error) -
             format!("one of {}", expected.trim_start_matches("one of ")),
         )
     } else {
-        (
-            message,
-            "a value of the type this key takes; see motors/fischer-ti085.toml".to_string(),
-        )
+        (message, format!("a value of the type this key takes; see {example}"))
     };
     source.error(span, path, problem, accepted).into()
 }

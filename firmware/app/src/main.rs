@@ -8,7 +8,7 @@
 #[cfg(target_os = "none")]
 mod board;
 #[cfg(target_os = "none")]
-use motor_config::{adc_frame, can_frame, config, hw};
+use motor_config::{adc_frame, bringup, can_frame, config, hw, motor, registers};
 
 #[cfg(target_os = "none")]
 mod target {
@@ -27,6 +27,7 @@ fn main() {
     use motor_config::{config, motor};
     println!("motor: {}", motor::limits::SWITCHING_FREQUENCY_HZ);
     println!("TIM1 ARR {} DTG {:#04x}", config::PWM_PERIOD, config::DEAD_TIME_DTG);
-    println!("ADC SMP {}", config::ADC_SMP);
+    println!("ADC JSQR {:#010x} {:#010x}", config::JSQR[0], config::JSQR[1]);
+    println!("TIM1 BDTR {:#010x}", config::BDTR);
     println!("IWDG PR {} RLR {}", config::WATCHDOG.0, config::WATCHDOG.1);
 }

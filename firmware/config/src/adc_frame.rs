@@ -66,15 +66,71 @@ pub fn to_sample(raw: &RawConversions, excitation: Excitation) -> AdcSample {
     }
 }
 
-/// A phase-current code at either end of the converter's range: the current is
-/// beyond the measurable full scale (1.25 × the peak current, thesis A Table 4.1),
-/// so the control interrupt trips the outputs (in addition to the comparator on
-/// the timer's break input).
-pub fn overcurrent(raw: &RawConversions) -> bool {
-    raw.phases.iter().any(|&c| {
-        let c = c & FULL;
-        c == 0 || c == FULL
-    })
+/// Signal codes of the board's ADC sequences (`motor::board::ADCx_SIGNALS`).
+pub mod signal {
+    /// Phase u current.
+    pub const CURRENT_U: u8 = 0;
+    /// Phase v current.
+    pub const CURRENT_V: u8 = 1;
+    /// Phase w current.
+    pub const CURRENT_W: u8 = 2;
+    /// DC-link voltage.
+    pub const DC_LINK: u8 = 3;
+    /// Resolver SIN.
+    pub const SIN: u8 = 4;
+    /// Resolver COS.
+    pub const COS: u8 = 5;
+}
+
+/// The conversions of one period from the injected data registers of both converters
+/// (`jdr[k]` = JDRk+1) and the signal each rank holds. Ranks beyond a sequence and a
+/// missing third phase read as 0.
+pub fn assemble(adc1: &[u16; 4], signals1: &[u8], adc2: &[u16; 4], signals2: &[u8]) -> RawConversions {
+    let mut raw = RawConversions::default();
+    for (codes, signals) in [(adc1, signals1), (adc2, signals2)] {
+        for (&code, &sig) in codes.iter().zip(signals) {
+            match sig {
+                signal::CURRENT_U => raw.phases[0] = code,
+                signal::CURRENT_V => raw.phases[1] = code,
+                signal::CURRENT_W => raw.phases[2] = code,
+                signal::DC_LINK => raw.dc_link = code,
+                signal::SIN => raw.sin = code,
+                signal::COS => raw.cos = code,
+                _ => {}
+            }
+        }
+    }
+    raw
+}
+
+/// The board's trip levels in the units of the conversions.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trips {
+    /// 16-bit code at zero current.
+    pub current_offset: i32,
+    /// |code − offset| above which a phase current trips (over-current level / A per code).
+    pub current_codes: i32,
+    /// 15-bit DC-link code above which the drive trips (over-voltage level / V per code).
+    pub dc_link_code: u16,
+    /// |ω_e| above which the drive trips \[rad/s\].
+    pub speed: f32,
+}
+
+impl Trips {
+    /// Whether the period's conversions or the observer's speed call for a trip: a
+    /// measured phase current beyond the over-current level or at either ADC rail (beyond
+    /// the measurable range; this adds to the comparator on the timer's break input), the
+    /// DC link beyond the over-voltage level, the electrical speed beyond the over-speed
+    /// level. `phases` is 2 or 3 (the third code is unused with two).
+    pub fn tripped(&self, raw: &RawConversions, phases: usize, omega_e: f32) -> bool {
+        let current = raw.phases.iter().take(phases).any(|&c| {
+            let c = c & FULL;
+            let code16 = i32::from(left_aligned(c));
+            c == 0 || c == FULL || (code16 - self.current_offset).abs() > self.current_codes
+        });
+        let dc_link = (raw.dc_link & FULL) << (15 - ADC_BITS);
+        current || dc_link > self.dc_link_code || omega_e.abs() > self.speed || omega_e.is_nan()
+    }
 }
 
 #[cfg(test)]
@@ -103,25 +159,79 @@ mod tests {
         assert_eq!(to_sample(&zero, Excitation::Negative).resolver.sin, i32::MAX);
     }
 
-    /// Rails trip; anything inside does not; bits above 12 are ignored.
+    /// A board with 0 A at code 32 768, a trip 8 000 codes away, U_dc trip at code
+    /// 20 000, ω_e trip at 4 000 rad/s: 12-bit 2048 (= 32 768) and 2500 (40 000, 7 232
+    /// away) and 1600 (25 600, 7 168 away) pass; 2600 (41 600, 8 832 away) trips, so does the rail 4095 and code 0;
+    /// DC link 2501 → 20 008 > 20 000 trips; ω_e 4 001 trips.
     #[test]
-    fn overcurrent_at_the_rails() {
+    fn trips_at_the_board_levels() {
+        let t = Trips {
+            current_offset: 32_768,
+            current_codes: 8_000,
+            dc_link_code: 20_000,
+            speed: 4_000.0,
+        };
         let ok = RawConversions {
-            phases: [1, 2048, 4094],
+            phases: [2048, 2500, 1600],
+            dc_link: 2500,
             ..Default::default()
         };
-        assert!(!overcurrent(&ok));
-        assert!(overcurrent(&RawConversions {
-            phases: [0, 2048, 2048],
-            ..ok
-        }));
-        assert!(overcurrent(&RawConversions {
-            phases: [2048, 2048, 4095],
-            ..ok
-        }));
-        assert!(!overcurrent(&RawConversions {
-            phases: [0x1800, 2048, 2048],
-            ..ok
-        }));
+        assert!(!t.tripped(&ok, 3, 3_999.0));
+        assert!(t.tripped(
+            &RawConversions {
+                phases: [2048, 2600, 2048],
+                ..ok
+            },
+            3,
+            0.0
+        ));
+        assert!(t.tripped(
+            &RawConversions {
+                phases: [4095, 2048, 2048],
+                ..ok
+            },
+            3,
+            0.0
+        ));
+        assert!(t.tripped(
+            &RawConversions {
+                phases: [2048, 2048, 0],
+                ..ok
+            },
+            3,
+            0.0
+        ));
+        // With two phases the third code is not a measurement.
+        assert!(!t.tripped(
+            &RawConversions {
+                phases: [2048, 2048, 0],
+                ..ok
+            },
+            2,
+            0.0
+        ));
+        assert!(t.tripped(&RawConversions { dc_link: 2501, ..ok }, 3, 0.0));
+        assert!(t.tripped(&ok, 3, -4_001.0));
+        assert!(t.tripped(&ok, 3, f32::NAN));
+    }
+
+    /// The reference board's ranks: ADC1 [i_u, SIN, U_dc], ADC2 [i_v, i_w, COS].
+    #[test]
+    fn conversions_by_signal() {
+        let raw = assemble(
+            &[100, 200, 300, 0],
+            &[signal::CURRENT_U, signal::SIN, signal::DC_LINK],
+            &[400, 500, 600, 0],
+            &[signal::CURRENT_V, signal::CURRENT_W, signal::COS],
+        );
+        assert_eq!(
+            raw,
+            RawConversions {
+                phases: [100, 400, 500],
+                dc_link: 300,
+                sin: 200,
+                cos: 600
+            }
+        );
     }
 }

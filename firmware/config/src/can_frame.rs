@@ -1,24 +1,21 @@
-//! The torque-setpoint CAN frame (pure): standard identifier
-//! [`hw::SETPOINT_CAN_ID`], at least two data bytes, bytes 0–1 a little-endian `i16`
-//! torque in units of [`hw::SETPOINT_TORQUE_MNM_PER_LSB`] mN·m.
+//! The torque-setpoint CAN frame (pure): standard identifier `board::SETPOINT_ID`, at
+//! least two data bytes, bytes 0–1 a little-endian `i16` torque in units of
+//! `board::TORQUE_PER_LSB_NM` (both from the board file's `[can]`).
 #![forbid(unsafe_code)]
 
-use crate::hw;
-
-/// Millinewton-metres per newton-metre.
-const MNM_PER_NM: f32 = 1_000.0;
+use crate::motor::board;
 
 /// Torque \[N·m\] carried by a frame, `None` if the frame is not a setpoint (other
 /// identifier, extended identifier, or fewer than two bytes).
 pub fn decode_torque(standard_id: Option<u16>, data: &[u8]) -> Option<f32> {
-    if standard_id != Some(hw::SETPOINT_CAN_ID) {
+    if standard_id != Some(board::SETPOINT_ID) {
         return None;
     }
     let [lo, hi, ..] = *data else {
         return None;
     };
     let raw = i16::from_le_bytes([lo, hi]);
-    Some(f32::from(raw) * hw::SETPOINT_TORQUE_MNM_PER_LSB as f32 / MNM_PER_NM)
+    Some(f32::from(raw) * board::TORQUE_PER_LSB_NM)
 }
 
 /// q-axis current reference \[A\] for a torque \[N·m\], i_q = T/K_t (2.34) with the
@@ -83,15 +80,17 @@ pub const fn nominal_bit_timing(clock_hz: u32, bitrate: u32, tq_per_bit: u32, ts
 mod tests {
     use super::*;
 
-    /// 0x0BB8 = 3000 LSB · 10 mN·m = 30 N·m; 0xF448 = −3000 → −30 N·m.
+    /// 0x0BB8 = 3000 LSB · 0.01 N·m = 30 N·m; 0xF448 = −3000 → −30 N·m (both seed
+    /// boards: `torque_resolution = "0.01 N·m"`).
     #[test]
     fn decodes_setpoints() {
-        let id = Some(hw::SETPOINT_CAN_ID);
-        assert_eq!(decode_torque(id, &[0xB8, 0x0B]), Some(30.0));
-        assert_eq!(decode_torque(id, &[0x48, 0xF4, 0xFF, 0x00]), Some(-30.0));
+        let id = Some(board::SETPOINT_ID);
+        let lsb = board::TORQUE_PER_LSB_NM;
+        assert_eq!(decode_torque(id, &[0xB8, 0x0B]), Some(3000.0 * lsb));
+        assert_eq!(decode_torque(id, &[0x48, 0xF4, 0xFF, 0x00]), Some(-3000.0 * lsb));
         assert_eq!(decode_torque(id, &[0xB8]), None);
         assert_eq!(decode_torque(None, &[0xB8, 0x0B]), None);
-        assert_eq!(decode_torque(Some(hw::SETPOINT_CAN_ID + 1), &[0xB8, 0x0B]), None);
+        assert_eq!(decode_torque(Some(board::SETPOINT_ID ^ 1), &[0xB8, 0x0B]), None);
     }
 
     /// Standard ID 0x100 → word 0 = 0x100 << 18 = 0x0400_0000; DLC 2 → word 1 =

@@ -1,17 +1,19 @@
-//! Hardware facts of the STM32G474 and of the board's front end: the only place in
-//! the firmware where numbers that are not generated from the motor spec live
-//! (`tests/literals.rs` enforces this). None of them is a motor or tuning parameter.
+//! Facts of the STM32G474 and choices of this firmware (clock tree, bit timing, filter
+//! codes): the only place in the firmware where numbers that are not generated from the
+//! motor spec or the board file live (`tests/literals.rs` enforces this). None of them is
+//! a motor, tuning or board parameter — those are in `motor::board`, generated from
+//! `boards/<BOARD>.toml`.
 //!
-//! Sources: RM0440 (STM32G4 reference manual), DS12288 (STM32G474 datasheet) and
-//! the board assumptions listed in `firmware/README.md` ("Board assumptions").
+//! Sources: RM0440 (STM32G4 reference manual), DS12288 (STM32G474 datasheet).
 
 /// SYSCLK = HCLK = PCLK1 = PCLK2 \[Hz\]: HSI16 → PLL ×85/8 (M = 4, N = 85, R = 2),
 /// the STM32G474's maximum in range-1 boost mode (DS12288 §3.9).
 pub const SYSCLK_HZ: u32 = 170_000_000;
 /// TIM1 kernel clock \[Hz\]: PCLK2 with APB2 prescaler 1 (RM0440 §7.2.17: ×1).
 pub const TIMER_CLOCK_HZ: u32 = SYSCLK_HZ;
-/// ADC clock \[Hz\]: synchronous HCLK/4 (ADC12_CCR.CKMODE = 0b11), within the
-/// 60 MHz limit of DS12288 Table 66.
+/// ADC clock \[Hz\]: synchronous HCLK/4 (ADC12_CCR.CKMODE = 0b11), within the 52 MHz
+/// of DS12288 Table 66 for several ADCs at V_DDA ≥ 2.7 V. The board's sampling codes are
+/// chosen for it (`motor::board::ADC_CLOCK_HZ`, checked equal at compile time).
 pub const ADC_CLOCK_HZ: u32 = SYSCLK_HZ / 4;
 /// ADC resolution \[bit\] (ADC_CFGR.RES = 0).
 pub const ADC_BITS: u32 = 12;
@@ -19,33 +21,6 @@ pub const ADC_BITS: u32 = 12;
 pub const LSI_HZ: u32 = 32_000;
 /// FDCAN kernel clock \[Hz\]: PCLK1 (RCC_CCIPR.FDCANSEL = 0b10).
 pub const FDCAN_CLOCK_HZ: u32 = SYSCLK_HZ;
-
-/// Board front end: sample-and-hold capacitance C_ADC \[pF\] (DS12288 Table 66).
-pub const ADC_SAMPLE_CAPACITANCE_PF: u32 = 5;
-/// Board front end: ADC switch resistance plus the driving op-amp's output and
-/// anti-aliasing series resistance R_ADC + R_EXT (7.2) \[Ω\] (board assumption).
-pub const ADC_SOURCE_RESISTANCE_OHM: u32 = 1_100;
-/// Inverter dead time \[ns\] used when the spec gives no `[drive] dead_time`: the
-/// gate driver's switching-time margin (board assumption, thesis A §3.2).
-pub const INVERTER_DEAD_TIME_NS: u32 = 500;
-
-/// FDCAN standard identifier of the torque-setpoint frame (vehicle unit → inverter).
-pub const SETPOINT_CAN_ID: u16 = 0x100;
-/// The vehicle unit sends a setpoint every 10 ms \[ms\].
-pub const SETPOINT_PERIOD_MS: u32 = 10;
-/// Missed setpoint periods after which the torque ramps to zero.
-pub const SETPOINT_TIMEOUT_PERIODS: u32 = 3;
-/// Time a missing setpoint takes to ramp the largest torque (peak current) to zero
-/// \[ms\]: the ramp rate is PEAK_CURRENT_A/this (board policy, not a motor number).
-pub const SETPOINT_RAMP_MS: u32 = 100;
-
-/// Independent watchdog timeout in control periods: the main loop refreshes it only
-/// while the control interrupt runs, so a stalled interrupt resets the MCU within
-/// this many periods (plus one refresh period of the main loop).
-pub const WATCHDOG_CONTROL_PERIODS: u32 = 100;
-/// Torque resolution of the setpoint frame \[mN·m per LSB\]: bytes 0–1 hold a
-/// little-endian `i16`, so ±327.67 N·m in 0.01 N·m steps.
-pub const SETPOINT_TORQUE_MNM_PER_LSB: u32 = 10;
 
 /// PLL input divider M (HSI16/4 = 4 MHz, within RM0440's 2.66–8 MHz).
 pub const PLL_M: u32 = 4;
@@ -63,8 +38,6 @@ pub const ADC_VREG_STARTUP_US: u32 = 20;
 /// Microseconds per second.
 pub const US_PER_S: u32 = 1_000_000;
 
-/// FDCAN nominal bit rate \[bit/s\] of the vehicle bus.
-pub const CAN_BITRATE: u32 = 500_000;
 /// Time quanta per CAN bit: 1 (sync) + 15 (TSEG1) + 4 (TSEG2), sample point 80 %.
 pub const CAN_TQ_PER_BIT: u32 = 20;
 /// TSEG2 and the resynchronisation jump width \[tq\].

@@ -1,9 +1,7 @@
 //! Register encodings computed from times and frequencies (pure, host-tested):
-//! TIM1 period and dead time, ADC sampling time, watchdog prescaler and reload.
+//! TIM1 period and dead time, watchdog prescaler and reload.
 #![forbid(unsafe_code)]
 
-/// Picoseconds per second.
-const PS_PER_S: u64 = 1_000_000_000_000;
 /// Nanoseconds per second.
 const NS_PER_S: u64 = 1_000_000_000;
 
@@ -53,27 +51,6 @@ pub const fn dead_time_dtg(dead_ns: u32, timer_hz: u32) -> Option<u8> {
     } else {
         None
     }
-}
-
-/// STM32G4 ADC_SMPR sampling times in half ADC clock cycles, codes 0..=7
-/// (RM0440 §21.7.6: 2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5 cycles).
-pub const SAMPLE_HALF_CYCLES: [u32; 8] = [5, 13, 25, 49, 95, 185, 495, 1281];
-
-/// Smallest ADC_SMPR code whose sampling time settles the sample-and-hold to
-/// 1 LSB: `t_sample ≥ n·τ`, `τ = (R_ADC + R_EXT)·C_ADC` (thesis A (7.2), (7.4)),
-/// `n` = the design's settling multiple. `None` if even 640.5 cycles is too short.
-pub const fn adc_smp_code(settling_multiple: u32, resistance_ohm: u32, capacitance_pf: u32, adc_hz: u32) -> Option<u8> {
-    // n·τ in ps (Ω·pF = ps).
-    let t_min_ps = settling_multiple as u64 * resistance_ohm as u64 * capacitance_pf as u64;
-    let mut code = 0;
-    while code < SAMPLE_HALF_CYCLES.len() {
-        // half_cycles/(2·f_adc) ≥ t_min  ⇔  half_cycles·10¹² ≥ 2·t_min_ps·f_adc.
-        if SAMPLE_HALF_CYCLES[code] as u64 * PS_PER_S >= 2 * t_min_ps * adc_hz as u64 {
-            return Some(code as u8);
-        }
-        code += 1;
-    }
-    None
 }
 
 /// IWDG prescaler code PR (divider 4·2^PR, PR ≤ 6) and reload RLR (≤ 4095) for a
@@ -137,18 +114,6 @@ mod tests {
             assert!(got >= ticks);
             assert!(!all.iter().any(|&t| t >= ticks && t < got), "{ticks}: {got}");
         }
-    }
-
-    /// Hand calculations, the same as codegen's ADC design (thesis A (7.4): 9τ):
-    /// τ = 1.1 kΩ·5 pF = 5.5 ns, 9τ = 49.5 ns = 2.10 cycles at 42.5 MHz → 2.5 cycles
-    /// (code 0); 10.1 kΩ: τ = 50.5 ns, 9τ = 454.5 ns = 19.3 cycles → 24.5 (code 3);
-    /// 100 kΩ: 9τ = 4.5 µs = 191 cycles → 247.5 (code 6); 1 MΩ: 1913 cycles → None.
-    #[test]
-    fn adc_sampling_time() {
-        assert_eq!(adc_smp_code(9, 1_100, 5, 42_500_000), Some(0));
-        assert_eq!(adc_smp_code(9, 10_100, 5, 42_500_000), Some(3));
-        assert_eq!(adc_smp_code(9, 100_000, 5, 42_500_000), Some(6));
-        assert_eq!(adc_smp_code(9, 1_000_000, 5, 42_500_000), None);
     }
 
     /// Hand calculations: 160 LSI ticks (5 ms at 32 kHz) → /4, reload 40;

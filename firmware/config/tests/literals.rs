@@ -1,5 +1,6 @@
-//! Literal check: no motor or tuning number may be written into the firmware; they
-//! all come from the generated constants (`motor::`, `design::`).
+//! Literal check: no motor, tuning or board number may be written into the firmware;
+//! they all come from the generated constants (`motor::`, its `board` group from the
+//! board file).
 //!
 //! Every numeric literal in `src/**/*.rs` (comments, strings and the trailing
 //! `#[cfg(test)]` module excluded) must be one of:
@@ -11,10 +12,13 @@
 //! * a power of ten ≥ 1000, integer or float (unit conversions ms/s, µs/s, …);
 //! * listed in [`FILE_ALLOWLIST`] with its reason (register-encoding boundaries).
 //!
-//! In addition no literal anywhere in `src/` (hw.rs included) may equal a number of
-//! the generated module of the motor being built (magnitudes > 32, powers of ten
-//! ≥ 100 excepted): a motor number copied into the firmware fails even where literals
-//! are otherwise allowed.
+//! In addition no literal anywhere in `src/` (hw.rs included; hexadecimal too) may equal
+//! a number of the generated module of the motor and board being built (magnitudes
+//! up to 32, powers of ten ≥ 100 and a file's allowlisted register facts excepted): a motor
+//! or board number copied into the firmware fails even where literals are otherwise
+//! allowed. And no board-layer source may name a pin in a register accessor
+//! (`afrh8()`, `moder13()`, `idr6()`, `br13()`, …): which pins carry which signal is the
+//! board file's, and the pins are configured from its generated constants.
 
 use std::path::{Path, PathBuf};
 
@@ -192,7 +196,7 @@ fn violations(file: &str, src: &str) -> Vec<Literal> {
 /// The numbers of the generated module (its code, not its doc comments).
 fn generated_numbers() -> Vec<f64> {
     let out = Path::new(env!("OUT_DIR"));
-    ["motor.rs", "design_extra.rs"]
+    ["motor.rs"]
         .iter()
         .filter_map(|f| std::fs::read_to_string(out.join(f)).ok())
         .flat_map(|src| literals(&src))
@@ -246,9 +250,17 @@ fn no_motor_or_tuning_literals_in_the_firmware() {
                 l.text
             ));
         }
+        let allowed: &[f64] = FILE_ALLOWLIST
+            .iter()
+            .find(|(f, _, _)| *f == name)
+            .map_or(&[], |(_, v, _)| v);
         for l in literals(code) {
             let v = l.value.abs();
-            if generated.iter().any(|g| (g - v).abs() <= 1e-6 * g.max(1.0)) && !l.radix && v > 32.0 && !is_round(v) {
+            if generated.iter().any(|g| (g - v).abs() <= 1e-6 * g.max(1.0))
+                && v > 32.0
+                && !is_round(v)
+                && !allowed.contains(&v)
+            {
                 problems.push(format!(
                     "{}:{}: literal {} equals a generated motor constant",
                     path.display(),
@@ -258,7 +270,45 @@ fn no_motor_or_tuning_literals_in_the_firmware() {
             }
         }
     }
+    for (path, code) in &files {
+        for (line, accessor) in pin_accessors(code) {
+            problems.push(format!(
+                "{}:{line}: `{accessor}` names a pin in the firmware; pins come from the board file (motor::board)",
+                path.display()
+            ));
+        }
+    }
     assert!(problems.is_empty(), "{}", problems.join("\n"));
+}
+
+/// GPIO register accessors of the PAC that carry a pin number in their name.
+const PIN_FIELDS: [&str; 10] = [
+    "moder", "afrl", "afrh", "ospeedr", "otyper", "pupdr", "idr", "odr", "bs", "br",
+];
+
+/// Calls such as `.afrh8(` or `.br13(` in (stripped) source: (line, accessor).
+fn pin_accessors(src: &str) -> Vec<(usize, String)> {
+    let text = strip(src);
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        for (i, _) in line.match_indices('.') {
+            let rest = &line[i + 1..];
+            let ident: String = rest
+                .chars()
+                .take_while(|c| c.is_ascii_alphanumeric() || *c == '_')
+                .collect();
+            let digits = ident.trim_start_matches(|c: char| c.is_ascii_alphabetic());
+            let name = &ident[..ident.len() - digits.len()];
+            if !digits.is_empty()
+                && digits.chars().all(|c| c.is_ascii_digit())
+                && PIN_FIELDS.contains(&name)
+                && rest[ident.len()..].starts_with('(')
+            {
+                out.push((n + 1, ident));
+            }
+        }
+    }
+    out
 }
 
 /// The scanner itself: a copied inductance, observer gain or switching frequency
@@ -275,6 +325,9 @@ fn scanner_catches_motor_numbers() {
     assert!(violations("pwm.rs", ok).is_empty(), "{:?}", violations("pwm.rs", ok));
     // hw.rs may hold hardware numbers, but the generated-value check covers it too.
     assert!(violations("hw.rs", bad).is_empty());
+    // Pin-numbered register accessors are board facts; the generic ones are not.
+    let pins = "gpioa.afrh().modify(|_, w| w.afrh8().set(6));\nw.br13().set_bit(); r.bits(); w.oc4m().set(7);";
+    assert_eq!(pin_accessors(pins), [(1, "afrh8".to_string()), (2, "br13".to_string())]);
     assert_eq!(
         literals("let a = 5e-5; let b = 1.5e3;")
             .iter()

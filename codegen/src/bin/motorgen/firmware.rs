@@ -1,12 +1,15 @@
-//! `motorgen firmware <stem>` / `motorgen firmware --all`: the STM32G474 image of one
-//! motor or of every motor in `motors/`.
+//! `motorgen firmware <stem> [--board <board>]` / `motorgen firmware --all`: the
+//! STM32G474 image of one motor or of every motor in `motors/`, on a board of `boards/`
+//! (default `motorgen-reference`).
 //!
-//! Per motor: designs the spec first (a bad spec stops here with its located
-//! diagnostic), runs
+//! Per motor: designs the spec on the board first (a bad spec or board file stops here
+//! with its located diagnostic; what does not fit between them is printed as warnings
+//! on stderr), runs
 //! `cargo build --release --target thumbv7em-none-eabihf -p motor-firmware` in
-//! `firmware/` with `MOTOR=<stem>` and `MOTORS_DIR=<motors folder>` (one shared target
-//! directory, so only the app crate rebuilds per motor), copies the ELF to
-//! `target/firmware/<stem>.elf` under the repository root, writes `<stem>.bin` (the
+//! `firmware/` with `MOTOR=<stem>`, `MOTORS_DIR`, `BOARD=<board>` and `BOARDS_DIR` (one
+//! shared target directory, so only the app crate rebuilds per motor), copies the ELF to
+//! `target/firmware/<stem>.elf` under the repository root (`target/firmware/<board>/`
+//! for another board), writes `<stem>.bin` (the
 //! ELF's loadable segments placed by load address, gaps filled with the erased-flash
 //! byte 0xFF) and prints flash and static RAM use; for one motor it first prints the
 //! constants summary of the design the image is built from. An image over 64 KiB of flash is an
@@ -214,10 +217,10 @@ fn repo_root(motors: &Path) -> Result<PathBuf, String> {
         })
 }
 
-/// Motor stems in `dir`, sorted.
-fn stems(dir: &Path) -> Result<Vec<String>, String> {
+/// The `*.toml` stems (motors or boards) in `dir`, sorted.
+fn stems(dir: &Path, what: &str) -> Result<Vec<String>, String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| format!("cannot read the motors folder {}: {e}", dir.display()))?
+        .map_err(|e| format!("cannot read the {what} folder {}: {e}", dir.display()))?
         .filter_map(|e| e.ok().map(|e| e.path()))
         .filter(|p| p.extension().is_some_and(|x| x == "toml"))
         .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
@@ -226,15 +229,36 @@ fn stems(dir: &Path) -> Result<Vec<String>, String> {
     Ok(v)
 }
 
+/// The "accepted:" list of an unknown stem: the stems that exist.
+fn accepted(known: &[String]) -> String {
+    if known.is_empty() {
+        "none: the folder holds no *.toml".to_string()
+    } else {
+        known.join(", ")
+    }
+}
+
+/// The motor and board an image is built for, with their folders.
+pub struct Target<'a> {
+    /// Motor specs folder.
+    pub motors: &'a Path,
+    /// Board stem.
+    pub board: &'a str,
+    /// Board files folder.
+    pub boards: &'a Path,
+}
+
 /// Runs cargo for `stem`; returns the built ELF's path (from cargo's JSON messages).
-fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String> {
+fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, String> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
     let child = Command::new(&cargo)
         .args(["build", "--release", "--target", TARGET, "-p", PACKAGE])
         .args(["--message-format=json-render-diagnostics"])
         .current_dir(root.join("firmware"))
         .env("MOTOR", stem)
-        .env("MOTORS_DIR", motors)
+        .env("MOTORS_DIR", t.motors)
+        .env("BOARD", t.board)
+        .env("BOARDS_DIR", t.boards)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn();
@@ -257,8 +281,8 @@ fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String
             String::new()
         };
         return Err(format!(
-            "MOTOR={stem} cargo build --release --target {TARGET} -p {PACKAGE} failed ({}):\n{stderr}{hint}",
-            output.status
+            "MOTOR={stem} BOARD={} cargo build --release --target {TARGET} -p {PACKAGE} failed ({}):\n{stderr}{hint}",
+            t.board, output.status
         ));
     }
     let stdout = String::from_utf8_lossy(&output.stdout);
@@ -273,8 +297,8 @@ fn cargo_build(root: &Path, motors: &Path, stem: &str) -> Result<PathBuf, String
 }
 
 /// Builds, checks and writes one motor's image (its spec designs); returns its report.
-fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
-    let elf_path = cargo_build(root, motors, stem)?;
+fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, String> {
+    let elf_path = cargo_build(root, t, stem)?;
     let bytes = std::fs::read(&elf_path).map_err(|e| format!("cannot read {}: {e}", elf_path.display()))?;
     let image = image(&bytes).map_err(|e| format!("{}: {e}", elf_path.display()))?;
     let mut report = report(stem, &image.usage);
@@ -286,7 +310,10 @@ fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
             elf_path.display()
         ));
     }
-    let out = root.join("target").join("firmware");
+    let mut out = root.join("target").join("firmware");
+    if t.board != codegen::board::DEFAULT_BOARD {
+        out = out.join(t.board);
+    }
     let elf_out = out.join(format!("{stem}.elf"));
     let bin_out = out.join(format!("{stem}.bin"));
     // The pair is replaced together or not at all.
@@ -303,8 +330,8 @@ fn build_one(root: &Path, motors: &Path, stem: &str) -> Result<String, String> {
 }
 
 /// The `firmware` subcommand.
-pub fn run(which: Which, motors: &Path) -> ExitCode {
-    let known = match stems(motors) {
+pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode {
+    let known = match stems(motors, "motors") {
         Ok(k) => k,
         Err(e) => {
             errln!("error: {e}");
@@ -325,11 +352,7 @@ pub fn run(which: Which, motors: &Path) -> ExitCode {
             errln!(
                 "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
                 motors.display(),
-                if known.is_empty() {
-                    "none: the folder holds no *.toml".to_string()
-                } else {
-                    known.join(", ")
-                }
+                accepted(&known)
             );
             return ExitCode::FAILURE;
         }
@@ -342,24 +365,45 @@ pub fn run(which: Which, motors: &Path) -> ExitCode {
         }
     };
     let motors = motors.canonicalize().unwrap_or_else(|_| motors.to_path_buf());
-    // Every selected spec must design before cargo runs (located diagnostics).
+    let boards = boards.canonicalize().unwrap_or_else(|_| boards.to_path_buf());
+    let board_file = boards.join(format!("{board}.toml"));
+    if !board_file.is_file() {
+        errln!(
+            "error: no board `{board}` in {} (no {board}.toml)\n  accepted: {}",
+            boards.display(),
+            accepted(&stems(&boards, "boards").unwrap_or_default())
+        );
+        return ExitCode::FAILURE;
+    }
+    // Every selected spec must design on the board before cargo runs (located
+    // diagnostics); what does not fit is a warning.
     let mut designs = Vec::new();
     for stem in &selected {
-        match super::design(&motors.join(format!("{stem}.toml"))) {
-            Ok(d) => designs.push(d),
+        match super::design_on(&motors.join(format!("{stem}.toml")), Some(&board_file)) {
+            Ok(d) => {
+                for w in d.board.iter().flat_map(|b| &b.warnings) {
+                    errln!("warning: {stem} on {board}: {w}");
+                }
+                designs.push(d);
+            }
             Err(d) => err!("{d}"),
         }
     }
     if designs.len() != selected.len() {
         return ExitCode::FAILURE;
     }
+    let target = Target {
+        motors: &motors,
+        board,
+        boards: &boards,
+    };
     // One motor: the constants the image is built from, as `motorgen design` prints them.
     if let [d] = designs.as_slice() {
         out!("{}", codegen::summary::summary(d));
     }
     let mut ok = true;
     for stem in &selected {
-        match build_one(&root, &motors, stem) {
+        match build_one(&root, &target, stem) {
             Ok(report) => out!("{report}"),
             Err(e) => {
                 ok = false;

@@ -35,6 +35,10 @@ enum Command {
         /// Directory with replacement templates (for rust, c, markdown).
         #[arg(long)]
         templates: Option<PathBuf>,
+        /// A board file (boards/<name>.toml): adds the `board` constants and the checks
+        /// of the motor on that board.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
     /// Write the Rust module, C header and Markdown summary of one motor into a directory
     /// (files are only rewritten when their bytes change).
@@ -47,10 +51,14 @@ enum Command {
         /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2).
         #[arg(long)]
         templates: Option<PathBuf>,
+        /// A board file: adds its `board` constants (as `design --board`).
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
-    /// Validate specs; exit non-zero if any has a problem.
+    /// Validate motor specs and board files (a file with a top-level `chip` is a board);
+    /// exit non-zero if any has a problem.
     Check {
-        /// One or more motor specs.
+        /// One or more motor specs or board files.
         #[arg(required = true)]
         specs: Vec<PathBuf>,
     },
@@ -62,8 +70,9 @@ enum Command {
         #[arg(long)]
         dir: Option<PathBuf>,
     },
-    /// Build the STM32G474 image of one motor (or --all) into target/firmware/<stem>.elf
-    /// and .bin and print its flash and RAM use (fails above 64 KiB of flash).
+    /// Build the STM32G474 image of one motor (or --all) on a board into
+    /// target/firmware/<stem>.elf and .bin (target/firmware/<board>/… for a board other
+    /// than the default) and print its flash and RAM use (fails above 64 KiB of flash).
     Firmware {
         /// Motor file stem in the motors folder, e.g. fischer-ti085.
         #[arg(required_unless_present = "all", conflicts_with = "all")]
@@ -74,6 +83,12 @@ enum Command {
         /// Directory of motor specs (default: motors/).
         #[arg(long)]
         dir: Option<PathBuf>,
+        /// Board file stem in the boards folder (default: motorgen-reference).
+        #[arg(long, default_value = codegen::board::DEFAULT_BOARD)]
+        board: String,
+        /// Directory of board files (default: boards/ beside the motors folder).
+        #[arg(long)]
+        boards_dir: Option<PathBuf>,
     },
     /// Simulate the firmware's current loop and observer with the motor and print a
     /// pass/fail table of measured vs designed figures (non-zero exit on a failure).
@@ -183,6 +198,21 @@ fn design(path: &Path) -> Result<codegen::Design, Diagnostics> {
     codegen::design_source(&path.display().to_string(), &text)
 }
 
+/// The design of a motor, on `board` if given (its constants and checks added).
+fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Diagnostics> {
+    let Some(board) = board else {
+        return design(path);
+    };
+    let text = read_spec(path)?;
+    let board_text = read_spec(board)?;
+    codegen::design_with_board(
+        &path.display().to_string(),
+        &text,
+        &board.display().to_string(),
+        &board_text,
+    )
+}
+
 /// `motors/` in the working directory, else the one in this repository.
 fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
     dir.unwrap_or_else(|| {
@@ -207,7 +237,8 @@ fn run(cli: Cli) -> ExitCode {
             spec,
             format,
             templates,
-        } => match design(&spec) {
+            board,
+        } => match design_on(&spec, board.as_deref()) {
             Ok(d) => {
                 let out = match format {
                     Format::Rust | Format::C | Format::Markdown => {
@@ -239,12 +270,17 @@ fn run(cli: Cli) -> ExitCode {
                 ExitCode::FAILURE
             }
         },
-        Command::Generate { spec, out, templates } => {
+        Command::Generate {
+            spec,
+            out,
+            templates,
+            board,
+        } => {
             if let Err(e) = atomic::check_out_dir(&out) {
                 errln!("{e}");
                 return ExitCode::FAILURE;
             }
-            let d = match design(&spec) {
+            let d = match design_on(&spec, board.as_deref()) {
                 Ok(d) => d,
                 Err(e) => {
                     err!("{e}");
@@ -282,6 +318,17 @@ fn run(cli: Cli) -> ExitCode {
         Command::Check { specs } => {
             let mut ok = true;
             for path in &specs {
+                let is_board = std::fs::read_to_string(path).is_ok_and(|t| codegen::board::is_board_file(&t));
+                if is_board {
+                    match read_spec(path).and_then(|t| codegen::board_source(&path.display().to_string(), &t)) {
+                        Ok(b) => outln!("ok: {} (board: {}, {} {})", path.display(), b.name, b.chip, b.package),
+                        Err(e) => {
+                            ok = false;
+                            err!("{e}");
+                        }
+                    }
+                    continue;
+                }
                 match design(path) {
                     Ok(d) => {
                         outln!("ok: {} ({})", path.display(), d.name);
@@ -340,12 +387,27 @@ fn run(cli: Cli) -> ExitCode {
                 }
             }
         }
-        Command::Firmware { stem, all, dir } => {
+        Command::Firmware {
+            stem,
+            all,
+            dir,
+            board,
+            boards_dir,
+        } => {
             let which = match stem {
                 Some(stem) if !all => firmware::Which::One(stem),
                 _ => firmware::Which::All,
             };
-            firmware::run(which, &motors_dir(dir))
+            let motors = motors_dir(dir);
+            let boards = boards_dir.unwrap_or_else(|| {
+                let beside = motors.join("..").join("boards");
+                if beside.is_dir() {
+                    beside
+                } else {
+                    Path::new(env!("CARGO_MANIFEST_DIR")).join("..").join("boards")
+                }
+            });
+            firmware::run(which, &motors, &board, &boards)
         }
         Command::Verify { spec } => verify::run(&spec),
         Command::Report { spec, out } => report::run(&spec, &out),

@@ -51,6 +51,9 @@ pub struct ObserverOut {
     pub lead_q16: i32,
     /// Lag k·ω_e,max·T_s at maximum speed [deg] (4.23).
     pub lead_at_max_speed_deg: f64,
+    /// The error form as the generated `observer::ERROR_FORM`: 0 = trig identity (4.8),
+    /// 1 = atan2 (CORDIC phase, normalised by π).
+    pub error_form: u8,
 }
 
 /// The observer section, or `None` with the broken rules in `cx.errors`.
@@ -116,5 +119,9 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
         lead_samples_source: o.lead_samples.source,
         lead_q16: (lead * 65_536.0).round() as i32,
         lead_at_max_speed_deg: angle_observer::lag_angle(lead, 2.0 * PI * fe_max, fs).to_degrees(),
+        error_form: match o.error {
+            ObserverError::TrigIdentity => 0,
+            ObserverError::Atan2 => 1,
+        },
     })
 }

@@ -1,34 +1,40 @@
-//! ADC1 and ADC2: injected conversions triggered by TIM1 TRGO at the carrier
-//! maximum (RM0440 §21.4.21), sampling time [`crate::config::ADC_SMP`] from the
-//! settling rule (thesis A (7.2), (7.4)).
-//!
-//! | rank | ADC1 | ADC2 |
-//! |---|---|---|
-//! | 1 | SIN (IN2) | COS (IN4) |
-//! | 2 | i_u (IN1) | i_v (IN3) |
-//! | 3 | U_dc (IN3) | i_w (IN17) |
-//!
-//! Both converters start on the same trigger with equal sequences, so SIN/COS and
-//! i_u/i_v are sampled simultaneously. ADC1's end of injected sequence (JEOS) is the
-//! control interrupt.
+//! ADC1 and ADC2: the board's injected sequences ([`crate::config::JSQR`], from
+//! `motor::board::ADCx_CHANNELS`: currents in the first ranks), each channel's sampling
+//! time ([`crate::config::SMPR`]: DS12288 Table 67 for its class and source
+//! resistance), triggered together by TIM1_TRGO2 at the board's sampling instant (see
+//! `pwm`). ADC1's end of injected sequence (JEOS) is the control interrupt.
 
 use stm32g4::stm32g474 as pac;
 
 use super::clocks::{POLL_LIMIT, delay_us, wait_for};
-use crate::adc_frame::RawConversions;
-use crate::config::ADC_SMP;
+use crate::adc_frame::{self, RawConversions};
+use crate::bringup::{self, AdcEnable};
+use crate::config::{JSQR, SMPR};
 use crate::hw;
+use crate::motor::board;
+use crate::registers::Field;
 
-/// Injected sequence of one converter: three channel numbers, rank order.
-struct Sequence([u8; 3]);
+/// One converter's ADEN/ADRDY, for the host-tested enable sequence.
+struct Enable<'a>(&'a pac::adc1::RegisterBlock);
 
-const ADC1_SEQUENCE: Sequence = Sequence([2, 1, 3]);
-const ADC2_SEQUENCE: Sequence = Sequence([4, 3, 17]);
+impl AdcEnable for Enable<'_> {
+    fn aden(&mut self) -> bool {
+        self.0.cr().read().aden().bit_is_set()
+    }
+    fn set_aden(&mut self) {
+        self.0.cr().modify(|_, w| w.aden().set_bit());
+    }
+    fn adrdy(&mut self) -> bool {
+        self.0.isr().read().adrdy().bit_is_set()
+    }
+}
 
-/// Regulator start-up, calibration and enable of one converter (RM0440 §21.4.6–9).
+/// Regulator start-up, calibration and enable of one converter (RM0440 §21.4.6–9):
+/// DEEPPWD off, ADVREGEN, t_ADCVREG_STUP, ADCAL until it reads 0, then ADEN re-written
+/// until ADRDY (defect 1: an ADEN written less than 4 ADC cycles after ADCAL clears is
+/// reset by the calibration logic; ST's `ADC_Enable` retries the same way).
 fn power_up(adc: &pac::adc1::RegisterBlock) -> bool {
-    // Leave deep power-down, then enable the regulator (CR bits must be changed
-    // one at a time with read-modify-write: DEEPPWD resets to 1).
+    // CR bits must be changed one at a time with read-modify-write: DEEPPWD resets to 1.
     adc.cr().modify(|_, w| w.deeppwd().clear_bit());
     adc.cr().modify(|_, w| w.advregen().set_bit());
     delay_us(hw::ADC_VREG_STARTUP_US);
@@ -37,39 +43,20 @@ fn power_up(adc: &pac::adc1::RegisterBlock) -> bool {
         return false;
     }
     adc.isr().write(|w| w.adrdy().clear_bit_by_one());
-    adc.cr().modify(|_, w| w.aden().set_bit());
-    wait_for(POLL_LIMIT, || adc.isr().read().adrdy().bit_is_set())
+    bringup::enable_adc(&mut Enable(adc), POLL_LIMIT)
 }
 
-/// Sampling times and the injected sequence, triggered on TIM1 TRGO rising edges.
-fn configure(adc: &pac::adc1::RegisterBlock, seq: &Sequence) {
-    adc.smpr1().write(|w| {
-        w.smp1()
-            .set(ADC_SMP)
-            .smp2()
-            .set(ADC_SMP)
-            .smp3()
-            .set(ADC_SMP)
-            .smp4()
-            .set(ADC_SMP)
-    });
-    adc.smpr2().write(|w| w.smp17().set(ADC_SMP));
-    let [a, b, c] = seq.0;
-    // SAFETY: channel numbers 1..=17 are valid JSQx codes; JEXTSEL 0 = TIM1_TRGO.
-    adc.jsqr().write(|w| unsafe {
-        w.jl()
-            .bits(2)
-            .jextsel()
-            .bits(0)
-            .jexten()
-            .bits(0b01)
-            .jsq1()
-            .bits(a)
-            .jsq2()
-            .bits(b)
-            .jsq3()
-            .bits(c)
-    });
+/// Sampling times and the injected sequence of converter `k` (0 = ADC1, 1 = ADC2).
+fn configure(adc: &pac::adc1::RegisterBlock, k: usize) {
+    let [s1, s2]: [Field; 2] = SMPR[k];
+    // SAFETY: only the sampling fields of the board's channels change (host-tested
+    // motor_config::registers::smpr): SMPR1 channels 0–9, SMPR2 10–18.
+    adc.smpr1().modify(|r, w| unsafe { w.bits(s1.apply(r.bits())) });
+    // SAFETY: as above.
+    adc.smpr2().modify(|r, w| unsafe { w.bits(s2.apply(r.bits())) });
+    // SAFETY: host-tested JSQR value (motor_config::registers::jsqr): JL, JEXTSEL =
+    // TIM1_TRGO2, JEXTEN = rising edge, the channels of each rank.
+    adc.jsqr().write(|w| unsafe { w.bits(JSQR[k]) });
 }
 
 /// Brings up both converters and arms the injected conversions; `false` if a
@@ -80,8 +67,8 @@ pub fn init(common: &pac::ADC12_COMMON, adc1: &pac::ADC1, adc2: &pac::ADC2) -> b
     if !(power_up(adc1) && power_up(adc2)) {
         return false;
     }
-    configure(adc1, &ADC1_SEQUENCE);
-    configure(adc2, &ADC2_SEQUENCE);
+    configure(adc1, 0);
+    configure(adc2, 1);
     adc1.isr()
         .write(|w| w.jeos().clear_bit_by_one().jeoc().clear_bit_by_one());
     adc2.isr()
@@ -92,8 +79,19 @@ pub fn init(common: &pac::ADC12_COMMON, adc1: &pac::ADC1, adc2: &pac::ADC2) -> b
     true
 }
 
-/// Reads one control period's conversions and acknowledges them. ADC2 finishes with
-/// ADC1 (same sequence and timing); `None` if it has not (a missed sample).
+/// The four injected data registers.
+fn jdr(adc: &pac::adc1::RegisterBlock) -> [u16; 4] {
+    [
+        adc.jdr1().read().jdata().bits(),
+        adc.jdr2().read().jdata().bits(),
+        adc.jdr3().read().jdata().bits(),
+        adc.jdr4().read().jdata().bits(),
+    ]
+}
+
+/// Reads one control period's conversions and acknowledges them. ADC2's sequence is
+/// never longer than ADC1's (codegen's plan), so it has finished or is about to; `None`
+/// if it has not within [`hw::ADC_SLAVE_POLLS`] polls (a missed sample).
 pub fn read(adc1: &pac::ADC1, adc2: &pac::ADC2) -> Option<RawConversions> {
     adc1.isr()
         .write(|w| w.jeos().clear_bit_by_one().jeoc().clear_bit_by_one());
@@ -102,14 +100,10 @@ pub fn read(adc1: &pac::ADC1, adc2: &pac::ADC2) -> Option<RawConversions> {
     }
     adc2.isr()
         .write(|w| w.jeos().clear_bit_by_one().jeoc().clear_bit_by_one());
-    Some(RawConversions {
-        sin: adc1.jdr1().read().jdata().bits(),
-        phases: [
-            adc1.jdr2().read().jdata().bits(),
-            adc2.jdr2().read().jdata().bits(),
-            adc2.jdr3().read().jdata().bits(),
-        ],
-        dc_link: adc1.jdr3().read().jdata().bits(),
-        cos: adc2.jdr1().read().jdata().bits(),
-    })
+    Some(adc_frame::assemble(
+        &jdr(adc1),
+        &board::ADC1_SIGNALS,
+        &jdr(adc2),
+        &board::ADC2_SIGNALS,
+    ))
 }

@@ -1,4 +1,5 @@
-//! FDCAN1 receiving the torque setpoint (classic CAN, [`crate::hw::CAN_BITRATE`]).
+//! FDCAN1 receiving the torque setpoint (classic CAN at the board's
+//! `motor::board::CAN_BIT_RATE`).
 //!
 //! Every standard frame goes to RX FIFO 0 (no filter elements; extended and remote
 //! frames are rejected) and the main loop picks out the setpoint identifier
@@ -10,9 +11,15 @@ use stm32g4::stm32g474 as pac;
 use super::clocks::{POLL_LIMIT, wait_for};
 use crate::can_frame::{RxFrame, nominal_bit_timing};
 use crate::hw;
+use crate::motor::board;
 
 /// FDCAN_NBTP of the bus (a build error if the clock does not divide).
-const NBTP: u32 = match nominal_bit_timing(hw::FDCAN_CLOCK_HZ, hw::CAN_BITRATE, hw::CAN_TQ_PER_BIT, hw::CAN_TSEG2) {
+const NBTP: u32 = match nominal_bit_timing(
+    hw::FDCAN_CLOCK_HZ,
+    board::CAN_BIT_RATE,
+    hw::CAN_TQ_PER_BIT,
+    hw::CAN_TSEG2,
+) {
     Some(v) => v,
     None => panic!("the FDCAN clock does not divide into the bit rate"),
 };

@@ -80,8 +80,13 @@ pub fn enable_peripherals(rcc: &pac::RCC) {
             .adc12en()
             .set_bit()
     });
-    rcc.apb2enr().modify(|_, w| w.tim1en().set_bit());
+    rcc.apb2enr().modify(|_, w| w.tim1en().set_bit().syscfgen().set_bit());
     rcc.apb1enr1().modify(|_, w| w.tim3en().set_bit().fdcanen().set_bit());
     // SAFETY: FDCANSEL 0b10 selects PCLK1 (RM0440 §7.4.26).
     rcc.ccipr().modify(|_, w| unsafe { w.fdcansel().bits(0b10) });
+    // RM0440 RCC: after a peripheral clock is enabled, allow two clock cycles before
+    // touching the peripheral — read an enable register back (ST's
+    // __HAL_RCC_*_CLK_ENABLE does the same with a dummy read).
+    let _ = rcc.apb2enr().read();
+    let _ = rcc.apb1enr1().read();
 }

@@ -2,12 +2,15 @@
 //! [`motor_control::ControllerConfig::process`] step per carrier period with the
 //! CORDIC as [`motor_control::Trig`].
 //!
-//! Order: read and acknowledge the conversions; trip on the break flag or a
-//! phase-current code at the converter's rail ([`crate::adc_frame::overcurrent`]);
-//! advance the setpoint supervision with the value the main loop received over CAN
-//! ([`crate::config::SETPOINT`]: timeout, ramp to zero); run the step; write
-//! `StepOutput::compare` to CCR1..3; enable the gates only while not tripped and the
-//! setpoint is alive or still ramping down (a tripped drive stays off until reset).
+//! Order: read and acknowledge the conversions; trip on the board's levels
+//! ([`crate::config::TRIPS`]: a phase current beyond the over-current level or at the
+//! converter's rail, the DC link beyond the over-voltage level, the last period's
+//! electrical speed beyond the over-speed level); advance the setpoint supervision with
+//! the value the main loop received over CAN ([`crate::config::SETPOINT`]: timeout, ramp
+//! to zero); run the step; write `StepOutput::compare` to CCR1..3; then set MOE only if
+//! nothing tripped, the setpoint is alive or still ramping down, and the break flag —
+//! read again now, not at the start of the interrupt (defect 6) — is clear
+//! (`motor_config::bringup::finish_period`). A tripped drive stays off until reset.
 //! i_d = 0 (the torque → i_q conversion (2.34) assumes it).
 
 use core::cell::Cell;
@@ -22,7 +25,9 @@ use stm32g4::stm32g474::interrupt;
 use super::cordic::Cordic;
 use super::{adc, pins, pwm};
 use crate::adc_frame::{self, Excitation};
-use crate::config::{CONTROLLER, SETPOINT};
+use crate::bringup;
+use crate::config::{CONTROLLER, SETPOINT, TRIPS};
+use crate::motor::board;
 
 /// Control periods run (wrapping); the main loop refreshes the watchdog only when
 /// this advances.
@@ -50,11 +55,12 @@ pub struct Control {
     tim1: pac::TIM1,
     adc1: pac::ADC1,
     adc2: pac::ADC2,
-    gpioc: pac::GPIOC,
     cordic: Cordic,
     state: ControllerState,
     setpoint: SetpointState,
     tripped: bool,
+    /// Electrical speed of the last step \[rad/s\], for the over-speed trip.
+    omega_e: f32,
 }
 
 /// Passes the [`Control`] from `run` to the interrupt once.
@@ -62,23 +68,23 @@ pub static HANDOFF: Mutex<Cell<Option<Control>>> = Mutex::new(Cell::new(None));
 
 impl Control {
     /// Takes the peripherals of the control path (configured by the caller).
-    pub fn new(tim1: pac::TIM1, adc1: pac::ADC1, adc2: pac::ADC2, gpioc: pac::GPIOC, cordic: Cordic) -> Self {
+    pub fn new(tim1: pac::TIM1, adc1: pac::ADC1, adc2: pac::ADC2, cordic: Cordic) -> Self {
         Self {
             tim1,
             adc1,
             adc2,
-            gpioc,
             cordic,
             state: ControllerState::new(),
             setpoint: SetpointState::new(),
             tripped: false,
+            omega_e: 0.0,
         }
     }
 
     /// Latches a trip and switches the gates off at once.
     fn trip(&mut self) {
         self.tripped = true;
-        pwm::set_outputs(&self.tim1, false);
+        pwm::outputs_off(&self.tim1);
     }
 
     /// One control period.
@@ -87,10 +93,10 @@ impl Control {
             // A lost conversion: no valid currents this period.
             return self.trip();
         };
-        if pwm::break_tripped(&self.tim1) || adc_frame::overcurrent(&raw) {
+        if TRIPS.tripped(&raw, usize::from(board::CURRENT_PHASES), self.omega_e) {
             self.trip();
         }
-        let excitation = if pins::excitation_high(&self.gpioc) {
+        let excitation = if pins::excitation_high() {
             Excitation::Positive
         } else {
             Excitation::Negative
@@ -109,8 +115,9 @@ impl Control {
             Demand::Off
         };
         let out = CONTROLLER.process(&mut self.state, &mut self.cordic, &sample, demand);
+        self.omega_e = out.omega_e;
         pwm::set_compare(&self.tim1, out.compare);
-        pwm::set_outputs(&self.tim1, run);
+        bringup::finish_period(&mut pwm::Break(&self.tim1), &mut self.tripped, run);
         TICKS.fetch_add(1, Ordering::Relaxed);
     }
 }

@@ -9,6 +9,21 @@ use stm32g4::stm32g474 as pac;
 
 use super::{pins, watchdog};
 
+/// Routes faults the software can no longer handle to TIM1's break input and stops TIM1
+/// under a debugger halt (defect 6): SYSCFG_CFGR2.CLL (Cortex-M4 LOCKUP), SPL (SRAM
+/// parity), ECCL (flash double ECC error) — write-once lock bits that connect the
+/// error outputs to the break inputs of TIM1/8/20/15/16/17 (RM0440 §11.3.10); without
+/// them a core in lockup (a fault inside the HardFault handler) leaves the bridge
+/// switching with the last compare values. DBGMCU_APB2FZ.DBG_TIM1_STOP: TIM1's counter
+/// stops and its outputs go to their safe state while the core is halted (RM0440
+/// debug chapter, DBGMCU_APB2FZ).
+pub fn route_faults_to_break(syscfg: &pac::SYSCFG, dbgmcu: &pac::DBGMCU) {
+    syscfg
+        .cfgr2()
+        .modify(|_, w| w.cll().set_bit().spl().set_bit().eccl().set_bit());
+    dbgmcu.apb2_fz().modify(|_, w| w.dbg_tim1_stop().set_bit());
+}
+
 /// Switches the outputs off and waits for the watchdog reset.
 pub fn halt() -> ! {
     cortex_m::interrupt::disable();
@@ -17,7 +32,7 @@ pub fn halt() -> ! {
     // outputs towards the off state, which is safe whatever those owners did last.
     let dp = unsafe { pac::Peripherals::steal() };
     dp.TIM1.bdtr().modify(|_, w| w.moe().clear_bit());
-    pins::gates_low(&dp.GPIOA, &dp.GPIOB);
+    pins::gates_low(&dp.GPIOA, &dp.GPIOB, &dp.GPIOC);
     watchdog::start_default(&dp.IWDG);
     loop {
         cortex_m::asm::nop();

@@ -5,12 +5,12 @@
 //! | module | drives |
 //! |---|---|
 //! | [`clocks`] | 170 MHz system clock, peripheral clocks |
-//! | [`pins`] | pin assignment, gate pins forced low |
-//! | [`pwm`] | TIM1: PWM, dead time, break, ADC trigger |
+//! | [`pins`] | the board's pins (from the board file), gate pins forced low |
+//! | [`pwm`] | TIM1: PWM, dead time, break, ADC trigger at the board's sampling instant |
 //! | [`resolver`] | TIM3: resolver excitation locked to the carrier |
 //! | [`adc`] | ADC1/ADC2 injected conversions |
 //! | [`cordic`] | CORDIC as the core's `Trig` |
-//! | [`fmac`] | FMAC running the generated FIR |
+//! | [`fmac`] | FMAC start-up self-test of the generated FIR against the bit-exact model |
 //! | [`can`] | FDCAN1 setpoint reception |
 //! | [`watchdog`] | IWDG |
 //! | [`control`] | the control interrupt |
@@ -33,24 +33,45 @@ use core::sync::atomic::Ordering;
 
 use stm32g4::stm32g474 as pac;
 
-use crate::{can_frame, config};
+use crate::motor::board;
+use crate::{can_frame, config, registers};
 use control::{Control, HANDOFF, TICKS, publish_setpoint};
 use fault::halt;
 
 /// Brings the board up, starts the control interrupt and runs the main loop:
 /// setpoint reception and the watchdog refresh (only while the control interrupt
-/// advances). Any bring-up failure — a clock or converter that does not become
-/// ready, a CORDIC or FMAC result that disagrees with the software model — halts
-/// with the outputs off.
+/// advances). Any bring-up failure — option bytes that let PB8 select the bootloader, a
+/// clock or converter that does not become ready, a break input that is active, a
+/// CORDIC or FMAC result that disagrees with the software model — halts with the
+/// outputs off.
+///
+/// Order (each step's reason in its module):
+/// 1. clocks; the boot source (defect 2): with `boot0.handling = "option_bytes"` the
+///    image runs only if FLASH_OPTR.nSWBOOT0 = 0 and nBOOT0 = 1, so PB8's level at the
+///    next reset cannot start the system bootloader (DS12288 §3.7);
+/// 2. fault routing (defect 6): SYSCFG_CFGR2 locks the Cortex-M4 LOCKUP output, SRAM
+///    parity and flash ECC errors onto TIM1's break (RM0440 §11.3.10 — a locked-up core
+///    can no longer clear MOE itself), and DBGMCU_APB2FZ.DBG_TIM1_STOP stops TIM1 with its
+///    outputs in the safe state while a debugger halts the core;
+/// 3. TIM1 with MOE = 0 and its one BDTR write (defects 4, 8), then the pins (the gate
+///    pins are routed to a timer that already drives them to their off level), then the
+///    break armed on the routed pin (defect 3);
+/// 4. CORDIC and FMAC self-tests, ADCs (defect 1), TIM3, FDCAN, start.
 pub fn run() -> ! {
     let Some(dp) = pac::Peripherals::take() else { halt() };
     if !clocks::init(&dp.RCC, &dp.PWR, &dp.FLASH) {
         halt()
     }
+    if board::BOOT0_OPTION_BYTES == 1 && !registers::boots_from_flash_regardless_of_pb8(dp.FLASH.optr().read().bits()) {
+        halt()
+    }
     clocks::enable_peripherals(&dp.RCC);
-    // TIM1 first: its outputs are disabled before the pins are routed to it.
+    fault::route_faults_to_break(&dp.SYSCFG, &dp.DBGMCU);
     pwm::init(&dp.TIM1);
     pins::init(&dp.GPIOA, &dp.GPIOB, &dp.GPIOC);
+    if pwm::arm_break(&dp.TIM1).is_err() {
+        halt()
+    }
     let mut cordic = cordic::Cordic::new(dp.CORDIC);
     let mut fmac = fmac::Fmac::new(dp.FMAC);
     if !cordic.self_test() || !fmac.self_test(&config::FILTER) {
@@ -64,7 +85,7 @@ pub fn run() -> ! {
         halt()
     };
     pwm::start(&dp.TIM1);
-    let control = Control::new(dp.TIM1, dp.ADC1, dp.ADC2, dp.GPIOC, cordic);
+    let control = Control::new(dp.TIM1, dp.ADC1, dp.ADC2, cordic);
     cortex_m::interrupt::free(|cs| HANDOFF.borrow(cs).set(Some(control)));
     // SAFETY: the handler's data has been handed over; no critical section of this
     // thread relies on the interrupt being masked.

@@ -1,28 +1,34 @@
-//! TIM1: centre-aligned complementary PWM at f_s with dead time, the over-current
-//! break input, and TRGO at the carrier maximum for the injected ADC conversions
-//! (RM0440 §28).
+//! TIM1: centre-aligned complementary PWM at f_s with dead time, the over-current break
+//! input, and the ADC trigger at the board's sampling instant (RM0440 advanced-control
+//! timer chapter; the board's values from `motor::board`, register values from
+//! `motor_config::registers`).
 //!
-//! * Centre-aligned mode 1, ARR = f_tim/(2·f_s) ([`crate::config::PWM_PERIOD`]),
-//!   PWM mode 1 on CH1–CH3 with preload: the high side conducts while CNT < CCR, so
-//!   duty = CCR/ARR and the low sides conduct around the carrier maximum.
-//! * Repetition counter RCR = 1, written before the counter starts: one update
-//!   event per carrier period, at the overflow (carrier maximum, RM0440 §28.3.3).
-//!   TRGO = update (MMS = 010) starts the injected conversions there, and the new
-//!   compare values computed from them load at the next maximum (the 1.5-sample
-//!   delay the angle lead (4.23) compensates).
-//! * Dead time [`crate::config::DEAD_TIME_DTG`]; OSSR = OSSI = 1 and idle levels 0:
-//!   with MOE = 0 all six outputs are driven to their inactive (off) level.
-//! * BKIN (PB12, active low, filtered) clears MOE in hardware; AOE = 0 keeps it
-//!   cleared until software sets it again, which the control interrupt never does
-//!   after a break. LOCK level 1 freezes the dead time and break configuration.
+//! * Centre-aligned mode 1, ARR = f_tim/(2·f_s) ([`crate::config::PWM_PERIOD`]), PWM
+//!   mode 1 on CH1–CH3 with preload: a high side conducts while CNT < CCR, so duty =
+//!   CCR/ARR, the high sides conduct around the carrier minimum and the low sides
+//!   around the maximum.
+//! * Repetition counter RCR = 1, loaded before the counter starts: one update event per
+//!   carrier period, at the *underflow* (carrier minimum, RM0440 §29.3.5), where the
+//!   preloaded compare values from the last control step take effect.
+//! * The ADC trigger is not the update event: channel 4 (no pin) makes OC4REF rise at
+//!   the board's `sensing.sample_instant` ([`crate::config::TRIGGER`]: one tick before
+//!   the carrier maximum for low-side shunts, at the minimum otherwise), routed as TRGO2
+//!   (MMS2 = OC4REF) to the injected conversions and as TRGO (MMS = OC4REF) to TIM3,
+//!   which resets the resolver excitation at the same instant.
+//! * TIM1_BDTR is written once ([`crate::config::BDTR`]): dead time, OSSR = OSSI = 1 and
+//!   idle levels 0 (with MOE = 0 all six outputs are driven to their off level), break
+//!   enable with the board's polarity and filter, LOCK level 1. LOCK and the fields it
+//!   protects are write-once after reset (RM0440 §29.3.18): the old second write for
+//!   LOCK never took effect.
+//! * BKIN clears MOE in hardware; AOE = 0 keeps it cleared. BIF is armed only after the
+//!   pin is routed ([`arm_break`]) and read again before MOE is set each period
+//!   (`motor_config::bringup::finish_period`).
 
 use stm32g4::stm32g474 as pac;
 
-use crate::config::{DEAD_TIME_DTG, PWM_PERIOD};
-use crate::hw;
-
-/// PWM mode 1 (OCxM = 0110).
-const PWM_MODE_1: u8 = 0b110;
+use crate::bringup::{self, BreakActive, BreakControl};
+use crate::config::{BDTR, PWM_PERIOD, TRIGGER};
+use crate::registers::{MMS_OC4REF, PWM_MODE_1};
 
 /// Configures TIM1 with the outputs disabled (MOE = 0) and 50 % duty.
 pub fn init(tim1: &pac::TIM1) {
@@ -34,6 +40,8 @@ pub fn init(tim1: &pac::TIM1) {
     tim1.ccr1().write(|w| w.ccr().set(half));
     tim1.ccr2().write(|w| w.ccr().set(half));
     tim1.ccr3().write(|w| w.ccr().set(half));
+    let (oc4m, ccr4) = TRIGGER;
+    tim1.ccr4().write(|w| w.ccr().set(u32::from(ccr4)));
     tim1.ccmr1_output().write(|w| {
         w.oc1m()
             .set(PWM_MODE_1)
@@ -44,10 +52,20 @@ pub fn init(tim1: &pac::TIM1) {
             .oc2pe()
             .set_bit()
     });
-    tim1.ccmr2_output()
-        .write(|w| w.oc3m().set(PWM_MODE_1).oc3pe().set_bit());
-    // SAFETY: MMS = 0b010 selects the update event as TRGO (RM0440 §28.6.2).
-    tim1.cr2().write(|w| unsafe { w.mms().bits(0b010) });
+    tim1.ccmr2_output().write(|w| {
+        w.oc3m()
+            .set(PWM_MODE_1)
+            .oc3pe()
+            .set_bit()
+            .oc4m()
+            .set(oc4m)
+            .oc4pe()
+            .set_bit()
+    });
+    // SAFETY: MMS and MMS2 take OC4REF's code (RM0440 TIMx_CR2; ST's LL_TIM_TRGO_OC4REF,
+    // LL_TIM_TRGO2_OC4).
+    tim1.cr2()
+        .write(|w| unsafe { w.mms().bits(MMS_OC4REF).mms2().bits(MMS_OC4REF) });
     tim1.ccer().write(|w| {
         w.cc1e()
             .set_bit()
@@ -62,31 +80,36 @@ pub fn init(tim1: &pac::TIM1) {
             .cc3ne()
             .set_bit()
     });
-    // BKIN from the pin (reset value, made explicit), active low.
+    // BKIN from the pin (reset value, made explicit), not inverted: the polarity is
+    // BDTR.BKP (TIMx_AF1.BKINP must be programmed together with it).
     tim1.af1().modify(|_, w| w.bkine().set_bit().bkinp().clear_bit());
-    // SAFETY: BKF is a 4-bit filter code; DTG any 8-bit code.
-    tim1.bdtr().write(|w| unsafe {
-        w.dtg()
-            .bits(DEAD_TIME_DTG)
-            .ossr()
-            .set_bit()
-            .ossi()
-            .set_bit()
-            .bke()
-            .set_bit()
-            .bkp()
-            .clear_bit()
-            .bkf()
-            .bits(hw::BREAK_FILTER)
-            .aoe()
-            .clear_bit()
-            .moe()
-            .clear_bit()
-    });
-    tim1.bdtr().modify(|_, w| w.lock().set(0b01));
+    // SAFETY: one write of the host-tested value (motor_config::registers::bdtr).
+    tim1.bdtr().write(|w| unsafe { w.bits(BDTR) });
     // Load ARR, CCRx and the repetition counter before the start.
     tim1.egr().write(|w| w.ug().set_bit());
-    tim1.sr().write(|w| unsafe { w.bits(0) });
+}
+
+/// TIM1's break flag and main output, for the host-tested sequences.
+pub struct Break<'a>(pub &'a pac::TIM1);
+
+impl BreakControl for Break<'_> {
+    fn break_flag(&mut self) -> bool {
+        self.0.sr().read().bif().bit_is_set()
+    }
+    fn clear_break_flag(&mut self) {
+        self.0.sr().write(|w| w.bif().clear());
+    }
+    fn set_main_output(&mut self, on: bool) {
+        if self.0.bdtr().read().moe().bit_is_set() != on {
+            self.0.bdtr().modify(|_, w| w.moe().bit(on));
+        }
+    }
+}
+
+/// After the break pin is routed: clears the break flag latched while BKE was set on an
+/// unrouted pin and checks it stays clear (`Err` if the comparator reports a fault).
+pub fn arm_break(tim1: &pac::TIM1) -> Result<(), BreakActive> {
+    bringup::arm_break(&mut Break(tim1))
 }
 
 /// Starts the carrier (and with it the ADC triggers).
@@ -102,14 +125,7 @@ pub fn set_compare(tim1: &pac::TIM1, compare: [u16; 3]) {
     tim1.ccr3().write(|r| r.ccr().set(u32::from(w)));
 }
 
-/// The break input has fired (latched in SR.BIF until cleared; never cleared here).
-pub fn break_tripped(tim1: &pac::TIM1) -> bool {
-    tim1.sr().read().bif().bit_is_set()
-}
-
-/// Enables (MOE = 1) or disables (MOE = 0, outputs to their off level) the gates.
-pub fn set_outputs(tim1: &pac::TIM1, on: bool) {
-    if tim1.bdtr().read().moe().bit_is_set() != on {
-        tim1.bdtr().modify(|_, w| w.moe().bit(on));
-    }
+/// Disables the gates at once (MOE = 0, outputs to their off level).
+pub fn outputs_off(tim1: &pac::TIM1) {
+    Break(tim1).set_main_output(false);
 }

@@ -1,14 +1,15 @@
-//! Resolver excitation locked to the PWM, thesis A §4.3: a square wave at f_s/2 on
-//! TIM3_CH1 (PC6), turned into the sinusoidal excitation (4.2) by the board's
+//! Resolver excitation locked to the PWM, thesis A §4.3: a square wave at f_s/2 on the
+//! board's TIM3_CH1 pin, turned into the sinusoidal excitation (4.2) by the board's
 //! excitation filter/amplifier (thesis A §4.4: "excitation filters").
 //!
 //! TIM3 runs from the same 170 MHz clock with one period equal to the carrier's
 //! (ARR3 = 2·ARR1 − 1) and is reset by TIM1's TRGO (slave reset mode, ITR0 = TIM1),
-//! i.e. at every carrier maximum. OC1 toggles at CNT3 = ARR1, the carrier minimum,
-//! so the excitation has its edges at the minima and the middle of each half period
-//! — the extremum of its fundamental — at the carrier maxima, where the injected
-//! conversions sample SIN and COS: one sample per half period of the excitation,
-//! exactly at its maximum or minimum (synchronous demodulation, thesis A §4.3). The
+//! which is OC4REF — the same instant as the ADC trigger (TRGO2), see `pwm`. OC1
+//! toggles at CNT3 = ARR1, half a carrier period after the reset, so the excitation's
+//! edges fall half a period away from the sampling instant and the middle of each half
+//! period of the square wave — the extremum of its fundamental — at the sampling
+//! instant, whichever instant the board chose: one sample per half period of the
+//! excitation, at its maximum or minimum (synchronous demodulation, thesis A §4.3). The
 //! excitation's sign at that instant is read back from the pin.
 //!
 //! Assumption (documented in firmware/README.md): the excitation filter and the

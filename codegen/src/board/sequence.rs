@@ -1,0 +1,196 @@
+//! Which converter samples which analog input, in which rank, for how long.
+//!
+//! The firmware triggers ADC1 and ADC2 together from TIM1 and converts up to four
+//! injected ranks each (ADC_JSQR.JL = 0…3, RM0440 §21.4.21). The plan puts every input
+//! on a converter that has it as a channel and prefers, in this order: the resolver's
+//! SIN and COS on different converters (sampled at the same instant); the phase
+//! currents in the first ranks (a rank-k conversion samples k−1 conversions after the
+//! trigger, and low-side shunts carry the current only inside the low-side pulse); equal
+//! sequence lengths, ADC1 the longer one (the control interrupt runs on ADC1's end of
+//! sequence and then waits for ADC2).
+
+use serde::Serialize;
+
+use super::chip::{self, Chip};
+use super::raw::RawBoard;
+use super::sampling::{self, Sampling};
+use super::{ADC_CLOCK_HZ, PinUse, Signal};
+use crate::spec::{Param, Resolver_};
+
+/// ADC1 or ADC2.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Converter {
+    /// ADC1.
+    Adc1,
+    /// ADC2.
+    Adc2,
+}
+
+impl Converter {
+    /// Peripheral name in the chip data.
+    pub fn name(self) -> &'static str {
+        match self {
+            Converter::Adc1 => "ADC1",
+            Converter::Adc2 => "ADC2",
+        }
+    }
+}
+
+/// One injected rank.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AdcSlot {
+    /// The input.
+    pub signal: Signal,
+    /// Its pin.
+    pub pin: &'static str,
+    /// Channel number (ADC_JSQR.JSQx).
+    pub channel: u8,
+    /// The sampling chosen for it.
+    pub sampling: Sampling,
+}
+
+/// Rank order within one converter: currents, resolver, DC link.
+fn priority(s: Signal) -> u8 {
+    match s {
+        Signal::CurrentU => 0,
+        Signal::CurrentV => 1,
+        Signal::CurrentW => 2,
+        Signal::ResolverSin | Signal::ResolverCos => 3,
+        _ => 4,
+    }
+}
+
+/// Cost of one assignment (lower is better), see the module documentation.
+fn cost(seqs: &[Vec<Signal>; 2]) -> u32 {
+    let same_resolver = seqs
+        .iter()
+        .any(|s| s.contains(&Signal::ResolverSin) && s.contains(&Signal::ResolverCos));
+    let current_ranks: u32 = seqs
+        .iter()
+        .flat_map(|s| {
+            s.iter()
+                .enumerate()
+                .filter(|(_, x)| priority(**x) <= 2)
+                .map(|(k, _)| k as u32)
+        })
+        .sum();
+    let (n1, n2) = (seqs[0].len() as u32, seqs[1].len() as u32);
+    u32::from(same_resolver) * 1000 + current_ranks * 10 + n1.abs_diff(n2) + u32::from(n2 > n1)
+}
+
+/// The sequences of ADC1 and ADC2, or located errors.
+pub(super) fn plan(
+    cx: &mut Resolver_<'_>,
+    raw: &RawBoard,
+    chip: &'static Chip,
+    pins: &[PinUse],
+    [r_current, r_dc, r_resolver]: [&Param; 3],
+    fixed: Option<&(u8, Param)>,
+) -> Option<[Vec<AdcSlot>; 2]> {
+    let _ = raw;
+    let analog: Vec<&PinUse> = pins
+        .iter()
+        .filter(|p| matches!(p.signal.need(), super::Need::Analog))
+        .collect();
+    let conv = [Converter::Adc1, Converter::Adc2];
+    let mut best: Option<(u32, [Vec<Signal>; 2])> = None;
+    for mask in 0u32..(1 << analog.len()) {
+        let mut seqs: [Vec<Signal>; 2] = [Vec::new(), Vec::new()];
+        let feasible = analog.iter().enumerate().all(|(k, p)| {
+            let c = ((mask >> k) & 1) as usize;
+            seqs[c].push(p.signal);
+            chip.adc_channel(p.pin, conv[c].name()).is_some()
+        });
+        if !feasible || seqs.iter().any(|s| s.len() > 4) {
+            continue;
+        }
+        for s in &mut seqs {
+            s.sort_by_key(|x| (priority(*x), *x));
+        }
+        let c = cost(&seqs);
+        if best.as_ref().is_none_or(|(b, _)| c < *b) {
+            best = Some((c, seqs));
+        }
+    }
+    let Some((_, seqs)) = best else {
+        let p = analog.first()?;
+        cx.err(
+            p.span.clone(),
+            &format!("pins.{}", p.signal.key()),
+            "the analog inputs cannot be shared out over ADC1 and ADC2 (at most four injected conversions each, RM0440 §21.4.21)",
+            "analog pins that ADC1 and ADC2 both convert (ADC12 inputs), at most four on a converter",
+        );
+        return None;
+    };
+    let mut out: [Vec<AdcSlot>; 2] = [Vec::new(), Vec::new()];
+    let mut ok = true;
+    // Inputs a board-wide `sampling_cycles` is too short for: (cycles needed, slow, message).
+    let mut too_short: Vec<(f64, bool, String)> = Vec::new();
+    for (c, seq) in seqs.iter().enumerate() {
+        for signal in seq {
+            let Some(p) = analog.iter().find(|p| p.signal == *signal) else {
+                continue;
+            };
+            let channel = chip.adc_channel(p.pin, conv[c].name())?;
+            let fast = chip::is_fast_channel(channel);
+            let r = match signal {
+                Signal::CurrentU | Signal::CurrentV | Signal::CurrentW => r_current,
+                Signal::DcLink => r_dc,
+                _ => r_resolver,
+            };
+            let class = if fast { "fast" } else { "slow" };
+            let what = format!("{} is {}_IN{channel}, a {class} channel", p.pin, conv[c].name());
+            match sampling::sampling(r.value, fast, ADC_CLOCK_HZ) {
+                Ok(mut s) => {
+                    if let Some((code, given)) = fixed {
+                        if *code < s.smp_code {
+                            too_short.push((s.cycles, !fast, format!(
+                                "{} cycles is too short for `pins.{}`: {what}; {:.0} Ω needs ≥ {} cycles at {:.1} MHz (DS12288 Table 67: {:.0} ns, thesis A (7.4): {:.1} ns)",
+                                given.value,
+                                signal.key(),
+                                r.value,
+                                s.cycles,
+                                ADC_CLOCK_HZ / 1e6,
+                                s.table_time_s * 1e9,
+                                s.settling_time_s * 1e9
+                            )));
+                        } else {
+                            s.smp_code = *code;
+                            s.cycles = given.value;
+                        }
+                    }
+                    out[c].push(AdcSlot {
+                        signal: *signal,
+                        pin: p.pin,
+                        channel,
+                        sampling: s,
+                    });
+                }
+                Err(e) => {
+                    cx.err(
+                        r.span.clone(),
+                        &r.key,
+                        format!("{:.0} Ω is too high for `pins.{}`: {what}, which settles at most {:.0} Ω even at 640.5 cycles (DS12288 Table 67)", r.value, signal.key(), e.max_ohm),
+                        format!("a source resistance up to {:.0} Ω (buffer the signal), or a fast channel (IN1–IN5)", e.max_ohm),
+                    );
+                    ok = false;
+                }
+            }
+        }
+    }
+    // One error, for the input that needs the most (a slow one first on a tie).
+    if let (Some((code, given)), Some((cycles, _, problem))) = (
+        fixed,
+        too_short.iter().max_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1))),
+    ) {
+        let _ = code;
+        cx.err(
+            given.span.clone(),
+            "sensing.sampling_cycles",
+            problem.clone(),
+            format!("sampling_cycles = {cycles} or more, or leave the key out to let each input get the shortest time that settles it"),
+        );
+        ok = false;
+    }
+    ok.then_some(out)
+}

@@ -1,0 +1,364 @@
+//! Register values computed from the board's constants (pure, host-tested), so that the
+//! board layer (`../app/src/board/`) only writes them: GPIO mode/alternate-function/speed
+//! fields, the ADC injected sequence and sampling times, the one TIM1_BDTR write, the
+//! ADC trigger at the board's sampling instant.
+//!
+//! An emulator (or a reviewer) can compare every value here with RM0440's register
+//! descriptions without running the firmware.
+#![forbid(unsafe_code)]
+
+/// A read-modify-write of one 32-bit register: `new = (old & !mask) | value`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Field {
+    /// Bits written.
+    pub mask: u32,
+    /// Their new value.
+    pub value: u32,
+}
+
+impl Field {
+    /// The register value after the write.
+    pub const fn apply(self, old: u32) -> u32 {
+        (old & !self.mask) | self.value
+    }
+
+    const fn or(self, other: Field) -> Field {
+        Field {
+            mask: self.mask | other.mask,
+            value: self.value | other.value,
+        }
+    }
+}
+
+/// GPIO ports the firmware configures: A, B, C (the LQFP64's PD2, PF0/1, PG10 carry no
+/// signal the board files may name for gates, break, excitation or CAN on this package;
+/// a pin on another port is refused at compile time by [`port_config`]).
+pub const PORTS: usize = 3;
+
+/// The GPIO writes of one port (RM0440 GPIO registers: MODER 2 bits/pin, OSPEEDR 2 bits/pin,
+/// AFRL pins 0–7 and AFRH pins 8–15, 4 bits each).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct PortConfig {
+    /// MODER: 0b10 (alternate function) for each pin.
+    pub moder: Field,
+    /// OSPEEDR: 0b11 (very high speed) for each pin.
+    pub ospeedr: Field,
+    /// AFRL.
+    pub afrl: Field,
+    /// AFRH.
+    pub afrh: Field,
+}
+
+/// Port index (A = 0) and pin number of a `port·16 + pin` code.
+pub const fn split(code: u8) -> (usize, u32) {
+    ((code / 16) as usize, (code % 16) as u32)
+}
+
+/// The alternate-function configuration of `pins` (codes `port·16 + pin`) with `afs`,
+/// per port A, B, C. `None` if a pin is on another port or an AF is above 15.
+pub const fn port_config(pins: &[u8], afs: &[u8]) -> Option<[PortConfig; PORTS]> {
+    let mut out = [PortConfig {
+        moder: Field { mask: 0, value: 0 },
+        ospeedr: Field { mask: 0, value: 0 },
+        afrl: Field { mask: 0, value: 0 },
+        afrh: Field { mask: 0, value: 0 },
+    }; PORTS];
+    if pins.len() != afs.len() {
+        return None;
+    }
+    let mut k = 0;
+    while k < pins.len() {
+        let (port, n) = split(pins[k]);
+        let af = afs[k] as u32;
+        if port >= PORTS || af > 15 {
+            return None;
+        }
+        let p = &mut out[port];
+        p.moder = p.moder.or(Field {
+            mask: 0b11 << (2 * n),
+            value: 0b10 << (2 * n),
+        });
+        p.ospeedr = p.ospeedr.or(Field {
+            mask: 0b11 << (2 * n),
+            value: 0b11 << (2 * n),
+        });
+        let f = Field {
+            mask: 0xF << (4 * (n % 8)),
+            value: af << (4 * (n % 8)),
+        };
+        if n < 8 {
+            p.afrl = p.afrl.or(f);
+        } else {
+            p.afrh = p.afrh.or(f);
+        }
+        k += 1;
+    }
+    Some(out)
+}
+
+/// MODER write that makes `pins` general-purpose outputs (0b01), per port (the fault
+/// path drives the gate pins low independently of the timer).
+pub const fn output_mode(pins: &[u8]) -> [Field; PORTS] {
+    let mut out = [Field { mask: 0, value: 0 }; PORTS];
+    let mut k = 0;
+    while k < pins.len() {
+        let (port, n) = split(pins[k]);
+        if port < PORTS {
+            out[port] = out[port].or(Field {
+                mask: 0b11 << (2 * n),
+                value: 0b01 << (2 * n),
+            });
+        }
+        k += 1;
+    }
+    out
+}
+
+/// BSRR value that resets (drives low) `pins` of each port (BRy, bits 16–31).
+pub const fn reset_bits(pins: &[u8]) -> [u32; PORTS] {
+    let mut out = [0; PORTS];
+    let mut k = 0;
+    while k < pins.len() {
+        let (port, n) = split(pins[k]);
+        if port < PORTS {
+            out[port] |= 1 << (16 + n);
+        }
+        k += 1;
+    }
+    out
+}
+
+/// ADC_JSQR.JEXTSEL of TIM1_TRGO2 for ADC1/ADC2 injected conversions (RM0440 ADC chapter, table
+/// "ADC1/2 external triggers for injected channels"; ST's LL: `LL_ADC_INJ_TRIG_EXT_TIM1_TRGO2 = ADC_JSQR_JEXTSEL_3`).
+pub const JEXTSEL_TIM1_TRGO2: u32 = 8;
+
+/// ADC_JSQR for `channels` (1 to 4 ranks), triggered on the rising edge (JEXTEN = 01)
+/// of TIM1_TRGO2 (RM0440, ADC_JSQR: JL bits 1:0 = ranks − 1, JEXTSEL 6:2, JEXTEN 8:7,
+/// JSQ1 13:9, JSQ2 19:15, JSQ3 25:21, JSQ4 31:27). `None` for 0 or more than 4 ranks
+/// or a channel above 18.
+pub const fn jsqr(channels: &[u8]) -> Option<u32> {
+    let n = channels.len();
+    if n == 0 || n > 4 {
+        return None;
+    }
+    let mut v = (n as u32 - 1) | (JEXTSEL_TIM1_TRGO2 << 2) | (0b01 << 7);
+    let shifts = [9, 15, 21, 27];
+    let mut k = 0;
+    while k < n {
+        if channels[k] > 18 {
+            return None;
+        }
+        v |= (channels[k] as u32) << shifts[k];
+        k += 1;
+    }
+    Some(v)
+}
+
+/// ADC_SMPR1 (channels 0–9) and ADC_SMPR2 (10–18) writes for the sampling codes of
+/// `channels` (RM0440, ADC_SMPR1/2: 3 bits per channel).
+pub const fn smpr(channels: &[u8], codes: &[u8]) -> [Field; 2] {
+    let mut out = [Field { mask: 0, value: 0 }; 2];
+    let mut k = 0;
+    while k < channels.len() && k < codes.len() {
+        let ch = channels[k] as u32;
+        let (reg, pos) = if ch < 10 { (0, ch) } else { (1, ch - 10) };
+        out[reg] = out[reg].or(Field {
+            mask: 0b111 << (3 * pos),
+            value: ((codes[k] & 0b111) as u32) << (3 * pos),
+        });
+        k += 1;
+    }
+    out
+}
+
+/// TIM1_BDTR in one write (RM0440, TIMx_BDTR; as ST's `HAL_TIMEx_ConfigBreakDeadTime`
+/// assembles it in a variable and writes it once): DTG, LOCK, OSSI, OSSR, BKE, BKP,
+/// BKF, AOE = 0, MOE = 0. LOCK and the fields it protects are write-once after reset,
+/// so a second write (the old firmware's `modify` for LOCK) never takes effect.
+pub const fn bdtr(dtg: u8, break_active_high: bool, break_filter: u8, lock: u8) -> u32 {
+    let dtg = dtg as u32; // bits 7:0
+    let lock = ((lock & 0b11) as u32) << 8;
+    let ossi = 1 << 10;
+    let ossr = 1 << 11;
+    let bke = 1 << 12;
+    let bkp = (break_active_high as u32) << 13;
+    let bkf = ((break_filter & 0xF) as u32) << 16;
+    dtg | lock | ossi | ossr | bke | bkp | bkf
+}
+
+/// TIMx_BDTR.LOCK level 1: DTG, BKE, BKP, AOE, OSSI, OSSR and BKF cannot be written
+/// again until reset (RM0440, TIMx_BDTR).
+pub const LOCK_LEVEL_1: u8 = 0b01;
+
+/// OCxM codes (RM0440, TIMx_CCMR1/2 OCxM): PWM mode 1 (active while CNT < CCR) and 2.
+pub const PWM_MODE_1: u8 = 0b110;
+/// PWM mode 2: active while CNT ≥ CCR (up-counting).
+pub const PWM_MODE_2: u8 = 0b111;
+/// TIMx_CR2.MMS / MMS2 code of OC4REF(C) as TRGO / TRGO2 (RM0440, TIMx_CR2:
+/// MMS = 111; MMS2 = 0111; ST's LL: `LL_TIM_TRGO_OC4REF`, `LL_TIM_TRGO2_OC4`).
+pub const MMS_OC4REF: u8 = 0b0111;
+
+/// Where the ADC trigger (and the resolver excitation's reset) falls in the carrier.
+///
+/// Centre-aligned mode 1 counts 0 → ARR → 0. PWM mode 1 on CH1–3 makes a high side
+/// conduct while CNT < CCRx, so around the carrier minimum (CNT = 0) the high sides
+/// conduct and around the maximum (CNT = ARR) the low sides do. The update event does
+/// *not* mark the maximum: with RCR = 1 loaded before the counter starts, the first
+/// repetition-counter underflow comes at the first overflow and the update event at the
+/// following underflow — every carrier minimum (RM0440 §29.3.5, Figure "update rate
+/// examples depending on mode and TIMx_RCR"). So the trigger comes from channel 4:
+/// OC4REF as TRGO2 for the ADC and as TRGO for TIM3.
+///
+/// * Carrier maximum (low-side centre): PWM mode 2 with CCR4 = ARR − 1: OC4REF rises
+///   when the up-count reaches ARR − 1, one timer tick (5.9 ns at 170 MHz) before the
+///   peak.
+/// * Carrier minimum (high-side centre): PWM mode 1 with CCR4 = 1: OC4REF rises when the
+///   down-count passes below 1, at CNT = 0.
+///
+/// Returns (OC4M, CCR4).
+pub const fn trigger_channel(at_carrier_maximum: bool, arr: u16) -> (u8, u16) {
+    if at_carrier_maximum {
+        (PWM_MODE_2, arr.saturating_sub(1))
+    } else {
+        (PWM_MODE_1, 1)
+    }
+}
+
+/// FLASH_OPTR bits for the boot source (RM0440 §5.4.1, §3.4.1): nSWBOOT0 (bit 26) = 0
+/// takes BOOT0 from the nBOOT0 option bit (bit 27) instead of the PB8-BOOT0 pin, and
+/// nBOOT0 = 1 selects the main flash.
+pub const OPTR_NSWBOOT0: u32 = 1 << 26;
+/// nBOOT0.
+pub const OPTR_NBOOT0: u32 = 1 << 27;
+
+/// Whether FLASH_OPTR makes the MCU boot from flash whatever the PB8-BOOT0 pin does:
+/// nSWBOOT0 = 0 and nBOOT0 = 1. With the factory value (nSWBOOT0 = 1) a CAN
+/// transceiver's idle-high RXD on PB8 starts the system bootloader at the next reset.
+pub const fn boots_from_flash_regardless_of_pb8(optr: u32) -> bool {
+    optr & OPTR_NSWBOOT0 == 0 && optr & OPTR_NBOOT0 != 0
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The reference board's gates PA8, PA9, PA10 (AF6), PB13, PB14 (AF6), PB15 (AF4):
+    /// hand-assembled register values (RM0440 GPIO registers): port A MODER bits 16–21 = 10 10 10
+    /// (mask 0x003F_0000, value 0x002A_0000), AFRH of pins 8–10 = 6 (0x0000_0666);
+    /// port B MODER bits 26–31 (0xFC00_0000 / 0xA800_0000), AFRH pins 13–15 = 6, 6, 4
+    /// (0x4660_0000 in mask 0xFFF0_0000).
+    #[test]
+    fn gpio_fields_by_hand() {
+        let pins = [0x08, 0x09, 0x0A, 0x1D, 0x1E, 0x1F];
+        let afs = [6, 6, 6, 6, 6, 4];
+        let c = port_config(&pins, &afs).unwrap();
+        assert_eq!(
+            c[0].moder,
+            Field {
+                mask: 0x003F_0000,
+                value: 0x002A_0000
+            }
+        );
+        assert_eq!(
+            c[0].afrh,
+            Field {
+                mask: 0x0000_0FFF,
+                value: 0x0000_0666
+            }
+        );
+        assert_eq!(c[0].afrl, Field::default());
+        assert_eq!(
+            c[1].moder,
+            Field {
+                mask: 0xFC00_0000,
+                value: 0xA800_0000
+            }
+        );
+        assert_eq!(
+            c[1].afrh,
+            Field {
+                mask: 0xFFF0_0000,
+                value: 0x4660_0000
+            }
+        );
+        assert_eq!(c[1].ospeedr.value, 0xFC00_0000);
+        // A pin elsewhere in the register is kept: reset MODER of port A is 0xABFF_FFFF
+        // (RM0440 GPIOA_MODER reset value: PA13/PA14/PA15 in their debug AF).
+        assert_eq!(c[0].moder.apply(0xABFF_FFFF), 0xABEA_FFFF);
+        // Output mode and BSRR reset bits of the same pins.
+        assert_eq!(
+            output_mode(&pins)[1],
+            Field {
+                mask: 0xFC00_0000,
+                value: 0x5400_0000
+            }
+        );
+        assert_eq!(reset_bits(&pins), [0x0700_0000, 0xE000_0000, 0]);
+        assert_eq!(port_config(&[0x32], &[1]), None); // port D
+        assert_eq!(port_config(&[0x08], &[16]), None);
+    }
+
+    /// JSQR of ADC2 on the reference board (IN3, IN4, IN17), TRGO2, rising edge:
+    /// JL = 2, JEXTSEL 8 << 2 = 0x20, JEXTEN 1 << 7 = 0x80, 3 << 9, 4 << 15, 17 << 21 →
+    /// 0x2 | 0x20 | 0x80 | 0x600 | 0x2_0000 | 0x220_0000 = 0x0222_06A2.
+    #[test]
+    fn injected_sequence_by_hand() {
+        assert_eq!(jsqr(&[3, 4, 17]), Some(0x0222_06A2));
+        assert_eq!(jsqr(&[1]), Some(0x0000_02A0));
+        assert_eq!(jsqr(&[]), None);
+        assert_eq!(jsqr(&[1, 2, 3, 4, 5]), None);
+        assert_eq!(jsqr(&[19]), None);
+    }
+
+    /// IN17 at code 3 (24.5 cycles) → SMPR2 bits 21–23 = 011; IN3 code 1 → SMPR1 bits
+    /// 9–11 = 001.
+    #[test]
+    fn sampling_registers_by_hand() {
+        let [r1, r2] = smpr(&[3, 17], &[1, 3]);
+        assert_eq!(
+            r1,
+            Field {
+                mask: 0b111 << 9,
+                value: 1 << 9
+            }
+        );
+        assert_eq!(
+            r2,
+            Field {
+                mask: 0b111 << 21,
+                value: 3 << 21
+            }
+        );
+    }
+
+    /// 500 ns at 170 MHz → DTG 85 (0x55); LOCK 1 (0x100); OSSI, OSSR (0xC00); BKE
+    /// (0x1000); BKP = 0 for active low; BKF 3 (0x3_0000): 0x0003_1D55 — one value with
+    /// the lock in it, MOE and AOE clear.
+    #[test]
+    fn break_dead_time_register_in_one_write() {
+        assert_eq!(bdtr(85, false, 0b0011, LOCK_LEVEL_1), 0x0003_1D55);
+        assert_eq!(bdtr(85, true, 0b0011, LOCK_LEVEL_1), 0x0003_3D55);
+        let moe = 1 << 15;
+        let aoe = 1 << 14;
+        assert_eq!(bdtr(0xFF, true, 0xF, 0b11) & (moe | aoe), 0);
+    }
+
+    /// The trigger is one tick before the peak for low-side shunts, at zero otherwise.
+    #[test]
+    fn trigger_at_the_board_instant() {
+        assert_eq!(trigger_channel(true, 4250), (PWM_MODE_2, 4249));
+        assert_eq!(trigger_channel(false, 4250), (PWM_MODE_1, 1));
+    }
+
+    /// As delivered nSWBOOT0 = nBOOT0 = 1 (RM0440 §3.4.1, boot configuration): the PB8
+    /// level decides; with nSWBOOT0 cleared and nBOOT0 set the pin is ignored.
+    #[test]
+    fn option_bytes_boot_source() {
+        let factory = OPTR_NSWBOOT0 | OPTR_NBOOT0 | 0x0000_00AA;
+        assert!(!boots_from_flash_regardless_of_pb8(factory));
+        assert!(boots_from_flash_regardless_of_pb8(factory & !OPTR_NSWBOOT0));
+        assert!(!boots_from_flash_regardless_of_pb8(
+            factory & !OPTR_NSWBOOT0 & !OPTR_NBOOT0
+        ));
+    }
+}
