@@ -38,6 +38,7 @@ fn every_motor_designs_and_has_the_json_contract() {
     for (stem, rel, text) in all {
         let d = codegen::design_source(&rel, &text).unwrap_or_else(|e| panic!("{stem}: {e}"));
         let v = serde_json::to_value(&d).unwrap();
+        assert_eq!(v["schema_version"], 1, "{stem}: the JSON form's version");
         for p in FLOAT_PATHS {
             f(&v, p);
         }

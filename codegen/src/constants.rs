@@ -21,11 +21,12 @@ pub struct Value {
     pub rust_type: String,
     /// Rust const expression.
     pub rust_expr: String,
-    /// C type, e.g. `float`, `int32_t`.
+    /// C type, e.g. `float`, `int32_t` (of the elements, for an array).
     pub c_type: String,
-    /// C array suffix (`[21]`) or empty.
-    pub c_array: String,
-    /// C initialiser.
+    /// Number of elements of an array constant; `None` for a scalar.
+    pub c_len: Option<usize>,
+    /// C initialiser; for an integer scalar an integer constant expression (`INT32_C(…)`),
+    /// which the header `#define`s so that it works in `#if`, `case` labels and array sizes.
     pub c_expr: String,
     /// The value as JSON-able number(s) for tests: integers are exact, floats are the f32 value.
     pub number: serde_json::Value,
@@ -117,24 +118,40 @@ fn f32v(x: f64) -> Value {
         rust_type: "f32".into(),
         rust_expr,
         c_type: "float".into(),
-        c_array: String::new(),
+        c_len: None,
         c_expr: c,
         number: serde_json::json!(x as f32),
     }
 }
 
-fn intv(x: i64, rust: &str, c: &str) -> Value {
-    let c_expr = if rust == "i32" && x == i64::from(i32::MIN) {
-        "INT32_MIN".to_string()
-    } else {
-        x.to_string()
+/// `x` as a C integer constant expression of the `<stdint.h>` type `c` (`int32_t`,
+/// `uint8_t`, …): the type's constant macro (`INT32_C(5)`, C99 §7.18.4), whose argument
+/// must be an unsigned literal, so a negative value is `(-INT32_C(5))` and the type's
+/// minimum is its named limit (`INT32_MIN`).
+fn c_integer(x: i64, c: &str) -> String {
+    let stem = c.strip_suffix("_t").unwrap_or(c).to_uppercase();
+    let min = match c {
+        "int8_t" => i64::from(i8::MIN),
+        "int16_t" => i64::from(i16::MIN),
+        "int32_t" => i64::from(i32::MIN),
+        _ => i64::MIN,
     };
+    if x == min {
+        format!("{stem}_MIN")
+    } else if x < 0 {
+        format!("(-{stem}_C({}))", x.unsigned_abs())
+    } else {
+        format!("{stem}_C({x})")
+    }
+}
+
+fn intv(x: i64, rust: &str, c: &str) -> Value {
     Value {
         rust_type: rust.into(),
         rust_expr: x.to_string(),
         c_type: c.into(),
-        c_array: String::new(),
-        c_expr,
+        c_len: None,
+        c_expr: c_integer(x, c),
         number: serde_json::json!(x),
     }
 }
@@ -144,8 +161,8 @@ fn q31v(bits: i32) -> Value {
         rust_type: "::fixed::types::I1F31".into(),
         rust_expr: format!("::fixed::types::I1F31::from_bits({bits})"),
         c_type: "int32_t".into(),
-        c_array: String::new(),
-        c_expr: bits.to_string(),
+        c_len: None,
+        c_expr: c_integer(i64::from(bits), "int32_t"),
         number: serde_json::json!(bits),
     }
 }
@@ -156,7 +173,7 @@ fn u8_array(v: &[u8]) -> Value {
         rust_type: format!("[u8; {}]", v.len()),
         rust_expr: format!("[{list}]"),
         c_type: "uint8_t".into(),
-        c_array: format!("[{}]", v.len()),
+        c_len: Some(v.len()),
         c_expr: format!("{{{list}}}"),
         number: serde_json::json!(v),
     }
@@ -168,7 +185,7 @@ fn i16_array(v: &[i16]) -> Value {
         rust_type: format!("[i16; {}]", v.len()),
         rust_expr: format!("[{list}]"),
         c_type: "int16_t".into(),
-        c_array: format!("[{}]", v.len()),
+        c_len: Some(v.len()),
         c_expr: format!("{{{list}}}"),
         number: serde_json::json!(v),
     }
@@ -336,19 +353,20 @@ pub fn constants(d: &Design) -> Vec<Group> {
             )
             .at(j("anti_windup_gain")),
         );
-        if let Some(p) = &g.prefilter {
-            current.push(
-                c(
-                    format!("{axis}_PREFILTER"),
-                    f32v(p.discrete_coefficient),
-                    phys(p.discrete_coefficient, ""),
-                    "a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y)",
-                    "thesis A (5.16)",
-                    format!("{ins}, {fs_in}"),
-                )
-                .at(j("prefilter/discrete_coefficient")),
-            );
-        }
+        current.push(
+            c(
+                format!("{axis}_PREFILTER"),
+                f32v(g.reference_filter),
+                phys(g.reference_filter, ""),
+                match g.prefilter {
+                    Some(_) => "a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y)",
+                    None => "y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel",
+                },
+                "thesis A (5.16)",
+                format!("{ins}, {fs_in}"),
+            )
+            .at(j("reference_filter")),
+        );
     }
     let ff = &cl.feedforward;
     current.push(
@@ -712,5 +730,18 @@ mod tests {
         // A value one f32 ulp off π is an ordinary literal.
         assert_eq!(f32v(f64::from(f32::from_bits(0x4049_0FDC))).rust_expr, "3.141593");
         assert_eq!(f32v(3.0).rust_expr, "3.0");
+    }
+
+    /// Integer scalars are C integer constant expressions (C99 §7.18.4.1): the stdint
+    /// macro takes an unsigned literal, the minimum is the named limit.
+    #[test]
+    fn c_integers_are_constant_expressions() {
+        assert_eq!(intv(5, "u32", "uint32_t").c_expr, "UINT32_C(5)");
+        assert_eq!(intv(-7, "i32", "int32_t").c_expr, "(-INT32_C(7))");
+        assert_eq!(intv(i64::from(i32::MIN), "i32", "int32_t").c_expr, "INT32_MIN");
+        assert_eq!(q31v(i32::MIN).c_expr, "INT32_MIN");
+        assert_eq!(q31v(1 << 30).c_expr, "INT32_C(1073741824)");
+        assert_eq!(intv(12, "u8", "uint8_t").c_expr, "UINT8_C(12)");
+        assert_eq!(i16_array(&[1, -2]).c_len, Some(2));
     }
 }

@@ -1,15 +1,17 @@
 //! `codegen`: a motor description (TOML) in, every tuned controller constant out.
 //!
-//! The library does no file I/O: [`design_source`] takes the file's name and
-//! text and returns the [`Design`] or located [`Diagnostics`]. The `motorgen`
-//! CLI, the firmware's build script and the proc-macros all call it, so a
-//! constant cannot differ between the three paths.
+//! The design path does no file I/O: [`design_source`] takes the file's name and
+//! text and returns the [`Design`] or located [`Diagnostics`]. The `motorgen` CLI, the
+//! firmware's build script and the proc-macros all call it, so a constant cannot differ
+//! between the three paths. ([`files`] holds the one helper the CLI and the build
+//! scripts share to write generated files.)
 
 pub mod board;
 pub mod constants;
 pub mod design;
 pub mod diagnostic;
 pub mod escape;
+pub mod files;
 #[cfg(feature = "identify")]
 pub mod identify;
 pub mod render;

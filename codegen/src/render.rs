@@ -138,6 +138,33 @@ fn render_error(e: &minijinja::Error, fallback: &str) -> RenderError {
     }
 }
 
+/// The C identifier prefix of a motor: its spec file's stem in upper case with every
+/// character other than a letter or digit replaced by `_` (`motors/fischer-ti085.toml`
+/// → `FISCHER_TI085`), `MOTOR_` in front if it would start with a digit. The C header
+/// prefixes its include guard and every name with it, so the headers of two motors can
+/// be included in one translation unit.
+pub fn c_prefix(spec_file: &str) -> String {
+    let stem = std::path::Path::new(spec_file)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let id: String = stem
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_uppercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    match id.chars().next() {
+        None => "MOTOR".into(),
+        Some(c) if c.is_ascii_digit() => format!("MOTOR_{id}"),
+        Some(_) => id,
+    }
+}
+
 /// Renders `source` (named `name` for messages) for the design `d`.
 pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, RenderError> {
     let mut env = Environment::new();
@@ -165,6 +192,7 @@ pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, Rende
     tmpl.render(context! {
         spec_file => d.spec_file.clone(),
         name => d.name.clone(),
+        c_prefix => c_prefix(&d.spec_file),
         groups => Value::from(Serde(&groups)),
         design => Value::from(Serde(d)),
     })
@@ -187,4 +215,18 @@ pub fn new_spec(stem: &str) -> Result<String, RenderError> {
 /// Renders one output with the built-in template.
 pub fn render(d: &Design, out: Output) -> Result<String, RenderError> {
     render_with(d, out.template(), out.builtin())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::c_prefix;
+
+    #[test]
+    fn c_prefixes_are_identifiers() {
+        assert_eq!(c_prefix("motors/fischer-ti085.toml"), "FISCHER_TI085");
+        assert_eq!(c_prefix("chalmers-hev50.toml"), "CHALMERS_HEV50");
+        assert_eq!(c_prefix("/x/142umd.toml"), "MOTOR_142UMD");
+        assert_eq!(c_prefix("my motor (v2).toml"), "MY_MOTOR__V2_");
+        assert_eq!(c_prefix(""), "MOTOR");
+    }
 }

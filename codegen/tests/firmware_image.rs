@@ -1,7 +1,8 @@
 //! `motorgen firmware` as a user runs it: the fischer-ti085 image is built into
-//! `target/firmware/`, is a valid STM32G474 flash image and fits in 64 KiB; an unknown
-//! stem and a bad spec are refused before anything is built or written; `--all` builds
-//! every motor on the default board and on the NUCLEO-G474RE + X-NUCLEO-IHM08M1 board.
+//! `target/firmware/` with cargo's progress on stderr, is a valid STM32G474 flash image
+//! and fits in 64 KiB; an unknown stem and a bad spec are refused (exit 1) before
+//! anything is built or written; `--all` builds every motor on the default board and on
+//! the NUCLEO-G474RE + X-NUCLEO-IHM08M1 board.
 //!
 //! The image builds in the firmware workspace's own target directory, `firmware/target`,
 //! where `motorgen firmware` builds it for a user and where `tests/firmware.rs` builds the
@@ -49,6 +50,13 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "motorgen firmware failed:\n{stdout}\n{stderr}");
     println!("{stdout}");
+    // cargo's progress is relayed on stderr as it comes: the command, then cargo's own
+    // lines, at least the closing "Finished" (also when nothing needs compiling).
+    assert!(
+        stderr.contains("fischer-ti085: MOTOR=fischer-ti085 BOARD=motorgen-reference cargo build --release")
+            && stderr.contains("Finished"),
+        "no build progress on stderr:\n{stderr}"
+    );
 
     // "fischer-ti085: flash <bytes> bytes (…)"
     let flash: usize = stdout

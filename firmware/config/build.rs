@@ -104,14 +104,13 @@ fn main() {
         Ok(c) => c,
         Err(e) => return fail(&e.to_string()),
     };
-    write_if_changed(&out_dir.join("motor.rs"), &code);
+    write(&out_dir.join("motor.rs"), &code);
 }
 
-/// Writes only when the bytes change, so an unchanged design causes no rebuild.
-fn write_if_changed(out: &Path, code: &str) {
-    if std::fs::read(out).ok().as_deref() != Some(code.as_bytes())
-        && let Err(e) = std::fs::write(out, code)
-    {
+/// Writes through codegen's [`codegen::files::write_if_changed`] (an unchanged design
+/// causes no rebuild); a failure fails the build with the path.
+fn write(out: &Path, code: &str) {
+    if let Err(e) = codegen::files::write_if_changed(out, code.as_bytes()) {
         fail(&format!("cannot write {}: {e}", out.display()));
     }
 }

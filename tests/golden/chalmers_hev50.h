@@ -3,10 +3,13 @@
  * Chalmers HEV 50 kW salient PMSM
  *
  * The same constants as the generated Rust module, bit for bit. Each carries its
- * physical value with unit, formula, source equation and input provenance.
+ * physical value with unit, formula, source equation and input provenance. Every name
+ * starts with CHALMERS_HEV50_, so the headers of several motors can share a translation
+ * unit. Integer constants are macros expanding to integer constant expressions (usable
+ * in #if, case labels and array sizes); each array has its length as NAME_LEN.
  */
-#ifndef MOTORGEN_MOTOR_CONSTANTS_H
-#define MOTORGEN_MOTOR_CONSTANTS_H
+#ifndef MOTORGEN_CHALMERS_HEV50_H
+#define MOTORGEN_CHALMERS_HEV50_H
 
 #include <stdint.h>
 
@@ -14,322 +17,335 @@
 
 /** 0.275619 V/A: k_p = α_c·L, thesis B (2.38), (2.39).
  *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_D_KP = 0.2756192f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_KP = 0.2756192f;
 
 /** 330.287 V/(A·s): k_i = α_c·(R + R_a), thesis B (2.38), (2.39).
  *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_D_KI = 330.2867f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_KI = 330.2867f;
 
 /** 0.0330287 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
  *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
-static const float CURRENT_LOOP_D_KI_TS = 0.033028673f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_KI_TS = 0.033028673f;
 
 /** 1198.34 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
  *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_D_KB = 1198.3444f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_KB = 1198.3444f;
 
 /** 0.267719 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
  *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_D_ACTIVE_DAMPING = 0.2677192f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_ACTIVE_DAMPING = 0.2677192f;
 
 /** 3.62819 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
  *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_D_ANTI_WINDUP = 3.628194f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_ANTI_WINDUP = 3.628194f;
+
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+static const float CHALMERS_HEV50_CURRENT_LOOP_D_PREFILTER = 1.0f;
 
 /** 0.671673 V/A: k_p = α_c·L, thesis B (2.38), (2.39).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_Q_KP = 0.6716734f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KP = 0.6716734f;
 
 /** 805.616 V/(A·s): k_i = α_c·(R + R_a), thesis B (2.38), (2.39).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_Q_KI = 805.61646f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KI = 805.61646f;
 
 /** 0.0805616 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
-static const float CURRENT_LOOP_Q_KI_TS = 0.080561645f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KI_TS = 0.080561645f;
 
 /** 1199.42 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_Q_KB = 1199.4169f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KB = 1199.4169f;
 
 /** 0.663773 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.6637734f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.6637734f;
 
 /** 1.48882 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
  *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
-static const float CURRENT_LOOP_Q_ANTI_WINDUP = 1.4888188f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_ANTI_WINDUP = 1.4888188f;
+
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+static const float CHALMERS_HEV50_CURRENT_LOOP_Q_PREFILTER = 1.0f;
 
 /** 0.00023 H: L_d in u_q,ff = ω_e(L_d·i_d + ψ_M), thesis A (5.3).
  *  Inputs: L_d = 0.00023 H (datasheet). */
-static const float CURRENT_LOOP_FF_LD = 0.00023f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_FF_LD = 0.00023f;
 
 /** 0.00056 H: L_q in u_d,ff = −ω_e·L_q·i_q, thesis A (5.3).
  *  Inputs: L_q = 0.00056 H (datasheet). */
-static const float CURRENT_LOOP_FF_LQ = 0.00056f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_FF_LQ = 0.00056f;
 
 /** 0.104 Wb: ψ_M in the back-EMF term ω_e·ψ_M, thesis A (5.3).
  *  Inputs: ψ_M = 0.104 Wb (datasheet). */
-static const float CURRENT_LOOP_FF_PSI = 0.104f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_FF_PSI = 0.104f;
 
 /** 3.20513 A/(N·m): 1/K_t, K_t = 3/2·n_p·ψ_M (0 if ψ_M unknown), thesis A (2.34).
  *  Inputs: n_p = 2 (datasheet), ψ_M = 0.104 Wb (datasheet). */
-static const float CURRENT_LOOP_IQ_PER_NM = 3.2051282f;
+static const float CHALMERS_HEV50_CURRENT_LOOP_IQ_PER_NM = 3.2051282f;
 
 /* Angle tracking observer (Q1.31) and resolver → electrical angle. */
 
 /** 0.00445634: K̃_p = 2ζω_n/(f_s·π), Q1.31, thesis A (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 10000 Hz (spec). */
-static const int32_t OBSERVER_KP = 9569914;
+#define CHALMERS_HEV50_OBSERVER_KP INT32_C(9569914)
 
 /** 0.0000155972: K̃_i = ω_n²/(f_s²·π), Q1.31, thesis A (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 10000 Hz (spec). */
-static const int32_t OBSERVER_KI = 33495;
+#define CHALMERS_HEV50_OBSERVER_KI INT32_C(33495)
 
 /** 2: n_p, thesis A (4.5).
  *  Inputs: n_p (datasheet). */
-static const uint32_t OBSERVER_MOTOR_POLE_PAIRS = 2;
+#define CHALMERS_HEV50_OBSERVER_MOTOR_POLE_PAIRS UINT32_C(2)
 
 /** 1: n_r, thesis A (4.5).
  *  Inputs: n_r (spec [resolver]). */
-static const uint32_t OBSERVER_RESOLVER_POLE_PAIRS = 1;
+#define CHALMERS_HEV50_OBSERVER_RESOLVER_POLE_PAIRS UINT32_C(1)
 
 /** 1.5 samples: k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16, thesis A (4.19), (4.23).
  *  Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6). */
-static const int32_t OBSERVER_LEAD_Q16 = 98304;
+#define CHALMERS_HEV50_OBSERVER_LEAD_Q16 INT32_C(98304)
 
 /** 0 rad = 0°: θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9)), thesis A (4.5), (6.9).
  *  Inputs: θ_off not in the spec: 0. */
-static const int32_t OBSERVER_RESOLVER_OFFSET = 0;
+#define CHALMERS_HEV50_OBSERVER_RESOLVER_OFFSET INT32_C(0)
 
 /** 0: trig identity: error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π, thesis A (4.8)–(4.10), (4.22).
  *  Inputs: angle_observer.error (spec). */
-static const uint8_t OBSERVER_ERROR_FORM = 0;
+#define CHALMERS_HEV50_OBSERVER_ERROR_FORM UINT8_C(0)
 
 /* Per-unit fixed-point scalings (full scale A and SI per LSB). */
 
 /** 395.98 A: A of phase current: margin·√2·I_peak,rms = 1.25·√2·224 A, thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.15 (spec). */
-static const float SCALING_CURRENT_FULL_SCALE = 395.9798f;
+static const float CHALMERS_HEV50_SCALING_CURRENT_FULL_SCALE = 395.9798f;
 
 /** 0.0120843 A: A/2^15 (Q1.15), thesis A (4.16).
  *  Inputs: A = 395.98 A. */
-static const float SCALING_CURRENT_PER_LSB = 0.012084344f;
+static const float CHALMERS_HEV50_SCALING_CURRENT_PER_LSB = 0.012084344f;
 
 /** 230.94 V: A of phase voltage: margin·U_dc/√3 = 1.25·320 V/√3 (THPWM phase amplitude limit), thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.15 (spec). */
-static const float SCALING_VOLTAGE_FULL_SCALE = 230.94011f;
+static const float CHALMERS_HEV50_SCALING_VOLTAGE_FULL_SCALE = 230.94011f;
 
 /** 0.00704773 V: A/2^15 (Q1.15), thesis A (4.16).
  *  Inputs: A = 230.94 V. */
-static const float SCALING_VOLTAGE_PER_LSB = 0.007047733f;
+static const float CHALMERS_HEV50_SCALING_VOLTAGE_PER_LSB = 0.007047733f;
 
 /** 400 V: A of DC-link voltage: margin·U_dc = 1.25·320 V, thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.15 (spec). */
-static const float SCALING_DC_LINK_FULL_SCALE = 400.0f;
+static const float CHALMERS_HEV50_SCALING_DC_LINK_FULL_SCALE = 400.0f;
 
 /** 0.012207 V: A/2^15 (Q1.15), thesis A (4.16).
  *  Inputs: A = 400 V. */
-static const float SCALING_DC_LINK_PER_LSB = 0.012207031f;
+static const float CHALMERS_HEV50_SCALING_DC_LINK_PER_LSB = 0.012207031f;
 
 /** 3.14159 rad: A of angle: A = π, dictated by the CORDIC interface (4.20), thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.31 (spec). */
-static const float SCALING_ANGLE_FULL_SCALE = 3.1415927f;
+static const float CHALMERS_HEV50_SCALING_ANGLE_FULL_SCALE = 3.1415927f;
 
 /** 1.46292e-9 rad: A/2^31 (Q1.31), thesis A (4.16).
  *  Inputs: A = 3.14159 rad. */
-static const float SCALING_ANGLE_PER_LSB = 1.4629181e-9f;
+static const float CHALMERS_HEV50_SCALING_ANGLE_PER_LSB = 1.4629181e-9f;
 
 /** 31415.9 rad/s: A of observer speed: A = f_s·π so that θ^i(n) = θ^i(n−1) + ω^i(n−1) (4.19), (4.20), thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.31 (spec). */
-static const float SCALING_SPEED_FULL_SCALE = 31415.926f;
+static const float CHALMERS_HEV50_SCALING_SPEED_FULL_SCALE = 31415.926f;
 
 /** 0.0000146292 rad/s: A/2^31 (Q1.31), thesis A (4.16).
  *  Inputs: A = 31415.9 rad/s. */
-static const float SCALING_SPEED_PER_LSB = 1.462918e-5f;
+static const float CHALMERS_HEV50_SCALING_SPEED_PER_LSB = 1.462918e-5f;
 
 /** 1 1: A of observer error: A = 1 (4.20); atan2 error normalised by π, thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.31 (spec). */
-static const float SCALING_OBSERVER_ERROR_FULL_SCALE = 1.0f;
+static const float CHALMERS_HEV50_SCALING_OBSERVER_ERROR_FULL_SCALE = 1.0f;
 
 /** 4.65661e-10 1: A/2^31 (Q1.31), thesis A (4.16).
  *  Inputs: A = 1 1. */
-static const float SCALING_OBSERVER_ERROR_PER_LSB = 4.656613e-10f;
+static const float CHALMERS_HEV50_SCALING_OBSERVER_ERROR_PER_LSB = 4.656613e-10f;
 
 /* Identification FIR low-pass for the FMAC. */
 
 /** 21 taps, Σ = 32768 (DC gain 1): equiripple low-pass (Parks–McClellan), Q1.15, symmetric, thesis A §6.2.
  *  Inputs: order 20, pass band 0–100 Hz with ripple ≤ 0.001, stop band 2000 Hz–f_s/2, f_s = 10000 Hz (spec); achieved (Q1.15): ripple 9.90e-4, attenuation 75.9 dB. */
-static const int16_t FILTER_TAPS_Q15[21] = {-25, -106, -255, -404, -377, 73, 1120, 2713, 4498, 5917, 6460, 5917, 4498, 2713, 1120, 73, -377, -404, -255, -106, -25};
+#define CHALMERS_HEV50_FILTER_TAPS_Q15_LEN 21
+static const int16_t CHALMERS_HEV50_FILTER_TAPS_Q15[CHALMERS_HEV50_FILTER_TAPS_Q15_LEN] = {-25, -106, -255, -404, -377, 73, 1120, 2713, 4498, 5917, 6460, 5917, 4498, 2713, 1120, 73, -377, -404, -255, -106, -25};
 
 /** 20: N − 1, thesis A §6.2.
  *  Inputs: order 20, pass band 0–100 Hz with ripple ≤ 0.001, stop band 2000 Hz–f_s/2, f_s = 10000 Hz (spec); achieved (Q1.15): ripple 9.90e-4, attenuation 75.9 dB. */
-static const uint32_t FILTER_ORDER = 20;
+#define CHALMERS_HEV50_FILTER_ORDER UINT32_C(20)
 
 /** 10 samples: order/2 (linear phase), thesis A §6.2.
  *  Inputs: order 20, pass band 0–100 Hz with ripple ≤ 0.001, stop band 2000 Hz–f_s/2, f_s = 10000 Hz (spec); achieved (Q1.15): ripple 9.90e-4, attenuation 75.9 dB. */
-static const float FILTER_GROUP_DELAY_SAMPLES = 10.0f;
+static const float CHALMERS_HEV50_FILTER_GROUP_DELAY_SAMPLES = 10.0f;
 
 /* Sampling, voltage and current limits, modulator and ADC. */
 
 /** 10000 Hz: f_s = sampling frequency, thesis A (1.1).
  *  Inputs: f_s = 10000 Hz (spec). */
-static const float LIMITS_SWITCHING_FREQUENCY_HZ = 10000.0f;
+static const float CHALMERS_HEV50_LIMITS_SWITCHING_FREQUENCY_HZ = 10000.0f;
 
 /** 0.0001 s: T_s = 1/f_s, thesis A (4.17).
  *  Inputs: f_s = 10000 Hz (spec). */
-static const float LIMITS_SAMPLE_PERIOD_S = 0.0001f;
+static const float CHALMERS_HEV50_LIMITS_SAMPLE_PERIOD_S = 0.0001f;
 
 /** 184.752 V: U_dc/√3 (voltage circle), thesis B (2.50).
  *  Inputs: U_dc = 320 V (spec). */
-static const float LIMITS_VOLTAGE_LIMIT_V = 184.75209f;
+static const float CHALMERS_HEV50_LIMITS_VOLTAGE_LIMIT_V = 184.75209f;
 
 /** 320 V: lowest U_dc for the 1/U_dc feed-forward (5.1), thesis A (5.1).
  *  Inputs: spec. */
-static const float LIMITS_DC_LINK_MIN_V = 320.0f;
+static const float CHALMERS_HEV50_LIMITS_DC_LINK_MIN_V = 320.0f;
 
 /** 0.096225: u_NM/U_dc amplitude 1/(6√3), thesis A (3.7).
  *  Inputs: —. */
-static const float LIMITS_THPWM_COMMON_MODE = 0.096225046f;
+static const float CHALMERS_HEV50_LIMITS_THPWM_COMMON_MODE = 0.096225046f;
 
 /** 316.784 A: √2·I_peak,rms (current-circle radius), thesis B (2.51).
  *  Inputs: I_peak = 224 A rms (datasheet). */
-static const float LIMITS_PEAK_CURRENT_A = 316.78384f;
+static const float CHALMERS_HEV50_LIMITS_PEAK_CURRENT_A = 316.78384f;
 
 /** 2513.27 rad/s: ω_e,max = n_p·ω_m,max, thesis A (2.19).
  *  Inputs: n_max (datasheet). */
-static const float LIMITS_MAX_ELECTRICAL_SPEED = 2513.2742f;
+static const float CHALMERS_HEV50_LIMITS_MAX_ELECTRICAL_SPEED = 2513.2742f;
 
 /** 9: ⌈−ln 2^−N⌉, thesis A (7.4).
  *  Inputs: N = 12 bits. */
-static const uint32_t LIMITS_ADC_SETTLING_TIME_CONSTANTS = 9;
+#define CHALMERS_HEV50_LIMITS_ADC_SETTLING_TIME_CONSTANTS UINT32_C(9)
 
 /* Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3). */
 
 /** 0.9: V'_max/V_max (spec field_weakening.voltage_fraction, default 0.9 of thesis B Fig. 2.15), thesis B (2.55), Fig. 2.15.
  *  Inputs: V'_max/V_max = 0.9. */
-static const float FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
 
 /** 166.277 V: V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
  *  Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 184.752 V (U_dc = 320 V, spec). */
-static const float FIELD_WEAKENING_VOLTAGE_LIMIT_V = 166.27687f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_VOLTAGE_LIMIT_V = 166.27687f;
 
 /** 147 rad/s: α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c, thesis B (2.60), §2.3.3.
  *  Inputs: α_fw = 10·α_s, α_s = α_c/100 = 14.7 rad/s (no speed loop or J, b in the spec: thesis B Fig. 2.15), α_c = 1470 rad/s. */
-static const float FIELD_WEAKENING_BANDWIDTH = 147.0f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_BANDWIDTH = 147.0f;
 
 /** 1256.64 rad/s: ω_base (electrical): ω_fw = max(ω_base, |ω_r|), thesis B (2.60).
  *  Inputs: ω_base = 2π·f_n (per-unit base, thesis B App. A). */
-static const float FIELD_WEAKENING_BASE_SPEED = 1256.6371f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_BASE_SPEED = 1256.6371f;
 
 /** 0.00023 H: L̂_d in γ = α_fw/(2·ω_fw·L̂_d·V'_max), thesis B (2.60).
  *  Inputs: L_d = 0.00023 H. */
-static const float FIELD_WEAKENING_LD = 0.00023f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_LD = 0.00023f;
 
 /** 1.52939 A/(V²·s): γ = α_fw/(2·ω_base·L̂_d·V'_max) at ω_fw = ω_base and the nominal V'_max, thesis B (2.60).
  *  Inputs: α_fw, ω_base, L̂_d, V'_max above. */
-static const float FIELD_WEAKENING_GAIN_AT_BASE_SPEED = 1.5293883f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_GAIN_AT_BASE_SPEED = 1.5293883f;
 
 /** 316.784 A: I_max: current circle, −I_max ≤ i_d^ref, i_q^ref = √(I_max² − (i_d^ref)²) in Mode B, thesis B (2.50), (2.56), (2.57).
  *  Inputs: I_max = √2·I_peak,rms = √2·224 A. */
-static const float FIELD_WEAKENING_CURRENT_MAX_A = 316.78384f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_CURRENT_MAX_A = 316.78384f;
 
 /** -316.784 A: −I_max, lower limit of i_d^ref (demagnetisation), thesis B (2.56).
  *  Inputs: I_max = √2·I_peak,rms = √2·224 A. */
-static const float FIELD_WEAKENING_ID_MIN_A = -316.78384f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_ID_MIN_A = -316.78384f;
 
 /** -158.664 A: upper limit of i_d^ref at full current: i_d = −2ΔL·I²/(ψ_M + √(ψ_M² + 8ΔL²·I²)), (3.10) on |i| = I_max, thesis B (2.56), (3.10).
  *  Inputs: I_max = √2·I_peak,rms = √2·224 A, ΔL = L_q − L_d. */
-static const float FIELD_WEAKENING_ID_MTPA_AT_CURRENT_MAX_A = -158.66429f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_ID_MTPA_AT_CURRENT_MAX_A = -158.66429f;
 
 /** 274.185 A: √(I_max² − i_d²) at the MTPA point on the circle: Mode B limits |i_q^ref| below this, thesis B (2.57).
  *  Inputs: I_max = √2·I_peak,rms = √2·224 A. */
-static const float FIELD_WEAKENING_IQ_MODE_B_START_A = 274.18542f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_IQ_MODE_B_START_A = 274.18542f;
 
 /** 17 points, 0 … 274.185 A: uniform |i_q| grid of the MTPA table, thesis B (3.10).
  *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10). */
-static const float FIELD_WEAKENING_MTPA_IQ_A[17] = {0.0f, 17.13659f, 34.27318f, 51.409767f, 68.54636f, 85.682945f, 102.819534f, 119.95612f, 137.09271f, 154.2293f, 171.36589f, 188.50247f, 205.63907f, 222.77565f, 239.91225f, 257.04883f, 274.18542f};
+#define CHALMERS_HEV50_FIELD_WEAKENING_MTPA_IQ_A_LEN 17
+static const float CHALMERS_HEV50_FIELD_WEAKENING_MTPA_IQ_A[CHALMERS_HEV50_FIELD_WEAKENING_MTPA_IQ_A_LEN] = {0.0f, 17.13659f, 34.27318f, 51.409767f, 68.54636f, 85.682945f, 102.819534f, 119.95612f, 137.09271f, 154.2293f, 171.36589f, 188.50247f, 205.63907f, 222.77565f, 239.91225f, 257.04883f, 274.18542f};
 
 /** 0 A … -158.664 A: i_d,MTPA = ψ_M/(2ΔL) − √((ψ_M/(2ΔL))² + i_q²), ΔL = L_q − L_d, thesis B (3.10), (2.56).
  *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10). */
-static const float FIELD_WEAKENING_MTPA_ID_A[17] = {0.0f, -0.9290753f, -3.6841881f, -8.174306f, -14.263476f, -21.788916f, -30.57837f, -40.463608f, -51.289104f, -62.91641f, -75.22542f, -88.113686f, -101.49478f, -115.29621f, -129.45735f, -143.9275f, -158.66429f};
+#define CHALMERS_HEV50_FIELD_WEAKENING_MTPA_ID_A_LEN 17
+static const float CHALMERS_HEV50_FIELD_WEAKENING_MTPA_ID_A[CHALMERS_HEV50_FIELD_WEAKENING_MTPA_ID_A_LEN] = {0.0f, -0.9290753f, -3.6841881f, -8.174306f, -14.263476f, -21.788916f, -30.57837f, -40.463608f, -51.289104f, -62.91641f, -75.22542f, -88.113686f, -101.49478f, -115.29621f, -129.45735f, -143.9275f, -158.66429f};
 
 /** 0.231756 A: max |linear interpolation − (3.10)| at the grid midpoints, thesis B (3.10).
  *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10). */
-static const float FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.23175603f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.23175603f;
 
 /** 7 points, 0 … 1884.96 rad/s: uniform electrical-speed grid (rows of LOSS_MIN_ID_A), thesis B (3.8), (3.9).
  *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
-static const float FIELD_WEAKENING_LOSS_MIN_SPEED_RAD_S[7] = {0.0f, 314.15927f, 628.31854f, 942.4778f, 1256.6371f, 1570.7964f, 1884.9556f};
+#define CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_SPEED_RAD_S_LEN 7
+static const float CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_SPEED_RAD_S[CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_SPEED_RAD_S_LEN] = {0.0f, 314.15927f, 628.31854f, 942.4778f, 1256.6371f, 1570.7964f, 1884.9556f};
 
 /** -254.595 A … 0 A: i_d minimising P_res + P_co (+ P_loss,inv) at constant torque and speed, row-major [speed][MTPA_IQ_A], thesis B (3.3)–(3.9), (3.14), (C.3).
  *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
-static const float FIELD_WEAKENING_LOSS_MIN_ID_A[119] = {0.0f, -0.929075f, -3.684188f, -8.174305f, -14.263476f, -21.788916f, -30.578367f, -40.463604f, -51.2891f, -62.916405f, -75.22542f, -88.113686f, -101.49478f, -115.2962f, -129.45735f, -143.9275f, -158.66429f, 0.0f, -1.326426f, -4.468582f, -9.360402f, -15.883373f, -23.88512f, -33.19804f, -43.654385f, -55.09647f, -67.382225f, -80.38732f, -94.00501f, -108.14479f, -122.73048f, -137.69812f, -152.9942f, -158.66429f, 0.0f, -2.56724f, -6.903425f, -13.005556f, -20.798843f, -30.157042f, -40.924397f, -52.9348f, -66.025734f, -80.046776f, -94.86387f, -110.36038f, -126.43656f, -143.00792f, -160.00325f, -177.36281f, -158.66429f, 0.0f, -4.717815f, -11.103147f, -19.256144f, -29.169863f, -40.755287f, -53.8703f, -68.346535f, -84.0101f, -100.695335f, -118.2522f, -136.54933f, -155.47415f, -174.93149f, -194.84154f, -185.14291f, -158.66429f, 0.0f, -8.05936f, -17.52445f, -28.672186f, -41.596275f, -56.254505f, -72.51638f, -90.20559f, -109.13215f, -129.113f, -149.983f, -171.59901f, -193.84001f, -216.60527f, -206.86739f, -185.14291f, -158.66429f, 0.0f, -13.56896f, -27.531277f, -42.716885f, -59.454967f, -77.80308f, -97.66872f, -118.887764f, -141.27411f, -164.64755f, -188.84697f, -213.7345f, -239.19516f, -225.2177f, -206.86739f, -185.14291f, -158.66429f, 0.0f, -25.101364f, -44.7499f, -64.274216f, -84.767494f, -106.543755f, -129.62163f, -153.89627f, -179.21945f, -205.4383f, -232.41234f, -254.5954f, -240.96593f, -225.2177f, -206.86739f, -185.14291f, -158.66429f};
+#define CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_ID_A_LEN 119
+static const float CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_ID_A[CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_ID_A_LEN] = {0.0f, -0.929075f, -3.684188f, -8.174305f, -14.263476f, -21.788916f, -30.578367f, -40.463604f, -51.2891f, -62.916405f, -75.22542f, -88.113686f, -101.49478f, -115.2962f, -129.45735f, -143.9275f, -158.66429f, 0.0f, -1.326426f, -4.468582f, -9.360402f, -15.883373f, -23.88512f, -33.19804f, -43.654385f, -55.09647f, -67.382225f, -80.38732f, -94.00501f, -108.14479f, -122.73048f, -137.69812f, -152.9942f, -158.66429f, 0.0f, -2.56724f, -6.903425f, -13.005556f, -20.798843f, -30.157042f, -40.924397f, -52.9348f, -66.025734f, -80.046776f, -94.86387f, -110.36038f, -126.43656f, -143.00792f, -160.00325f, -177.36281f, -158.66429f, 0.0f, -4.717815f, -11.103147f, -19.256144f, -29.169863f, -40.755287f, -53.8703f, -68.346535f, -84.0101f, -100.695335f, -118.2522f, -136.54933f, -155.47415f, -174.93149f, -194.84154f, -185.14291f, -158.66429f, 0.0f, -8.05936f, -17.52445f, -28.672186f, -41.596275f, -56.254505f, -72.51638f, -90.20559f, -109.13215f, -129.113f, -149.983f, -171.59901f, -193.84001f, -216.60527f, -206.86739f, -185.14291f, -158.66429f, 0.0f, -13.56896f, -27.531277f, -42.716885f, -59.454967f, -77.80308f, -97.66872f, -118.887764f, -141.27411f, -164.64755f, -188.84697f, -213.7345f, -239.19516f, -225.2177f, -206.86739f, -185.14291f, -158.66429f, 0.0f, -25.101364f, -44.7499f, -64.274216f, -84.767494f, -106.543755f, -129.62163f, -153.89627f, -179.21945f, -205.4383f, -232.41234f, -254.5954f, -240.96593f, -225.2177f, -206.86739f, -185.14291f, -158.66429f};
 
 /** 10.8997 A: max |bilinear interpolation − numeric optimum| at cell centres and edge midpoints, thesis B (3.8), (3.9).
  *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
-static const float FIELD_WEAKENING_LOSS_MIN_MAX_INTERPOLATION_ERROR_A = 10.899656f;
+static const float CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_MAX_INTERPOLATION_ERROR_A = 10.899656f;
 
 /* Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4). */
 
 /** 147 rad/s: ρ: estimator bandwidth, ρ ≤ α_c/10, thesis B (4.74), Table 4.1.
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_RHO = 147.0f;
+static const float CHALMERS_HEV50_SENSORLESS_RHO = 147.0f;
 
 /** 21609 1/s²: γ1 = ρ², thesis B (4.7).
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_GAMMA1 = 21609.0f;
+static const float CHALMERS_HEV50_SENSORLESS_GAMMA1 = 21609.0f;
 
 /** 294 1/s: γ2 = 2ρ, thesis B (4.7).
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_GAMMA2 = 294.0f;
+static const float CHALMERS_HEV50_SENSORLESS_GAMMA2 = 294.0f;
 
 /** 3141.59 rad/s: ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10), thesis B (4.34).
  *  Inputs: 5α_c = 7350 rad/s, ω_sw/10 = 6283.19 rad/s. */
-static const float SENSORLESS_INJECTION_FREQUENCY = 3141.5928f;
+static const float CHALMERS_HEV50_SENSORLESS_INJECTION_FREQUENCY = 3141.5928f;
 
 /** 27.7451 V: V_e ≥ I_base·ω_e·L_d·L_q/(10·|ΔL|) (spec sensorless.injection_voltage, default the minimum), thesis B (4.35).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, minimum 27.7451 V. */
-static const float SENSORLESS_INJECTION_VOLTAGE = 27.74513f;
+static const float CHALMERS_HEV50_SENSORLESS_INJECTION_VOLTAGE = 27.74513f;
 
 /** 5.65685 A: K_e = V_e·ΔL/(4·ω_e·L_d·L_q), ΔL = L_q − L_d signed (negative for inverse saliency; e = e_si/(2K̂_e) (4.20) either way), thesis B (4.19).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb. */
-static const float SENSORLESS_INJECTION_GAIN = 5.656854f;
+static const float CHALMERS_HEV50_SENSORLESS_INJECTION_GAIN = 5.656854f;
 
 /** 18.8496 rad/s: ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base), thesis B §4.3, Table 4.1.
  *  Inputs: spec sensorless.highpass or the default. */
-static const float SENSORLESS_HIGHPASS = 18.849556f;
+static const float CHALMERS_HEV50_SENSORLESS_HIGHPASS = 18.849556f;
 
 /** 735 rad/s: ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ), thesis B Table 4.1.
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_LOWPASS = 735.0f;
+static const float CHALMERS_HEV50_SENSORLESS_LOWPASS = 735.0f;
 
 /** 246.269 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at the MTPA i_d (3.10) of I_base, thesis B (4.59), (4.69), Table 4.1.
  *  Inputs: ω_min1 = 246.269 rad/s, ω_min2 = 65.8568 rad/s (θ̃ = 10.0°, i_d = -99.5588 A), I_max = 316.784 A, I_base = 226.274 A. */
-static const float SENSORLESS_LOW_SPEED = 246.26897f;
+static const float CHALMERS_HEV50_SENSORLESS_LOW_SPEED = 246.26897f;
 
 /** 492.538 rad/s: ω_hs = 2·ω_ls, thesis B Table 4.1.
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_HIGH_SPEED = 492.53793f;
+static const float CHALMERS_HEV50_SENSORLESS_HIGH_SPEED = 492.53793f;
 
 /** 147 rad/s: Δω1 = ρ: γ0 = 0 below, thesis B (4.83), §4.6.
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_RESET_LOWER = 147.0f;
+static const float CHALMERS_HEV50_SENSORLESS_RESET_LOWER = 147.0f;
 
 /** 294 rad/s: Δω2 = 2ρ: γ0 = ρ above, thesis B (4.83), §4.6.
  *  Inputs: ρ = α_c/10, α_c = 1470 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_RESET_UPPER = 294.0f;
+static const float CHALMERS_HEV50_SENSORLESS_RESET_UPPER = 294.0f;
 
 /** 18.433 A: |i_q^ref| < ρ²·ψ_m/(γ0·ω_max·|ΔL|) with γ0 = ρ, while the resetting term acts (0: no limit needed), thesis B (4.92).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb, ω_max = 2513.27 rad/s. */
-static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 18.433037f;
+static const float CHALMERS_HEV50_SENSORLESS_IQ_LIMIT_RESETTING_A = 18.433037f;
 
 /** 315.152 A: |i_q| ≤ ψ_m/|ΔL|: no unwanted equilibria of the back-EMF estimator (0: no saliency), thesis B (4.66).
  *  Inputs: L_d = 0.00023 H, L_q = 0.00056 H, ψ_M = 0.104 Wb. */
-static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 315.15152f;
+static const float CHALMERS_HEV50_SENSORLESS_IQ_LIMIT_BIFURCATION_A = 315.15152f;
 
 /** 0.0079 Ω: R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI), thesis B (4.51).
  *  Inputs: phase resistance (spec). */
-static const float SENSORLESS_RS = 0.0079f;
+static const float CHALMERS_HEV50_SENSORLESS_RS = 0.0079f;
 
-#endif /* MOTORGEN_MOTOR_CONSTANTS_H */
+#endif /* MOTORGEN_CHALMERS_HEV50_H */

@@ -32,6 +32,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const D_ANTI_WINDUP: f32 = 3.628194;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    pub const D_PREFILTER: f32 = 1.0;
     /// 0.671673 V/A: `k_p = α_c·L`, thesis B (2.38), (2.39).
     ///
     /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
@@ -56,6 +60,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
     pub const Q_ANTI_WINDUP: f32 = 1.4888188;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    pub const Q_PREFILTER: f32 = 1.0;
     /// 0.00023 H: `L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)`, thesis A (5.3).
     ///
     /// Inputs: L_d = 0.00023 H (datasheet).

@@ -3,10 +3,13 @@
  * Fischer TI085-052-070-04B7S-07S04BE2
  *
  * The same constants as the generated Rust module, bit for bit. Each carries its
- * physical value with unit, formula, source equation and input provenance.
+ * physical value with unit, formula, source equation and input provenance. Every name
+ * starts with FISCHER_TI085_, so the headers of several motors can share a translation
+ * unit. Integer constants are macros expanding to integer constant expressions (usable
+ * in #if, case labels and array sizes); each array has its length as NAME_LEN.
  */
-#ifndef MOTORGEN_MOTOR_CONSTANTS_H
-#define MOTORGEN_MOTOR_CONSTANTS_H
+#ifndef MOTORGEN_FISCHER_TI085_H
+#define MOTORGEN_FISCHER_TI085_H
 
 #include <stdint.h>
 
@@ -14,310 +17,321 @@
 
 /** 0.0393 V/A: K_p = K_a = L·α, thesis A (5.9), (5.7).
  *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_D_KP = 0.0393f;
+static const float FISCHER_TI085_CURRENT_LOOP_D_KP = 0.0393f;
 
 /** 12.6 V/(A·s): K_i = K_a·K_b = R·α, thesis A (5.9), (5.7).
  *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_D_KI = 12.6f;
+static const float FISCHER_TI085_CURRENT_LOOP_D_KI = 12.6f;
 
 /** 0.00063 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
  *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec). */
-static const float CURRENT_LOOP_D_KI_TS = 0.00063f;
+static const float FISCHER_TI085_CURRENT_LOOP_D_KI_TS = 0.00063f;
 
 /** 320.611 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
  *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_D_KB = 320.6107f;
+static const float FISCHER_TI085_CURRENT_LOOP_D_KB = 320.6107f;
 
 /** 0 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
  *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_D_ACTIVE_DAMPING = 0.0f;
+static const float FISCHER_TI085_CURRENT_LOOP_D_ACTIVE_DAMPING = 0.0f;
 
 /** 25.4453 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
  *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_D_ANTI_WINDUP = 25.445293f;
+static const float FISCHER_TI085_CURRENT_LOOP_D_ANTI_WINDUP = 25.445293f;
+
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec). */
+static const float FISCHER_TI085_CURRENT_LOOP_D_PREFILTER = 1.0f;
 
 /** 0.0393 V/A: K_p = K_a = L·α, thesis A (5.9), (5.7).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_Q_KP = 0.0393f;
+static const float FISCHER_TI085_CURRENT_LOOP_Q_KP = 0.0393f;
 
 /** 12.6 V/(A·s): K_i = K_a·K_b = R·α, thesis A (5.9), (5.7).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_Q_KI = 12.6f;
+static const float FISCHER_TI085_CURRENT_LOOP_Q_KI = 12.6f;
 
 /** 0.00063 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec). */
-static const float CURRENT_LOOP_Q_KI_TS = 0.00063f;
+static const float FISCHER_TI085_CURRENT_LOOP_Q_KI_TS = 0.00063f;
 
 /** 320.611 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_Q_KB = 320.6107f;
+static const float FISCHER_TI085_CURRENT_LOOP_Q_KB = 320.6107f;
 
 /** 0 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.0f;
+static const float FISCHER_TI085_CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.0f;
 
 /** 25.4453 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
  *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec). */
-static const float CURRENT_LOOP_Q_ANTI_WINDUP = 25.445293f;
+static const float FISCHER_TI085_CURRENT_LOOP_Q_ANTI_WINDUP = 25.445293f;
+
+/** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
+ *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec). */
+static const float FISCHER_TI085_CURRENT_LOOP_Q_PREFILTER = 1.0f;
 
 /** 0.000393 H: L_d in u_q,ff = ω_e(L_d·i_d + ψ_M), thesis A (5.3).
  *  Inputs: L_d = 0.000393 H (datasheet). */
-static const float CURRENT_LOOP_FF_LD = 0.000393f;
+static const float FISCHER_TI085_CURRENT_LOOP_FF_LD = 0.000393f;
 
 /** 0.000393 H: L_q in u_d,ff = −ω_e·L_q·i_q, thesis A (5.3).
  *  Inputs: L_q = 0.000393 H (datasheet). */
-static const float CURRENT_LOOP_FF_LQ = 0.000393f;
+static const float FISCHER_TI085_CURRENT_LOOP_FF_LQ = 0.000393f;
 
 /** 0.0604207 Wb: ψ_M in the back-EMF term ω_e·ψ_M, thesis A (5.3).
  *  Inputs: ψ_M = 0.0604207 Wb (derived). */
-static const float CURRENT_LOOP_FF_PSI = 0.060420748f;
+static const float FISCHER_TI085_CURRENT_LOOP_FF_PSI = 0.060420748f;
 
 /** 2.75843 A/(N·m): 1/K_t, K_t = 3/2·n_p·ψ_M (0 if ψ_M unknown), thesis A (2.34).
  *  Inputs: n_p = 4 (datasheet), ψ_M = 0.0604207 Wb (derived). */
-static const float CURRENT_LOOP_IQ_PER_NM = 2.7584343f;
+static const float FISCHER_TI085_CURRENT_LOOP_IQ_PER_NM = 2.7584343f;
 
 /* Angle tracking observer (Q1.31) and resolver → electrical angle. */
 
 /** 0.00222817: K̃_p = 2ζω_n/(f_s·π), Q1.31, thesis A (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec). */
-static const int32_t OBSERVER_KP = 4784957;
+#define FISCHER_TI085_OBSERVER_KP INT32_C(4784957)
 
 /** 0.0000038993: K̃_i = ω_n²/(f_s²·π), Q1.31, thesis A (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec). */
-static const int32_t OBSERVER_KI = 8374;
+#define FISCHER_TI085_OBSERVER_KI INT32_C(8374)
 
 /** 4: n_p, thesis A (4.5).
  *  Inputs: n_p (datasheet). */
-static const uint32_t OBSERVER_MOTOR_POLE_PAIRS = 4;
+#define FISCHER_TI085_OBSERVER_MOTOR_POLE_PAIRS UINT32_C(4)
 
 /** 1: n_r, thesis A (4.5).
  *  Inputs: n_r (spec [resolver]). */
-static const uint32_t OBSERVER_RESOLVER_POLE_PAIRS = 1;
+#define FISCHER_TI085_OBSERVER_RESOLVER_POLE_PAIRS UINT32_C(1)
 
 /** 1.5 samples: k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16, thesis A (4.19), (4.23).
  *  Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6). */
-static const int32_t OBSERVER_LEAD_Q16 = 98304;
+#define FISCHER_TI085_OBSERVER_LEAD_Q16 INT32_C(98304)
 
 /** 0 rad = 0°: θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9)), thesis A (4.5), (6.9).
  *  Inputs: θ_off not in the spec: 0. */
-static const int32_t OBSERVER_RESOLVER_OFFSET = 0;
+#define FISCHER_TI085_OBSERVER_RESOLVER_OFFSET INT32_C(0)
 
 /** 0: trig identity: error architecture KP/KI are scaled for: 0 = sin θ_r cos θ̂ − cos θ_r sin θ̂, 1 = atan2/π, thesis A (4.8)–(4.10), (4.22).
  *  Inputs: angle_observer.error (spec). */
-static const uint8_t OBSERVER_ERROR_FORM = 0;
+#define FISCHER_TI085_OBSERVER_ERROR_FORM UINT8_C(0)
 
 /* Per-unit fixed-point scalings (full scale A and SI per LSB). */
 
 /** 107.834 A: A of phase current: margin·√2·I_peak,rms = 1.25·√2·61 A, thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.15 (spec). */
-static const float SCALING_CURRENT_FULL_SCALE = 107.833786f;
+static const float FISCHER_TI085_SCALING_CURRENT_FULL_SCALE = 107.833786f;
 
 /** 0.00329083 A: A/2^15 (Q1.15), thesis A (4.16).
  *  Inputs: A = 107.834 A. */
-static const float SCALING_CURRENT_PER_LSB = 0.003290826f;
+static const float FISCHER_TI085_SCALING_CURRENT_PER_LSB = 0.003290826f;
 
 /** 433.013 V: A of phase voltage: margin·U_dc/√3 = 1.25·600 V/√3 (THPWM phase amplitude limit), thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.15 (spec). */
-static const float SCALING_VOLTAGE_FULL_SCALE = 433.0127f;
+static const float FISCHER_TI085_SCALING_VOLTAGE_FULL_SCALE = 433.0127f;
 
 /** 0.0132145 V: A/2^15 (Q1.15), thesis A (4.16).
  *  Inputs: A = 433.013 V. */
-static const float SCALING_VOLTAGE_PER_LSB = 0.013214499f;
+static const float FISCHER_TI085_SCALING_VOLTAGE_PER_LSB = 0.013214499f;
 
 /** 750 V: A of DC-link voltage: margin·U_dc = 1.25·600 V, thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.15 (spec). */
-static const float SCALING_DC_LINK_FULL_SCALE = 750.0f;
+static const float FISCHER_TI085_SCALING_DC_LINK_FULL_SCALE = 750.0f;
 
 /** 0.0228882 V: A/2^15 (Q1.15), thesis A (4.16).
  *  Inputs: A = 750 V. */
-static const float SCALING_DC_LINK_PER_LSB = 0.022888184f;
+static const float FISCHER_TI085_SCALING_DC_LINK_PER_LSB = 0.022888184f;
 
 /** 3.14159 rad: A of angle: A = π, dictated by the CORDIC interface (4.20), thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.31 (spec). */
-static const float SCALING_ANGLE_FULL_SCALE = 3.1415927f;
+static const float FISCHER_TI085_SCALING_ANGLE_FULL_SCALE = 3.1415927f;
 
 /** 1.46292e-9 rad: A/2^31 (Q1.31), thesis A (4.16).
  *  Inputs: A = 3.14159 rad. */
-static const float SCALING_ANGLE_PER_LSB = 1.4629181e-9f;
+static const float FISCHER_TI085_SCALING_ANGLE_PER_LSB = 1.4629181e-9f;
 
 /** 62831.9 rad/s: A of observer speed: A = f_s·π so that θ^i(n) = θ^i(n−1) + ω^i(n−1) (4.19), (4.20), thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.31 (spec). */
-static const float SCALING_SPEED_FULL_SCALE = 62831.85f;
+static const float FISCHER_TI085_SCALING_SPEED_FULL_SCALE = 62831.85f;
 
 /** 0.0000292584 rad/s: A/2^31 (Q1.31), thesis A (4.16).
  *  Inputs: A = 62831.9 rad/s. */
-static const float SCALING_SPEED_PER_LSB = 2.925836e-5f;
+static const float FISCHER_TI085_SCALING_SPEED_PER_LSB = 2.925836e-5f;
 
 /** 1 1: A of observer error: A = 1 (4.20); atan2 error normalised by π, thesis A (4.16), (4.20), Table 4.1.
  *  Inputs: Q1.31 (spec). */
-static const float SCALING_OBSERVER_ERROR_FULL_SCALE = 1.0f;
+static const float FISCHER_TI085_SCALING_OBSERVER_ERROR_FULL_SCALE = 1.0f;
 
 /** 4.65661e-10 1: A/2^31 (Q1.31), thesis A (4.16).
  *  Inputs: A = 1 1. */
-static const float SCALING_OBSERVER_ERROR_PER_LSB = 4.656613e-10f;
+static const float FISCHER_TI085_SCALING_OBSERVER_ERROR_PER_LSB = 4.656613e-10f;
 
 /* Identification FIR low-pass for the FMAC. */
 
 /** 21 taps, Σ = 32768 (DC gain 1): equiripple low-pass (Parks–McClellan), Q1.15, symmetric, thesis A §6.2.
  *  Inputs: order 20, pass band 0–100 Hz with ripple ≤ 0.001, stop band 2000 Hz–f_s/2, f_s = 20000 Hz (spec); achieved (Q1.15): ripple 9.89e-4, attenuation 27.8 dB. */
-static const int16_t FILTER_TAPS_Q15[21] = {-845, -327, -171, 182, 733, 1449, 2254, 3049, 3722, 4173, 4330, 4173, 3722, 3049, 2254, 1449, 733, 182, -171, -327, -845};
+#define FISCHER_TI085_FILTER_TAPS_Q15_LEN 21
+static const int16_t FISCHER_TI085_FILTER_TAPS_Q15[FISCHER_TI085_FILTER_TAPS_Q15_LEN] = {-845, -327, -171, 182, 733, 1449, 2254, 3049, 3722, 4173, 4330, 4173, 3722, 3049, 2254, 1449, 733, 182, -171, -327, -845};
 
 /** 20: N − 1, thesis A §6.2.
  *  Inputs: order 20, pass band 0–100 Hz with ripple ≤ 0.001, stop band 2000 Hz–f_s/2, f_s = 20000 Hz (spec); achieved (Q1.15): ripple 9.89e-4, attenuation 27.8 dB. */
-static const uint32_t FILTER_ORDER = 20;
+#define FISCHER_TI085_FILTER_ORDER UINT32_C(20)
 
 /** 10 samples: order/2 (linear phase), thesis A §6.2.
  *  Inputs: order 20, pass band 0–100 Hz with ripple ≤ 0.001, stop band 2000 Hz–f_s/2, f_s = 20000 Hz (spec); achieved (Q1.15): ripple 9.89e-4, attenuation 27.8 dB. */
-static const float FILTER_GROUP_DELAY_SAMPLES = 10.0f;
+static const float FISCHER_TI085_FILTER_GROUP_DELAY_SAMPLES = 10.0f;
 
 /* Sampling, voltage and current limits, modulator and ADC. */
 
 /** 20000 Hz: f_s = sampling frequency, thesis A (1.1).
  *  Inputs: f_s = 20000 Hz (spec). */
-static const float LIMITS_SWITCHING_FREQUENCY_HZ = 20000.0f;
+static const float FISCHER_TI085_LIMITS_SWITCHING_FREQUENCY_HZ = 20000.0f;
 
 /** 0.00005 s: T_s = 1/f_s, thesis A (4.17).
  *  Inputs: f_s = 20000 Hz (spec). */
-static const float LIMITS_SAMPLE_PERIOD_S = 5e-5f;
+static const float FISCHER_TI085_LIMITS_SAMPLE_PERIOD_S = 5e-5f;
 
 /** 346.41 V: U_dc/√3 (voltage circle), thesis B (2.50).
  *  Inputs: U_dc = 600 V (spec). */
-static const float LIMITS_VOLTAGE_LIMIT_V = 346.41016f;
+static const float FISCHER_TI085_LIMITS_VOLTAGE_LIMIT_V = 346.41016f;
 
 /** 432 V: lowest U_dc for the 1/U_dc feed-forward (5.1), thesis A (5.1).
  *  Inputs: spec. */
-static const float LIMITS_DC_LINK_MIN_V = 432.0f;
+static const float FISCHER_TI085_LIMITS_DC_LINK_MIN_V = 432.0f;
 
 /** 0.096225: u_NM/U_dc amplitude 1/(6√3), thesis A (3.7).
  *  Inputs: —. */
-static const float LIMITS_THPWM_COMMON_MODE = 0.096225046f;
+static const float FISCHER_TI085_LIMITS_THPWM_COMMON_MODE = 0.096225046f;
 
 /** 86.267 A: √2·I_peak,rms (current-circle radius), thesis B (2.51).
  *  Inputs: I_peak = 61 A rms (datasheet). */
-static const float LIMITS_PEAK_CURRENT_A = 86.26703f;
+static const float FISCHER_TI085_LIMITS_PEAK_CURRENT_A = 86.26703f;
 
 /** 8377.58 rad/s: ω_e,max = n_p·ω_m,max, thesis A (2.19).
  *  Inputs: n_max (datasheet). */
-static const float LIMITS_MAX_ELECTRICAL_SPEED = 8377.58f;
+static const float FISCHER_TI085_LIMITS_MAX_ELECTRICAL_SPEED = 8377.58f;
 
 /** 9: ⌈−ln 2^−N⌉, thesis A (7.4).
  *  Inputs: N = 12 bits. */
-static const uint32_t LIMITS_ADC_SETTLING_TIME_CONSTANTS = 9;
+#define FISCHER_TI085_LIMITS_ADC_SETTLING_TIME_CONSTANTS UINT32_C(9)
 
 /* Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3). */
 
 /** 0.9: V'_max/V_max (spec field_weakening.voltage_fraction, default 0.9 of thesis B Fig. 2.15), thesis B (2.55), Fig. 2.15.
  *  Inputs: V'_max/V_max = 0.9. */
-static const float FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
+static const float FISCHER_TI085_FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
 
 /** 311.769 V: V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
  *  Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 346.41 V (U_dc = 600 V, spec). */
-static const float FIELD_WEAKENING_VOLTAGE_LIMIT_V = 311.76913f;
+static const float FISCHER_TI085_FIELD_WEAKENING_VOLTAGE_LIMIT_V = 311.76913f;
 
 /** 10 rad/s: α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c, thesis B (2.60), §2.3.3.
  *  Inputs: α_fw = 10·α_s, α_s = α_c/100 = 1 rad/s (no speed loop or J, b in the spec: thesis B Fig. 2.15), α_c = 100 rad/s. */
-static const float FIELD_WEAKENING_BANDWIDTH = 10.0f;
+static const float FISCHER_TI085_FIELD_WEAKENING_BANDWIDTH = 10.0f;
 
 /** 4362.49 rad/s: ω_base (electrical): ω_fw = max(ω_base, |ω_r|), thesis B (2.60).
  *  Inputs: no f_n: ω_base = the corner speed where the full-current MTPA point reaches V'_max, R_s included (2.26), (2.27), (2.53). */
-static const float FIELD_WEAKENING_BASE_SPEED = 4362.4883f;
+static const float FISCHER_TI085_FIELD_WEAKENING_BASE_SPEED = 4362.4883f;
 
 /** 0.000393 H: L̂_d in γ = α_fw/(2·ω_fw·L̂_d·V'_max), thesis B (2.60).
  *  Inputs: L_d = 0.000393 H. */
-static const float FIELD_WEAKENING_LD = 0.000393f;
+static const float FISCHER_TI085_FIELD_WEAKENING_LD = 0.000393f;
 
 /** 0.00935427 A/(V²·s): γ = α_fw/(2·ω_base·L̂_d·V'_max) at ω_fw = ω_base and the nominal V'_max, thesis B (2.60).
  *  Inputs: α_fw, ω_base, L̂_d, V'_max above. */
-static const float FIELD_WEAKENING_GAIN_AT_BASE_SPEED = 0.009354274f;
+static const float FISCHER_TI085_FIELD_WEAKENING_GAIN_AT_BASE_SPEED = 0.009354274f;
 
 /** 86.267 A: I_max: current circle, −I_max ≤ i_d^ref, i_q^ref = √(I_max² − (i_d^ref)²) in Mode B, thesis B (2.50), (2.56), (2.57).
  *  Inputs: I_max = √2·I_peak,rms = √2·61 A. */
-static const float FIELD_WEAKENING_CURRENT_MAX_A = 86.26703f;
+static const float FISCHER_TI085_FIELD_WEAKENING_CURRENT_MAX_A = 86.26703f;
 
 /** -86.267 A: −I_max, lower limit of i_d^ref (demagnetisation), thesis B (2.56).
  *  Inputs: I_max = √2·I_peak,rms = √2·61 A. */
-static const float FIELD_WEAKENING_ID_MIN_A = -86.26703f;
+static const float FISCHER_TI085_FIELD_WEAKENING_ID_MIN_A = -86.26703f;
 
 /** 0 A: upper limit of i_d^ref at full current: i_d = −2ΔL·I²/(ψ_M + √(ψ_M² + 8ΔL²·I²)), (3.10) on |i| = I_max, thesis B (2.56), (3.10).
  *  Inputs: I_max = √2·I_peak,rms = √2·61 A, ΔL = L_q − L_d. */
-static const float FIELD_WEAKENING_ID_MTPA_AT_CURRENT_MAX_A = 0.0f;
+static const float FISCHER_TI085_FIELD_WEAKENING_ID_MTPA_AT_CURRENT_MAX_A = 0.0f;
 
 /** 86.267 A: √(I_max² − i_d²) at the MTPA point on the circle: Mode B limits |i_q^ref| below this, thesis B (2.57).
  *  Inputs: I_max = √2·I_peak,rms = √2·61 A. */
-static const float FIELD_WEAKENING_IQ_MODE_B_START_A = 86.26703f;
+static const float FISCHER_TI085_FIELD_WEAKENING_IQ_MODE_B_START_A = 86.26703f;
 
 /** 17 points, 0 … 86.267 A: uniform |i_q| grid of the MTPA table, thesis B (3.10).
  *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
-static const float FIELD_WEAKENING_MTPA_IQ_A[17] = {0.0f, 5.3916893f, 10.783379f, 16.175068f, 21.566757f, 26.958447f, 32.350136f, 37.741825f, 43.133514f, 48.525204f, 53.916893f, 59.308582f, 64.70027f, 70.09196f, 75.48365f, 80.875336f, 86.26703f};
+#define FISCHER_TI085_FIELD_WEAKENING_MTPA_IQ_A_LEN 17
+static const float FISCHER_TI085_FIELD_WEAKENING_MTPA_IQ_A[FISCHER_TI085_FIELD_WEAKENING_MTPA_IQ_A_LEN] = {0.0f, 5.3916893f, 10.783379f, 16.175068f, 21.566757f, 26.958447f, 32.350136f, 37.741825f, 43.133514f, 48.525204f, 53.916893f, 59.308582f, 64.70027f, 70.09196f, 75.48365f, 80.875336f, 86.26703f};
 
 /** 0 A … 0 A: i_d,MTPA = ψ_M/(2ΔL) − √((ψ_M/(2ΔL))² + i_q²), ΔL = L_q − L_d, thesis B (3.10), (2.56).
  *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
-static const float FIELD_WEAKENING_MTPA_ID_A[17] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+#define FISCHER_TI085_FIELD_WEAKENING_MTPA_ID_A_LEN 17
+static const float FISCHER_TI085_FIELD_WEAKENING_MTPA_ID_A[FISCHER_TI085_FIELD_WEAKENING_MTPA_ID_A_LEN] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
 
 /** 0 A: max |linear interpolation − (3.10)| at the grid midpoints, thesis B (3.10).
  *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
-static const float FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.0f;
+static const float FISCHER_TI085_FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.0f;
 
 /* Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4). */
 
 /** 10 rad/s: ρ: estimator bandwidth, ρ ≤ α_c/10, thesis B (4.74), Table 4.1.
  *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_RHO = 10.0f;
+static const float FISCHER_TI085_SENSORLESS_RHO = 10.0f;
 
 /** 100 1/s²: γ1 = ρ², thesis B (4.7).
  *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_GAMMA1 = 100.0f;
+static const float FISCHER_TI085_SENSORLESS_GAMMA1 = 100.0f;
 
 /** 20 1/s: γ2 = 2ρ, thesis B (4.7).
  *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_GAMMA2 = 20.0f;
+static const float FISCHER_TI085_SENSORLESS_GAMMA2 = 20.0f;
 
 /** 0 rad/s: ω_e, 5α_c ≤ ω_e ≤ ω_sw/10 (spec sensorless.injection_frequency, default ω_sw/10), thesis B (4.34).
  *  Inputs: no signal injection → 0: L_q = L_d: no saliency, the carrier current holds no position information (thesis B (4.17)). */
-static const float SENSORLESS_INJECTION_FREQUENCY = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_INJECTION_FREQUENCY = 0.0f;
 
 /** 0 V: V_e ≥ I_base·ω_e·L_d·L_q/(10·|ΔL|) (spec sensorless.injection_voltage, default the minimum), thesis B (4.35).
  *  Inputs: no signal injection → 0: L_q = L_d: no saliency, the carrier current holds no position information (thesis B (4.17)). */
-static const float SENSORLESS_INJECTION_VOLTAGE = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_INJECTION_VOLTAGE = 0.0f;
 
 /** 0 A: K_e = V_e·ΔL/(4·ω_e·L_d·L_q), ΔL = L_q − L_d signed (negative for inverse saliency; e = e_si/(2K̂_e) (4.20) either way), thesis B (4.19).
  *  Inputs: no signal injection → 0: L_q = L_d: no saliency, the carrier current holds no position information (thesis B (4.17)). */
-static const float SENSORLESS_INJECTION_GAIN = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_INJECTION_GAIN = 0.0f;
 
 /** 0 rad/s: ω_hp: a few hertz (default 0.015 pu, §4.5.1; 2π·3 Hz without a per-unit base), thesis B §4.3, Table 4.1.
  *  Inputs: no signal injection → 0: L_q = L_d: no saliency, the carrier current holds no position information (thesis B (4.17)). */
-static const float SENSORLESS_HIGHPASS = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_HIGHPASS = 0.0f;
 
 /** 0 rad/s: ω_lp, 5ρ ≤ ω_lp ≤ 10ρ (default 5ρ), thesis B Table 4.1.
  *  Inputs: no signal injection → 0: L_q = L_d: no saliency, the carrier current holds no position information (thesis B (4.17)). */
-static const float SENSORLESS_LOWPASS = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_LOWPASS = 0.0f;
 
 /** 0 rad/s: ω_ls = max(ω_min1, ω_min2), ω_min1 = 5ρ·|ΔL|·I_max/(3ψ_m), ω_min2 = |R̃·i_d/(θ̃·(ψ_m − ΔL·i_d))| at the MTPA i_d (3.10) of I_base, thesis B (4.59), (4.69), Table 4.1.
  *  Inputs: ω_min1 = 0 rad/s, ω_min2 = 0 rad/s (θ̃ = 10.0°, i_d = 0 A), I_max = 86.267 A, I_base = 31.9612 A. */
-static const float SENSORLESS_LOW_SPEED = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_LOW_SPEED = 0.0f;
 
 /** 0 rad/s: ω_hs = 2·ω_ls, thesis B Table 4.1.
  *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_HIGH_SPEED = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_HIGH_SPEED = 0.0f;
 
 /** 10 rad/s: Δω1 = ρ: γ0 = 0 below, thesis B (4.83), §4.6.
  *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_RESET_LOWER = 10.0f;
+static const float FISCHER_TI085_SENSORLESS_RESET_LOWER = 10.0f;
 
 /** 20 rad/s: Δω2 = 2ρ: γ0 = ρ above, thesis B (4.83), §4.6.
  *  Inputs: ρ = α_c/10, α_c = 100 rad/s (Table 4.1 bound, as in Figs. 4.17, 4.18). */
-static const float SENSORLESS_RESET_UPPER = 20.0f;
+static const float FISCHER_TI085_SENSORLESS_RESET_UPPER = 20.0f;
 
 /** 0 A: |i_q^ref| < ρ²·ψ_m/(γ0·ω_max·|ΔL|) with γ0 = ρ, while the resetting term acts (0: no limit needed), thesis B (4.92).
  *  Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb, ω_max = 8377.58 rad/s. */
-static const float SENSORLESS_IQ_LIMIT_RESETTING_A = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_IQ_LIMIT_RESETTING_A = 0.0f;
 
 /** 0 A: |i_q| ≤ ψ_m/|ΔL|: no unwanted equilibria of the back-EMF estimator (0: no saliency), thesis B (4.66).
  *  Inputs: L_d = 0.000393 H, L_q = 0.000393 H, ψ_M = 0.0604207 Wb. */
-static const float SENSORLESS_IQ_LIMIT_BIFURCATION_A = 0.0f;
+static const float FISCHER_TI085_SENSORLESS_IQ_LIMIT_BIFURCATION_A = 0.0f;
 
 /** 0.126 Ω: R̂_s in the back-EMF error e_d (L̂_d, L̂_q, ψ̂_m: current_loop::FF_LD, FF_LQ, FF_PSI), thesis B (4.51).
  *  Inputs: phase resistance (spec). */
-static const float SENSORLESS_RS = 0.126f;
+static const float FISCHER_TI085_SENSORLESS_RS = 0.126f;
 
-#endif /* MOTORGEN_MOTOR_CONSTANTS_H */
+#endif /* MOTORGEN_FISCHER_TI085_H */

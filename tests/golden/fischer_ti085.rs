@@ -32,6 +32,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
     pub const D_ANTI_WINDUP: f32 = 25.445293;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec).
+    pub const D_PREFILTER: f32 = 1.0;
     /// 0.0393 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
     /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
@@ -56,6 +60,10 @@ pub mod current_loop {
     ///
     /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec).
     pub const Q_ANTI_WINDUP: f32 = 25.445293;
+    /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
+    ///
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 100 rad/s (spec), f_s = 20000 Hz (spec).
+    pub const Q_PREFILTER: f32 = 1.0;
     /// 0.000393 H: `L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)`, thesis A (5.3).
     ///
     /// Inputs: L_d = 0.000393 H (datasheet).

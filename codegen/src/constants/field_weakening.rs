@@ -17,7 +17,7 @@ fn f32_array(v: &[f64]) -> Value {
         rust_type: format!("[f32; {}]", v.len()),
         rust_expr: format!("[{rust}]"),
         c_type: "float".into(),
-        c_array: format!("[{}]", v.len()),
+        c_len: Some(v.len()),
         c_expr: format!("{{{cexpr}}}"),
         number: serde_json::json!(v.iter().map(|&x| x as f32).collect::<Vec<_>>()),
     }

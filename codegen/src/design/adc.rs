@@ -18,15 +18,15 @@ pub fn settling_multiple(bits: u32) -> u32 {
 /// A chosen STM32G4 sampling time.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SampleTime {
-    /// τ = (R_ADC + R_EXT)·C_ADC (7.2) [s].
+    /// τ = (R_ADC + R_EXT)·C_ADC (7.2) \[s\].
     pub time_constant_s: f64,
-    /// Minimum sampling time = multiple·τ [s].
+    /// Minimum sampling time = multiple·τ \[s\].
     pub min_sample_time_s: f64,
     /// ADC_SMPR code (0..=7).
     pub smp_code: u8,
     /// Sampling cycles of that code.
     pub cycles: f64,
-    /// Resulting sampling time [s].
+    /// Resulting sampling time \[s\].
     pub sample_time_s: f64,
 }
 

@@ -62,7 +62,7 @@ fn to_q31(gain: &'static str, x: f64) -> Result<i32, ObserverGainError> {
     Ok(i as i32)
 }
 
-/// Designs the observer for natural frequency `wn` [rad/s], damping `zeta`, sample rate `fs` [Hz].
+/// Designs the observer for natural frequency `wn` [rad/s], damping `zeta`, sample rate `fs` \[Hz\].
 pub fn design(wn: f64, zeta: f64, fs: f64, error: ObserverError) -> Result<ObserverGains, ObserverGainError> {
     let kp = 2.0 * zeta * wn;
     let ki = wn * wn;
@@ -85,7 +85,7 @@ pub fn design(wn: f64, zeta: f64, fs: f64, error: ObserverError) -> Result<Obser
     })
 }
 
-/// Angular lag of a delay of `k` samples at electrical speed `we` [rad/s], Δθ_e = k·ω_e·T_s (4.23) [rad].
+/// Angular lag of a delay of `k` samples at electrical speed `we` [rad/s], Δθ_e = k·ω_e·T_s (4.23) \[rad\].
 pub fn lag_angle(k: f64, we: f64, fs: f64) -> f64 {
     k * we / fs
 }

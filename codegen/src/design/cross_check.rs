@@ -65,7 +65,7 @@ pub fn disagreement_percent(a: f64, b: f64) -> f64 {
     if mean > 0.0 { 100.0 * (a - b).abs() / mean } else { 0.0 }
 }
 
-/// The largest torque [N·m] at current amplitude `i` [A]: (3.7) at the MTPA point (3.10)
+/// The largest torque [N·m] at current amplitude `i` \[A\]: (3.7) at the MTPA point (3.10)
 /// on |i| = `i`, T = 3/2·n_p·i_q·(ψ_m − ΔL·i_d).
 pub fn mtpa_torque(pole_pairs: u32, psi: f64, ld: f64, lq: f64, i: f64) -> f64 {
     let (id, iq) = mtpa_corner(psi, lq - ld, i);

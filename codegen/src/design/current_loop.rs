@@ -20,7 +20,7 @@ pub const SECOND_ORDER_BANDWIDTH_FRACTION: f64 = 0.17;
 /// The reference prefilter D(s) = (K_i/L)/((K_p/L)s + K_i/L) = 1/(τ_f·s + 1) (5.16).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Prefilter {
-    /// τ_f = K_p/K_i [s].
+    /// τ_f = K_p/K_i \[s\].
     pub time_constant_s: f64,
     /// Pole of D(s) = zero of (5.11) being cancelled, K_i/K_p [rad/s].
     pub pole_rad_s: f64,
@@ -39,7 +39,7 @@ pub struct AxisGains {
     pub ka: f64,
     /// Series zero K_b = K_i/K_p [rad/s] (5.7).
     pub kb: f64,
-    /// Active damping (virtual resistance) R_a [Ω], thesis B (2.43); 0 for the other methods.
+    /// Active damping (virtual resistance) R_a \[Ω\], thesis B (2.43); 0 for the other methods.
     pub active_damping_ohm: f64,
     /// Back-calculation anti-windup gain 1/k_p [A/(V·s)·s] of thesis B (2.49).
     pub anti_windup_gain: f64,
@@ -47,6 +47,9 @@ pub struct AxisGains {
     pub ki_ts: f64,
     /// Reference prefilter (pole placement only).
     pub prefilter: Option<Prefilter>,
+    /// Coefficient a of the reference filter y += a·(x − y) the controller runs: the
+    /// prefilter's (5.16), or 1 (the reference passes unfiltered) without one.
+    pub reference_filter: f64,
     /// Designed closed-loop poles, real and imaginary parts [rad/s].
     pub designed_poles: Vec<[f64; 2]>,
     /// The bandwidth α these gains were designed for [rad/s]: the spec's, or the lower
@@ -88,8 +91,8 @@ pub fn overshoot(zeta: f64) -> f64 {
     }
 }
 
-/// Designs one axis with resistance `r` [Ω], inductance `l` [H], bandwidth `alpha` [rad/s],
-/// damping `zeta` (pole placement), sample period `ts` [s].
+/// Designs one axis with resistance `r` \[Ω\], inductance `l` \[H\], bandwidth `alpha` [rad/s],
+/// damping `zeta` (pole placement), sample period `ts` \[s\].
 pub fn design_axis(
     method: Method,
     axis: char,
@@ -160,13 +163,14 @@ pub fn design_axis(
         active_damping_ohm: ra,
         anti_windup_gain: 1.0 / kp,
         ki_ts: ki * ts,
+        reference_filter: prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient),
         prefilter,
         designed_poles: poles,
         bandwidth_rad_s: alpha,
     })
 }
 
-/// Upper bandwidth guideline [rad/s] for `method` at switching frequency `fs` [Hz]: α/(2π) < fraction·f_s.
+/// Upper bandwidth guideline [rad/s] for `method` at switching frequency `fs` \[Hz\]: α/(2π) < fraction·f_s.
 pub fn bandwidth_limit(method: Method, fs: f64) -> f64 {
     let fraction = match method {
         Method::Imc | Method::ImcActiveDamping => FIRST_ORDER_BANDWIDTH_FRACTION,

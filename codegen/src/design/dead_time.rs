@@ -14,8 +14,8 @@
 //! error for signal injection on motors with small saliency. The firmware's current loop
 //! sees it as a disturbance its integral action removes in steady state.
 
-/// ΔU = U_dc·t_d·f_s [V]: the average phase-leg voltage error of a dead time `t_dead` [s]
-/// at DC link `u_dc` [V] and switching frequency `f_s` [Hz].
+/// ΔU = U_dc·t_d·f_s \[V\]: the average phase-leg voltage error of a dead time `t_dead` \[s\]
+/// at DC link `u_dc` \[V\] and switching frequency `f_s` \[Hz\].
 pub fn voltage_error(u_dc: f64, t_dead: f64, f_s: f64) -> f64 {
     u_dc * t_dead * f_s
 }

@@ -45,13 +45,13 @@ fn crossing(y: &[f64], dt: f64, level: f64) -> Option<f64> {
         .find_map(|(k, w)| (w[0] < level && w[1] >= level).then(|| (k as f64 + (level - w[0]) / (w[1] - w[0])) * dt))
 }
 
-/// 10–90 % rise time [s] of a unit step response sampled every `dt`; `None` if it never
+/// 10–90 % rise time \[s\] of a unit step response sampled every `dt`; `None` if it never
 /// reaches 90 %.
 pub fn rise_time(y: &[f64], dt: f64) -> Option<f64> {
     Some(crossing(y, dt, 0.9)? - crossing(y, dt, 0.1)?)
 }
 
-/// Rise time [s] of one axis designed with bandwidth `alpha` (first-order methods).
+/// Rise time \[s\] of one axis designed with bandwidth `alpha` (first-order methods).
 pub fn predicted_rise_time(g: &AxisGains, r: f64, l: f64, ts: f64, alpha: f64) -> Option<f64> {
     // 12 time constants of the designed loop (or at least 200 samples) cover the 90 % point.
     let n = ((12.0 / alpha / ts).ceil() as usize).clamp(200, 2_000_000);

@@ -38,7 +38,7 @@ pub fn fw_speed(w: f64, w_base: f64) -> f64 {
     w.abs().max(w_base)
 }
 
-/// The Mode-B limit (2.57) on |i_q^ref| [A] at `id`.
+/// The Mode-B limit (2.57) on |i_q^ref| \[A\] at `id`.
 pub fn mode_b_iq(i_max: f64, id: f64) -> f64 {
     (i_max * i_max - id * id).max(0.0).sqrt()
 }
@@ -61,7 +61,7 @@ pub enum BandwidthRule {
 pub struct Inputs {
     /// Motor (ψ_m > 0) and loss data; its `i_max` is the current-circle radius I_max.
     pub model: LossModel,
-    /// V_max = U_dc/√3 [V] at the nominal U_dc.
+    /// V_max = U_dc/√3 \[V\] at the nominal U_dc.
     pub voltage_max: f64,
     /// V'_max/V_max.
     pub voltage_fraction: f64,
@@ -80,19 +80,19 @@ pub struct Inputs {
 /// The MTPA table.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct MtpaTable {
-    /// |i_q| grid [A], uniform from 0 to the MTPA point on the circle |i| = I_max; the
+    /// |i_q| grid \[A\], uniform from 0 to the MTPA point on the circle |i| = I_max; the
     /// firmware holds the last value beyond it, which with (2.57) gives that point.
     pub iq_a: Vec<f64>,
-    /// i_d,MTPA [A] (3.10) at the grid points.
+    /// i_d,MTPA \[A\] (3.10) at the grid points.
     pub id_a: Vec<f64>,
-    /// Largest |linear interpolation − (3.10)| over the interval midpoints [A].
+    /// Largest |linear interpolation − (3.10)| over the interval midpoints \[A\].
     pub max_interpolation_error_a: f64,
 }
 
 /// The loss-minimising table and what it includes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LossMinimisation {
-    /// R_c [Ω], null = no core losses.
+    /// R_c \[Ω\], null = no core losses.
     pub core_resistance_ohm: Option<f64>,
     /// Whether the inverter losses (3.11)–(3.14) are included.
     pub inverter_losses: bool,
@@ -105,7 +105,7 @@ pub struct LossMinimisation {
 pub struct FieldWeakeningOut {
     /// V'_max/V_max.
     pub voltage_fraction: f64,
-    /// V'_max at the nominal U_dc [V] (the firmware scales it with the measured U_dc).
+    /// V'_max at the nominal U_dc \[V\] (the firmware scales it with the measured U_dc).
     pub voltage_limit_v: f64,
     /// α_fw [rad/s].
     pub bandwidth_rad_s: f64,
@@ -120,18 +120,18 @@ pub struct FieldWeakeningOut {
     /// Corner speed of the full-current MTPA point at V'_max, R_s included [rad/s]
     /// (ω_base when f_n is not given).
     pub corner_speed_rad_s: Option<f64>,
-    /// L̂_d [H] in γ.
+    /// L̂_d \[H\] in γ.
     pub d_inductance_h: f64,
     /// γ at ω_fw = ω_base and the nominal V'_max [A/(V²·s)] (2.60).
     pub gain_at_base_speed: f64,
-    /// I_max [A], the current-circle radius (2.50).
+    /// I_max \[A\], the current-circle radius (2.50).
     pub current_max_a: f64,
-    /// −I_max [A], the lower limit of (2.56).
+    /// −I_max \[A\], the lower limit of (2.56).
     pub id_min_a: f64,
-    /// i_d of the MTPA point on the current circle [A]: the upper limit of (2.56) at full
+    /// i_d of the MTPA point on the current circle \[A\]: the upper limit of (2.56) at full
     /// current.
     pub id_mtpa_at_current_max_a: f64,
-    /// (2.57) at that i_d [A]: the i_q where Mode B begins, the end of the table grid.
+    /// (2.57) at that i_d \[A\]: the i_q where Mode B begins, the end of the table grid.
     pub iq_mode_b_at_mtpa_a: f64,
     /// MTPA table (3.10).
     pub mtpa: MtpaTable,

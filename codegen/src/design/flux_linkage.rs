@@ -26,7 +26,7 @@ use crate::spec::{Amplitude, SpeedAxis};
 /// 3√3/π: U_ind/(ω_e·ψ_M) and k_M/(n_p·ψ_M) of block commutation.
 pub const BLOCK_COMMUTATION_FACTOR: f64 = 1.653_986_686_265_376_7;
 
-/// ψ_M [Wb] from K_t [N·m/A] quoted per `current` ampere: rms or peak phase current
+/// ψ_M \[Wb\] from K_t [N·m/A] quoted per `current` ampere: rms or peak phase current
 /// (2.34), or the DC supply current of block commutation.
 pub fn from_torque_constant(kt: f64, current: Amplitude, pole_pairs: u32) -> f64 {
     let np = f64::from(pole_pairs);
@@ -37,7 +37,7 @@ pub fn from_torque_constant(kt: f64, current: Amplitude, pole_pairs: u32) -> f64
     }
 }
 
-/// ψ_M [Wb] from K_e [V per rad/s of `speed`] quoted in the given conventions (6.11):
+/// ψ_M \[Wb\] from K_e [V per rad/s of `speed`] quoted in the given conventions (6.11):
 /// rms or peak, line to line or phase; or the induced DC voltage of block commutation
 /// (line to line by construction).
 pub fn from_back_emf_constant(

@@ -19,7 +19,7 @@
 
 use std::f64::consts::{PI, SQRT_2};
 
-/// i_d,MTPA(i_q) [A] of (3.10), in the cancellation-free form
+/// i_d,MTPA(i_q) \[A\] of (3.10), in the cancellation-free form
 /// `−2ΔL·i_q²/(ψ_m + √(ψ_m² + 4ΔL²·i_q²))` (0 for ΔL = 0).
 ///
 /// Derivation for either sign of ΔL: at |i| = I, T ∝ i_q·(ψ_m − ΔL·i_d) (3.7) with
@@ -39,7 +39,7 @@ pub fn mtpa_id(psi: f64, delta_l: f64, iq: f64) -> f64 {
     }
 }
 
-/// The MTPA point (i_d, i_q) [A] on the current circle |i| = `i_max` (the largest torque
+/// The MTPA point (i_d, i_q) \[A\] on the current circle |i| = `i_max` (the largest torque
 /// per (2.50)): (3.10) with i_d² + i_q² = I², i.e. `2i_d² − ψ/ΔL·i_d − I² = 0`, in the
 /// cancellation-free form `i_d = −2ΔL·I²/(ψ_m + √(ψ_m² + 8ΔL²·I²))` — the torque-maximising
 /// root for either sign of ΔL, as in [`mtpa_id`].
@@ -58,22 +58,22 @@ pub fn mtpa_corner(psi: f64, delta_l: f64, i_max: f64) -> (f64, f64) {
 /// r = r_CE ≈ r_T).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct InverterLoss {
-    /// On-state voltage V [V].
+    /// On-state voltage V \[V\].
     pub threshold_v: f64,
-    /// Lead resistance r [Ω].
+    /// Lead resistance r \[Ω\].
     pub resistance_ohm: f64,
-    /// E_on + E_off [J].
+    /// E_on + E_off \[J\].
     pub switching_energy_j: f64,
-    /// E_rr [J].
+    /// E_rr \[J\].
     pub recovery_energy_j: f64,
-    /// I_c,nom [A].
+    /// I_c,nom \[A\].
     pub nominal_current_a: f64,
-    /// f_sw [Hz].
+    /// f_sw \[Hz\].
     pub switching_frequency_hz: f64,
 }
 
 impl InverterLoss {
-    /// P_loss,inv [W] (3.14) at the current amplitude `i` [A] (I_rms = i/√2).
+    /// P_loss,inv \[W\] (3.14) at the current amplitude `i` \[A\] (I_rms = i/√2).
     pub fn loss(&self, i: f64) -> f64 {
         let irms = i / SQRT_2;
         let cond = 2.0 * SQRT_2 * self.threshold_v * irms / PI + self.resistance_ohm * irms * irms; // (3.11)
@@ -89,19 +89,19 @@ impl InverterLoss {
 pub struct LossModel {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub rs: f64,
-    /// L_d [H].
+    /// L_d \[H\].
     pub ld: f64,
-    /// L_q [H].
+    /// L_q \[H\].
     pub lq: f64,
-    /// ψ_m [Wb].
+    /// ψ_m \[Wb\].
     pub psi: f64,
-    /// R_c [Ω]; `None` = no core losses (R_c → ∞).
+    /// R_c \[Ω\]; `None` = no core losses (R_c → ∞).
     pub rc: Option<f64>,
     /// Inverter losses, if included.
     pub inverter: Option<InverterLoss>,
-    /// Current-circle radius I_max [A]; bounds the search (see [`LossModel::search_range`]).
+    /// Current-circle radius I_max \[A\]; bounds the search (see [`LossModel::search_range`]).
     pub i_max: f64,
 }
 
@@ -111,7 +111,7 @@ const GOLDEN_STEPS: usize = 100;
 const BISECTION_STEPS: usize = 100;
 
 impl LossModel {
-    /// Terminal currents (i_d, i_q) [A] of the magnetising currents at electrical speed `w` (Fig. 2.7).
+    /// Terminal currents (i_d, i_q) \[A\] of the magnetising currents at electrical speed `w` (Fig. 2.7).
     pub fn terminal(&self, w: f64, id0: f64, iq0: f64) -> (f64, f64) {
         match self.rc {
             Some(rc) => (id0 - w * self.lq * iq0 / rc, iq0 + w * (self.ld * id0 + self.psi) / rc),
@@ -124,7 +124,7 @@ impl LossModel {
         1.5 * f64::from(self.pole_pairs) * iq0 * (self.psi - (self.lq - self.ld) * id0)
     }
 
-    /// P_res (3.3) + P_co (3.4) + P_loss,inv (3.14) [W].
+    /// P_res (3.3) + P_co (3.4) + P_loss,inv (3.14) \[W\].
     pub fn loss(&self, w: f64, id0: f64, iq0: f64) -> f64 {
         let (id, iq) = self.terminal(w, id0, iq0);
         let res = 1.5 * self.rs * (id * id + iq * iq);
@@ -142,7 +142,7 @@ impl LossModel {
         if k.abs() > 0.0 { t / k } else { 0.0 }
     }
 
-    /// The interval of i_d0 [A] the loss minimum lies in. For ΔL ≥ 0: [−I_max, 0] — the
+    /// The interval of i_d0 \[A\] the loss minimum lies in. For ΔL ≥ 0: [−I_max, 0] — the
     /// MTPA point (3.10) is ≤ 0, the core losses (3.4) fall with the flux L_d·i_d + ψ_m
     /// and the inverter losses (3.14) pull back towards MTPA, so nothing favours i_d0 > 0.
     /// For inverse saliency (ΔL < 0) the MTPA point is ≥ 0 and the core losses pull it
@@ -157,7 +157,7 @@ impl LossModel {
         }
     }
 
-    /// The loss-minimising terminal (i_d, i_q) [A] at torque `t` and speed `w`:
+    /// The loss-minimising terminal (i_d, i_q) \[A\] at torque `t` and speed `w`:
     /// golden-section search over i_d0 in [`LossModel::search_range`] along the
     /// constant-torque curve.
     pub fn optimum(&self, w: f64, t: f64) -> (f64, f64) {
@@ -185,7 +185,7 @@ impl LossModel {
         self.terminal(w, id0, self.iq0_for(t, id0))
     }
 
-    /// The loss-minimising i_d [A] at terminal `iq` [A] ≥ 0 and speed `w` ≥ 0: bisection on
+    /// The loss-minimising i_d \[A\] at terminal `iq` \[A\] ≥ 0 and speed `w` ≥ 0: bisection on
     /// the torque until the optimum's terminal i_q is `iq`, then kept inside the current
     /// circle (2.50) — losses fall monotonically towards the unconstrained optimum along
     /// the constant-torque curve, so the constrained optimum lies on the circle.
@@ -232,11 +232,11 @@ pub fn midpoint_error(xs: &[f64], ys: &[f64], exact: impl Fn(f64) -> f64) -> f64
 pub struct LossTable {
     /// Electrical speeds ω [rad/s] (rows).
     pub speeds_rad_s: Vec<f64>,
-    /// |i_q| grid [A] (columns), the MTPA grid.
+    /// |i_q| grid \[A\] (columns), the MTPA grid.
     pub iq_a: Vec<f64>,
-    /// i_d [A], row-major: `id_a[k·iq_a.len() + j]` at `speeds_rad_s[k]`, `iq_a[j]`.
+    /// i_d \[A\], row-major: `id_a[k·iq_a.len() + j]` at `speeds_rad_s[k]`, `iq_a[j]`.
     pub id_a: Vec<f64>,
-    /// Largest bilinear-interpolation error [A] against the numeric optimum at the cell
+    /// Largest bilinear-interpolation error \[A\] against the numeric optimum at the cell
     /// centres and edge midpoints.
     pub max_interpolation_error_a: f64,
 }

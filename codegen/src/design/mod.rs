@@ -36,9 +36,16 @@ pub use step::motor::{MotorOut, Origin};
 pub use step::per_unit::PerUnitOut;
 pub use step::scaling::ScalingsOut;
 
+/// Version of the design's JSON form (`motorgen design --format json`): raised whenever
+/// a key is removed or renamed or changes meaning or unit, so that a consumer can refuse
+/// a form it does not know. New keys do not raise it.
+pub const SCHEMA_VERSION: u32 = 1;
+
 /// Every constant of one motor.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Design {
+    /// [`SCHEMA_VERSION`] of this form (the first key of the JSON).
+    pub schema_version: u32,
     /// Spec file as given.
     pub spec_file: String,
     /// Motor name.
@@ -101,6 +108,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         Err(e) => return Err(Diagnostics(vec![*e])),
     };
     Ok(Design {
+        schema_version: SCHEMA_VERSION,
         spec_file: src.file.to_string(),
         name: spec.name.clone(),
         motor,

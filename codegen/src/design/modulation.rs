@@ -12,19 +12,19 @@ pub fn thpwm_common_mode_ratio() -> f64 {
 pub struct Modulation {
     /// 1/(6√3): u_NM amplitude over U_dc (3.7).
     pub thpwm_common_mode_ratio: f64,
-    /// u_NM amplitude at nominal U_dc [V].
+    /// u_NM amplitude at nominal U_dc \[V\].
     pub thpwm_common_mode_amplitude_v: f64,
-    /// Largest phase-voltage amplitude with third-harmonic injection, U_dc/√3 [V] (thesis B 2.50).
+    /// Largest phase-voltage amplitude with third-harmonic injection, U_dc/√3 \[V\] (thesis B 2.50).
     pub max_phase_voltage_v: f64,
-    /// Largest phase-voltage amplitude with sinusoidal PWM, U_dc/2 [V] (3.4), (3.5).
+    /// Largest phase-voltage amplitude with sinusoidal PWM, U_dc/2 \[V\] (3.4), (3.5).
     pub max_phase_voltage_spwm_v: f64,
     /// Modulation index reached with THPWM, M = 2/√3 (3.6).
     pub max_modulation_index: f64,
-    /// Same at the lowest DC-link voltage [V].
+    /// Same at the lowest DC-link voltage \[V\].
     pub max_phase_voltage_at_min_dc_v: f64,
 }
 
-/// Constants for nominal `u_dc` [V] and minimum `u_dc_min` [V].
+/// Constants for nominal `u_dc` \[V\] and minimum `u_dc_min` \[V\].
 pub fn modulation(u_dc: f64, u_dc_min: f64) -> Modulation {
     Modulation {
         thpwm_common_mode_ratio: thpwm_common_mode_ratio(),

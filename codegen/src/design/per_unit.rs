@@ -14,28 +14,28 @@ use serde::Serialize;
 /// The base values; `None` where the spec lacks a quantity the definition needs.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Bases {
-    /// V_base = V_max = V_dc/√3 [V].
+    /// V_base = V_max = V_dc/√3 \[V\].
     pub voltage_v: f64,
-    /// I_base = √2·I_n [A] (needs I_n).
+    /// I_base = √2·I_n \[A\] (needs I_n).
     pub current_a: Option<f64>,
-    /// Z_base = V_base/I_base [Ω] (needs I_n).
+    /// Z_base = V_base/I_base \[Ω\] (needs I_n).
     pub impedance_ohm: Option<f64>,
     /// ω_base = 2π·f_n [rad/s] (needs f_n).
     pub angular_frequency_rad_s: Option<f64>,
-    /// ψ_base = V_base/ω_base [Wb] (needs f_n).
+    /// ψ_base = V_base/ω_base \[Wb\] (needs f_n).
     pub flux_wb: Option<f64>,
-    /// L_base = Z_base/ω_base [H] (needs I_n and f_n).
+    /// L_base = Z_base/ω_base \[H\] (needs I_n and f_n).
     pub inductance_h: Option<f64>,
     /// J_base = V_base·I_base/ω_base³ [kg·m²] as Table A.1 defines it (needs I_n and f_n).
     pub inertia: Option<f64>,
-    /// P_base = P_n [W], if given.
+    /// P_base = P_n \[W\], if given.
     pub power_w: Option<f64>,
     /// T_base = T_n [N·m], if given.
     pub torque_nm: Option<f64>,
 }
 
-/// Bases from the DC link [V] and, where given, the rated rms current [A], the rated
-/// electrical frequency [Hz], the rated power [W] and torque [N·m].
+/// Bases from the DC link \[V\] and, where given, the rated rms current \[A\], the rated
+/// electrical frequency \[Hz\], the rated power \[W\] and torque [N·m].
 pub fn bases(v_dc: f64, i_n_rms: Option<f64>, f_n: Option<f64>, p_n: Option<f64>, t_n: Option<f64>) -> Bases {
     let v = v_dc / 3f64.sqrt();
     let i = i_n_rms.map(|i| std::f64::consts::SQRT_2 * i);

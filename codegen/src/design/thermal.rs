@@ -3,7 +3,7 @@
 /// Copper's inferred zero-resistance temperature magnitude in (2.24) [°C].
 pub const COPPER_INFERRED_ZERO_C: f64 = 235.0;
 
-/// R_s at `t_c` [Ω] given R_s0 [Ω] measured at `t0_c` [°C], (2.24).
+/// R_s at `t_c` \[Ω\] given R_s0 \[Ω\] measured at `t0_c` [°C], (2.24).
 pub fn resistance_at(r0_ohm: f64, t0_c: f64, t_c: f64) -> f64 {
     (COPPER_INFERRED_ZERO_C + t_c) / (COPPER_INFERRED_ZERO_C + t0_c) * r0_ohm
 }

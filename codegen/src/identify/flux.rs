@@ -13,26 +13,26 @@ use crate::diagnostic::Diagnostics;
 /// What the design fixes for the ψ_M estimate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FluxSetup {
-    /// R_s [Ω] (residual-term correction).
+    /// R_s \[Ω\] (residual-term correction).
     pub resistance_ohm: f64,
-    /// L_d [H] (residual-term correction).
+    /// L_d \[H\] (residual-term correction).
     pub d_inductance_h: f64,
-    /// |i_dq| above which the run is not "at zero current" [A].
+    /// |i_dq| above which the run is not "at zero current" \[A\].
     pub max_current_a: f64,
     /// |ω_e| below which R·i would not be negligible against the back EMF [rad/s].
     pub min_speed_rad_s: f64,
-    /// Inverter voltage limit U_dc/√3 [V]: u_q at it means the loop was not in control.
+    /// Inverter voltage limit U_dc/√3 \[V\]: u_q at it means the loop was not in control.
     pub voltage_limit_v: f64,
 }
 
 /// ψ_M from one recording.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FluxEstimate {
-    /// ψ_M [Wb].
+    /// ψ_M \[Wb\].
     pub flux_linkage_wb: f64,
     /// Mean ω_e [rad/s].
     pub mean_speed_rad_s: f64,
-    /// The part of ψ_M removed by the current correction [Wb] (0 without current columns).
+    /// The part of ψ_M removed by the current correction \[Wb\] (0 without current columns).
     pub correction_wb: f64,
 }
 

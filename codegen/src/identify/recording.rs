@@ -118,7 +118,7 @@ pub struct Recording {
     pub values: Vec<Vec<f64>>,
     /// Byte offset of each row's line start.
     pub row_offsets: Vec<usize>,
-    /// T_s [s].
+    /// T_s \[s\].
     pub sample_period_s: f64,
     /// Row spacing in periods (the decimation, 1 for every period).
     pub spacing: f64,

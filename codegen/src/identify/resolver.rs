@@ -29,7 +29,7 @@ fn wrap(x: f64) -> f64 {
 pub struct OffsetEstimate {
     /// θ_off in [0, 2π·n_r/n_p) [rad, resolver angle].
     pub offset_rad: f64,
-    /// Largest deviation of θ_r from its mean in the averaging window [rad].
+    /// Largest deviation of θ_r from its mean in the averaging window \[rad\].
     pub deviation_rad: f64,
     /// Rows averaged.
     pub rows: usize,
@@ -131,9 +131,9 @@ pub struct RatioEstimate {
     pub ratio: f64,
     /// Both angles travelled in the same direction.
     pub directions_agree: bool,
-    /// Generated electrical travel [rad].
+    /// Generated electrical travel \[rad\].
     pub electrical_travel_rad: f64,
-    /// Observed resolver travel [rad].
+    /// Observed resolver travel \[rad\].
     pub resolver_travel_rad: f64,
 }
 

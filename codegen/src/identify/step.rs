@@ -31,35 +31,35 @@ pub struct StepSetup {
     pub axis: Axis,
     /// The FMAC's Q1.15 taps (the design's `fir.taps_q15`).
     pub taps_q15: Vec<i16>,
-    /// Current full scale of the Q1.15 format [A] (the design's phase-current scaling).
+    /// Current full scale of the Q1.15 format \[A\] (the design's phase-current scaling).
     pub current_full_scale_a: f64,
-    /// Current limit when the recording states no `current_trip` [A] (the motor's peak
+    /// Current limit when the recording states no `current_trip` \[A\] (the motor's peak
     /// current amplitude).
     pub current_limit_a: f64,
-    /// Largest voltage the inverter can apply in the linear range, U_dc/√3 [V].
+    /// Largest voltage the inverter can apply in the linear range, U_dc/√3 \[V\].
     pub voltage_limit_v: f64,
 }
 
 /// R, L and delay from one recording.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StepEstimate {
-    /// Step height U [V].
+    /// Step height U \[V\].
     pub voltage_v: f64,
-    /// i(∞) − i(0) of the filtered current [A].
+    /// i(∞) − i(0) of the filtered current \[A\].
     pub current_change_a: f64,
-    /// R = U/Δi (6.3) [Ω].
+    /// R = U/Δi (6.3) \[Ω\].
     pub resistance_ohm: f64,
-    /// T_r = t_90 − t_10 (6.6) [s].
+    /// T_r = t_90 − t_10 (6.6) \[s\].
     pub rise_time_s: f64,
-    /// τ = T_r/ln 9 (6.7) [s].
+    /// τ = T_r/ln 9 (6.7) \[s\].
     pub time_constant_s: f64,
-    /// L = R·τ (6.8) [H].
+    /// L = R·τ (6.8) \[H\].
     pub inductance_h: f64,
     /// 5 % crossing after the step, FIR group delay removed [periods T_s].
     pub crossing_5_samples: f64,
     /// Transport delay T_d = crossing − τ·ln(20/19) [periods T_s].
     pub delay_samples: f64,
-    /// T_d [s].
+    /// T_d \[s\].
     pub delay_s: f64,
 }
 
@@ -67,7 +67,7 @@ pub struct StepEstimate {
 /// (e^−6 = 0.25 % left at the start of the averaged last quarter of 8τ).
 pub const MIN_STEP_TIME_CONSTANTS: f64 = 8.0;
 
-/// Filters `currents` [A] through the FMAC model: Q1.15 of `full_scale` [A], `taps`
+/// Filters `currents` \[A\] through the FMAC model: Q1.15 of `full_scale` \[A\], `taps`
 /// (at most [`MAX_TAPS`], zero-padded to the FMAC's 127: zero taps add exactly zero to
 /// the accumulator), history preloaded with the first sample.
 pub fn fmac_filter(currents: &[f64], taps: &[i16], full_scale: f64) -> Vec<f64> {
@@ -392,7 +392,7 @@ mod tests {
 
     /// Zero-padding to the FMAC's 127 taps is exact: the output equals the firmware's
     /// `FmacFir<21>` with the same taps and preload, and the design's slice model
-    /// (`design::fir::fmac_fir_output`), sample for sample.
+    /// (`motor_control::fir::output` on a window), sample for sample.
     #[test]
     fn padded_filter_is_bit_exact() {
         let xs: Vec<f64> = (0..300)
@@ -411,14 +411,14 @@ mod tests {
             let direct = fir.process(&mut st, q(x));
             window.remove(0);
             window.push(q(x));
-            let model = crate::design::fir::fmac_fir_output(&TAPS, &window);
+            let model = motor_control::fir::output(&TAPS, window.iter().rev(), 0, true);
             assert_eq!(y[k], f64::from(direct) / 32768.0 * fs, "sample {k}");
             assert_eq!(direct, model, "sample {k}");
         }
     }
 
     /// A constant input equal to the preload passes the unity-DC-gain filter
-    /// unchanged up to the FMAC's truncation (< 1.2 LSB low, see design::fir).
+    /// unchanged up to the FMAC's truncation (< 1.2 LSB low, see `design::fir` tests).
     #[test]
     fn filter_has_unity_dc_gain() {
         let y = fmac_filter(&[3.0; 50], &TAPS, 16.0);

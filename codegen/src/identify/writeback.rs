@@ -139,7 +139,7 @@ pub fn parse_date(s: &str) -> Result<Datetime, String> {
 /// Only the lines that change are touched: every other line is kept byte for byte (its
 /// line ending and comments included), a UTF-8 byte-order mark stays, and new lines take
 /// the file's line ending (CRLF when most lines end so). `toml_edit` edits an LF copy of
-/// the text; [`splice`] puts its changed lines into the original.
+/// the text; `splice` puts its changed lines into the original.
 pub fn apply(text: &str, entries: &[Entry], origin: &Origin<'_>) -> Result<String, Refusal> {
     let (bom, body) = match text.strip_prefix('\u{feff}') {
         Some(rest) => ("\u{feff}", rest),

@@ -64,7 +64,7 @@ pub const SECTIONS: &[(&str, &str)] = &[
 /// (L_d·i_d + ψ_M)² + (L_q·i_q)² = (V_max/ω_e)², V_max = U_dc/√3, at a quarter, half,
 /// three quarters and all of ω_e,max, and at the speed where the ellipse passes through
 /// (0, i_max) when that is below ω_e,max. Returns the lines and the half-width of the
-/// square view [A].
+/// square view \[A\].
 pub fn dq_plane_lines(d: &Design) -> (Vec<Line>, f64) {
     let m = &d.motor;
     let i_max = m.peak_current_a;

@@ -7,9 +7,9 @@ use plotters::prelude::*;
 use crate::verify::Trace;
 use crate::verify::frequency::Response;
 
-/// Chart width and height [px].
+/// Chart width and height \[px\].
 pub const SIZE: (u32, u32) = (760, 380);
-/// Height of a two-panel (magnitude/phase) chart [px].
+/// Height of a two-panel (magnitude/phase) chart \[px\].
 pub const BODE_HEIGHT: u32 = 560;
 
 const COLORS: [RGBColor; 8] = [
@@ -155,7 +155,7 @@ pub fn line_chart(title: &str, x_desc: &str, y_desc: &str, lines: &[Line]) -> Re
     Ok(svg)
 }
 
-/// A scenario trace over time [ms].
+/// A scenario trace over time \[ms\].
 pub fn trace_chart(t: &Trace) -> Result<String, String> {
     let lines: Vec<Line> = t
         .series
@@ -170,7 +170,7 @@ pub fn trace_chart(t: &Trace) -> Result<String, String> {
     line_chart(&t.title, "t [ms]", &t.y_label, &lines)
 }
 
-/// Magnitude [dB] and phase [°] of labelled responses, stacked; `log_x` for Bode plots
+/// Magnitude \[dB\] and phase [°] of labelled responses, stacked; `log_x` for Bode plots
 /// over rad/s, else linear (e.g. Hz for the FIR).
 pub fn bode_chart(title: &str, x_desc: &str, responses: &[(String, &Response)], log_x: bool) -> Result<String, String> {
     let mag: Vec<Line> = responses

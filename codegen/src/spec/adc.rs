@@ -10,13 +10,13 @@ use crate::units::Kind;
 pub struct AdcSpec {
     /// N bits.
     pub resolution_bits: u32,
-    /// f_ADC [Hz].
+    /// f_ADC \[Hz\].
     pub clock: Param,
-    /// C_ADC [F].
+    /// C_ADC \[F\].
     pub sample_capacitance: Param,
-    /// R_ADC [Ω].
+    /// R_ADC \[Ω\].
     pub switch_resistance: Param,
-    /// R_EXT [Ω].
+    /// R_EXT \[Ω\].
     pub source_resistance: Param,
 }
 

@@ -8,13 +8,13 @@ use crate::units::Kind;
 /// The resolved drive.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Drive {
-    /// f_s = switching = sampling frequency [Hz].
+    /// f_s = switching = sampling frequency \[Hz\].
     pub switching_frequency: Param,
-    /// Nominal DC-link voltage U_dc [V].
+    /// Nominal DC-link voltage U_dc \[V\].
     pub dc_link_voltage: Param,
-    /// Lowest DC-link voltage the controller must work at [V] (defaults to U_dc).
+    /// Lowest DC-link voltage the controller must work at \[V\] (defaults to U_dc).
     pub dc_link_voltage_min: Param,
-    /// Dead time [s], if given.
+    /// Dead time \[s\], if given.
     pub dead_time: Option<Param>,
 }
 

@@ -44,7 +44,7 @@ pub struct FieldWeakeningSpec {
     pub voltage_fraction: Param,
     /// α_s [rad/s], if a speed loop is specified.
     pub speed_loop_bandwidth: Option<Param>,
-    /// R_c [Ω] (thesis B Fig. 2.7, (3.4)), if given.
+    /// R_c \[Ω\] (thesis B Fig. 2.7, (3.4)), if given.
     pub core_resistance: Option<Param>,
     /// Whether the loss minimum includes the inverter losses (3.14).
     pub include_inverter: bool,

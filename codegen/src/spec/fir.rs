@@ -11,15 +11,15 @@ use crate::units::Kind;
 /// The resolved FIR request.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FirSpec {
-    /// Pass-band edge [Hz].
+    /// Pass-band edge \[Hz\].
     pub pass_edge: Param,
-    /// Stop-band edge [Hz].
+    /// Stop-band edge \[Hz\].
     pub stop_edge: Param,
     /// Maximal relative pass-band deviation.
     pub pass_ripple: Param,
     /// Order, if given.
     pub order: Option<(usize, Param)>,
-    /// Required stop-band attenuation [dB], if given.
+    /// Required stop-band attenuation \[dB\], if given.
     pub stop_attenuation: Option<Param>,
     /// Span of the `[fir]` table (for whole-section errors).
     pub span: Range<usize>,

@@ -19,7 +19,7 @@ pub struct FluxSource {
     pub key: String,
     /// What it is, as written: `K_t = "0.492 N·m/A" per rms ampere`.
     pub written: String,
-    /// ψ_M [Wb] by (2.34) or (6.11).
+    /// ψ_M \[Wb\] by (2.34) or (6.11).
     pub flux_wb: f64,
 }
 

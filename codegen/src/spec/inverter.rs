@@ -10,19 +10,19 @@ use crate::units::Kind;
 pub struct InverterSpec {
     /// Part name.
     pub part: Option<String>,
-    /// I_c,nom [A].
+    /// I_c,nom \[A\].
     pub nominal_current: Param,
-    /// r_CE [Ω].
+    /// r_CE \[Ω\].
     pub transistor_resistance: Param,
-    /// V_CE0 [V].
+    /// V_CE0 \[V\].
     pub transistor_threshold: Param,
-    /// E_on + E_off [J].
+    /// E_on + E_off \[J\].
     pub switching_energy: Param,
-    /// r_T [Ω].
+    /// r_T \[Ω\].
     pub diode_resistance: Param,
-    /// V_T0 [V].
+    /// V_T0 \[V\].
     pub diode_threshold: Param,
-    /// E_rr [J].
+    /// E_rr \[J\].
     pub recovery_energy: Param,
 }
 

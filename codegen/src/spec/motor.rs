@@ -14,15 +14,15 @@ use crate::units::Kind;
 /// Optional harmonic data (thesis B 2.14–2.16, 2.23), SI.
 #[derive(Debug, Clone, PartialEq, Default)]
 pub struct Harmonics {
-    /// ψ_d,6 [Wb].
+    /// ψ_d,6 \[Wb\].
     pub d_flux_6: Option<Param>,
-    /// ψ_d,12 [Wb].
+    /// ψ_d,12 \[Wb\].
     pub d_flux_12: Option<Param>,
-    /// ψ_q,6 [Wb].
+    /// ψ_q,6 \[Wb\].
     pub q_flux_6: Option<Param>,
-    /// ψ_q,12 [Wb].
+    /// ψ_q,12 \[Wb\].
     pub q_flux_12: Option<Param>,
-    /// L_6 [H].
+    /// L_6 \[H\].
     pub inductance_6: Option<Param>,
 }
 
@@ -31,19 +31,19 @@ pub struct Harmonics {
 pub struct Motor {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub phase_resistance: Param,
-    /// L_d [H].
+    /// L_d \[H\].
     pub d_inductance: Param,
-    /// L_q [H].
+    /// L_q \[H\].
     pub q_inductance: Param,
-    /// ψ_M [Wb], if known or derivable.
+    /// ψ_M \[Wb\], if known or derivable.
     pub flux_linkage: Option<Param>,
     /// Every form in which the spec gives ψ_M (directly, K_t, K_e, k_n), for the cross-check.
     pub flux_sources: Vec<FluxSource>,
-    /// Rated current, rms [A].
+    /// Rated current, rms \[A\].
     pub nominal_current: Option<Param>,
-    /// Peak current, rms [A].
+    /// Peak current, rms \[A\].
     pub peak_current: Param,
     /// Maximum mechanical speed [rad/s].
     pub max_speed: Param,
@@ -51,11 +51,11 @@ pub struct Motor {
     pub nominal_torque: Option<Param>,
     /// Peak torque [N·m].
     pub peak_torque: Option<Param>,
-    /// Rated electrical frequency f_n [Hz] (given, or from the nominal speed).
+    /// Rated electrical frequency f_n \[Hz\] (given, or from the nominal speed).
     pub rated_frequency: Option<Param>,
     /// Nominal shaft speed [rad/s], if given (f_n comes from it when `rated_frequency` is not).
     pub nominal_speed: Option<Param>,
-    /// Rated power [W].
+    /// Rated power \[W\].
     pub rated_power: Option<Param>,
     /// Rotor inertia J [kg·m²].
     pub inertia: Option<Param>,
@@ -63,7 +63,7 @@ pub struct Motor {
     pub viscous_friction: Option<Param>,
     /// Harmonic data.
     pub harmonics: Harmonics,
-    /// L_q(|i_q|) curve points ([A], [H]), sorted by current.
+    /// L_q(|i_q|) curve points (\[A\], \[H\]), sorted by current.
     pub q_saturation: Vec<(f64, f64)>,
     /// Winding connection, if stated.
     pub connection: Option<Connection>,

@@ -10,7 +10,7 @@ use super::{Param, Provenance};
 pub struct Resolver {
     /// n_r.
     pub pole_pairs: u32,
-    /// θ_off [rad] in resolver angle (4.5), if known.
+    /// θ_off \[rad\] in resolver angle (4.5), if known.
     pub offset: Option<Param>,
 }
 

@@ -56,11 +56,11 @@ pub struct SensorlessSpec {
     pub bandwidth: Option<Param>,
     /// Largest shaft acceleration [rad/s², mechanical], if given.
     pub max_acceleration: Option<Param>,
-    /// θ̃_max [rad] (default 10°).
+    /// θ̃_max \[rad\] (default 10°).
     pub max_angle_error: Option<Param>,
     /// ω_e [rad/s], if given.
     pub injection_frequency: Option<Param>,
-    /// V_e [V], if given.
+    /// V_e \[V\], if given.
     pub injection_voltage: Option<Param>,
     /// ω_hp [rad/s], if given.
     pub highpass: Option<Param>,
@@ -146,7 +146,7 @@ impl Resolver_<'_> {
     }
 }
 
-/// θ̃_max [rad] of the spec, or the default 10°.
+/// θ̃_max \[rad\] of the spec, or the default 10°.
 pub fn angle_error_rad(s: &SensorlessSpec) -> (f64, Provenance) {
     s.max_angle_error
         .as_ref()

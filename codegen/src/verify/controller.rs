@@ -16,7 +16,7 @@ use crate::design::Design;
 use crate::design::current_loop::AxisGains;
 use crate::spec::ObserverError;
 
-/// TIM1 kernel clock [Hz]: the STM32G474's maximum SYSCLK (170 MHz, STM32G474 datasheet),
+/// TIM1 kernel clock \[Hz\]: the STM32G474's maximum SYSCLK (170 MHz, STM32G474 datasheet),
 /// as the firmware bench assumes; with centre-aligned PWM the auto-reload is
 /// `TIMER_CLOCK_HZ/(2·f_s)` (4250 at 20 kHz). Only the telemetry compare values use it;
 /// the simulated inverter applies the duties.
@@ -31,7 +31,7 @@ fn axis(g: &AxisGains) -> PiConfig {
         ki: g.ki as f32,
         anti_windup: g.anti_windup_gain as f32,
         active_damping: g.active_damping_ohm as f32,
-        reference_filter: g.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient as f32),
+        reference_filter: g.reference_filter as f32,
     }
 }
 

@@ -21,10 +21,11 @@ use motor_control::estimator::{EstimatorInput, EstimatorState, InjectionConfig, 
 use motor_control::step::{Demand, StepOutput};
 use motor_control::transforms::Dq;
 
-use super::plant::{SpeedProfile, wrap};
-use super::sim::{Bench, angle_q31};
 use super::{Check, ScenarioResult, Setup, format_value, series};
 use crate::design::Design;
+use motor_control::angle::from_radians_f64;
+use motor_sim::bench::Bench;
+use motor_sim::plant::{SpeedProfile, wrap};
 
 /// Initial speed error in units of ρ: Fig. 4.17's 0.5 pu drop at ρ = 0.1 pu.
 pub const INITIAL_ERROR_RHO: f64 = 5.0;
@@ -105,7 +106,7 @@ fn simulate(s: &Setup<'_>, c: &EstimatorConfig, w: f64, seconds: f64) -> Run {
     let mut b = Bench::new(s.cfg, s.plant(SpeedProfile::constant(w / np)));
     let rho = f64::from(c.rho);
     let mut st = EstimatorState {
-        theta: angle_q31(b.plant.theta_e()),
+        theta: from_radians_f64(b.plant.theta_e()),
         omega: (w + INITIAL_ERROR_RHO * rho) as f32,
         ..EstimatorState::default()
     };

@@ -18,11 +18,11 @@ use motor_control::field_weakening::{FieldWeakeningInput, FieldWeakeningState, M
 use motor_control::step::{Demand, StepOutput};
 use motor_control::transforms::{Dq, INV_SQRT_3};
 
-use super::plant::{MotorModel, SpeedProfile};
 use super::scenarios::trace;
-use super::sim::Bench;
 use super::{Check, ScenarioResult, Setup, format_value, series};
 use crate::design::Design;
+use motor_sim::bench::Bench;
+use motor_sim::plant::{MotorModel, Shaft, SpeedProfile};
 
 /// Electrical base speed ω_base [rad/s] of (2.60), from the design.
 pub fn base_speed(d: &Design) -> Option<f64> {
@@ -77,7 +77,7 @@ pub fn torque(m: &MotorModel, id: f64, iq: f64) -> f64 {
     1.5 * f64::from(m.pole_pairs) * iq * (m.psi + (m.ld - m.lq_at(iq)) * id)
 }
 
-/// Steady-state |v| [V] of the simulated machine at speed `w` (2.52), harmonics left out.
+/// Steady-state |v| \[V\] of the simulated machine at speed `w` (2.52), harmonics left out.
 pub fn steady_voltage(m: &MotorModel, w: f64, id: f64, iq: f64) -> f64 {
     let vd = m.resistance * id - w * m.lq_at(iq) * iq;
     let vq = m.resistance * iq + w * (m.ld * id + m.psi);
@@ -208,7 +208,7 @@ pub fn run(s: &Setup<'_>, fw: Option<FieldWeakeningConfig>) -> ScenarioResult {
         (vec![], vec![], vec![], vec![], vec![], vec![], vec![]);
     let (mut peak_v, mut peak_i) = (0.0f64, 0.0f64);
     for _ in 0..n {
-        b.plant.speed = segment(b.plant.t);
+        b.plant.shaft = Shaft::Imposed(segment(b.plant.t));
         let v_max = s.cfg.voltage_margin * effective_dc_link(prev.u_dc, s.cfg.dc_link_min) * INV_SQRT_3;
         let (id_ref, iq_ref) = fw.process(
             &mut st,

@@ -1,45 +1,9 @@
 //! Figures of sampled responses and of the designed (continuous) responses they are
-//! compared with.
+//! compared with (the sampled figures themselves are [`motor_sim::figures`]).
 
-/// Step-response figures of a sampled signal.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct StepFigures {
-    /// 10–90 % rise time [s] (linear interpolation between samples); NaN if never reached.
-    pub rise_time: f64,
-    /// Peak beyond the target, as a fraction of the step height (≥ 0).
-    pub overshoot: f64,
-    /// (last sample − target)/height.
-    pub final_error: f64,
-}
+use motor_sim::figures::crossing;
 
-/// Time [s] at which `samples` (spaced `dt`) first crosses `initial + level·(target − initial)`.
-pub fn crossing(samples: &[f64], dt: f64, initial: f64, target: f64, level: f64) -> f64 {
-    let height = target - initial;
-    let y = initial + level * height;
-    for n in 1..samples.len() {
-        let (a, b) = (samples[n - 1] - y, samples[n] - y);
-        if a * height.signum() < 0.0 && b * height.signum() >= 0.0 {
-            return ((n - 1) as f64 + a.abs() / (a.abs() + b.abs())) * dt;
-        }
-    }
-    f64::NAN
-}
-
-/// Rise time, overshoot and final error of a step from `initial` to `target`.
-pub fn step_figures(samples: &[f64], dt: f64, initial: f64, target: f64) -> StepFigures {
-    let height = target - initial;
-    let peak = samples
-        .iter()
-        .map(|&v| (v - initial) / height)
-        .fold(f64::NEG_INFINITY, f64::max);
-    StepFigures {
-        rise_time: crossing(samples, dt, initial, target, 0.9) - crossing(samples, dt, initial, target, 0.1),
-        overshoot: (peak - 1.0).max(0.0),
-        final_error: samples.last().map_or(f64::NAN, |&v| (v - target) / height),
-    }
-}
-
-/// Unit step response of the designed closed loop at `t` [s]: first order
+/// Unit step response of the designed closed loop at `t` \[s\]: first order
 /// `1 − e^(−αt)` (thesis A (5.8), thesis B (2.41)) when `zeta` is `None`, else the
 /// second-order system of thesis A (4.14) with ω_n, ζ (the prefilter (5.16) having
 /// cancelled the zero).
@@ -59,7 +23,7 @@ pub fn designed_step(t: f64, alpha: f64, second_order: Option<(f64, f64)>) -> f6
     }
 }
 
-/// 10–90 % rise time of [`designed_step`] [s], found on a grid of 1/(2000·α).
+/// 10–90 % rise time of [`designed_step`] \[s\], found on a grid of 1/(2000·α).
 pub fn designed_rise_time(alpha: f64, second_order: Option<(f64, f64)>) -> f64 {
     let dt = 1.0 / (2000.0 * alpha);
     let y: Vec<f64> = (0..40_000)
@@ -68,18 +32,10 @@ pub fn designed_rise_time(alpha: f64, second_order: Option<(f64, f64)>) -> f64 {
     crossing(&y, dt, 0.0, 1.0, 0.9) - crossing(&y, dt, 0.0, 1.0, 0.1)
 }
 
-/// Time [s] after which `|x|` stays below `threshold`; `None` if the last sample is not.
-pub fn settling_time(x: &[f64], dt: f64, threshold: f64) -> Option<f64> {
-    match x.iter().rposition(|v| v.abs() >= threshold) {
-        None => Some(0.0),
-        Some(k) if k + 1 < x.len() => Some((k + 1) as f64 * dt),
-        Some(_) => None,
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use motor_sim::figures::step_figures;
 
     /// ln 9/α for a first-order loop (thesis A (5.8)): α = 100 rad/s → 21.97 ms.
     #[test]
@@ -106,12 +62,5 @@ mod tests {
             "{}",
             f.overshoot
         );
-    }
-
-    #[test]
-    fn settling() {
-        let x = [5.0, 3.0, 0.5, 2.0, 0.1, 0.05];
-        assert_eq!(settling_time(&x, 1.0, 1.0), Some(4.0));
-        assert_eq!(settling_time(&x, 1.0, 0.01), None);
     }
 }

@@ -160,7 +160,7 @@ pub fn observer_designed(d: &Design, omega: &[f64]) -> Response {
 }
 
 /// Frequency response of the quantised FIR at `n` frequencies from 0 to f_s/2; the grid is
-/// in Hz here (`omega` holds f [Hz]).
+/// in Hz here (`omega` holds f \[Hz\]).
 pub fn fir(d: &Design, n: usize) -> Response {
     let fs = d.drive.switching_frequency_hz;
     let f: Vec<f64> = (0..n).map(|k| 0.5 * fs * k as f64 / (n - 1).max(1) as f64).collect();

@@ -10,10 +10,11 @@
 //!
 //! | module | what |
 //! |---|---|
-//! | [`plant`] | PMSM dq model, inverter, sensors |
+//! | [`motor_sim::plant`] | PMSM dq model, inverter, sensors (shared with the control core's tests) |
 //! | [`controller`] | [`ControllerConfig`] from a [`Design`] |
-//! | [`sim`] | controller + plant with the thesis-A §4.6 timing |
-//! | [`figures`] | rise time, overshoot, settling; designed responses |
+//! | [`motor_sim::bench`] | controller + plant with the thesis-A §4.6 timing |
+//! | [`motor_sim::figures`] | rise time, overshoot, settling of sampled responses |
+//! | [`figures`] | the designed responses they are compared with |
 //! | [`scenarios`] | the scenarios and their criteria |
 //! | [`frequency`] | frequency responses of the discrete designs (for the report) |
 //! | [`field_weakening`] | field weakening to 2× base speed (thesis B Fig. 2.15) |
@@ -24,9 +25,7 @@ pub mod estimator;
 pub mod field_weakening;
 pub mod figures;
 pub mod frequency;
-pub mod plant;
 pub mod scenarios;
-pub mod sim;
 
 use std::fmt::Write as _;
 
@@ -36,8 +35,8 @@ use serde::Serialize;
 use crate::design::Design;
 use crate::diagnostic::{Diagnostics, Source};
 use crate::spec::Spec;
-use plant::{MotorModel, Plant, SpeedProfile};
-use sim::Bench;
+use motor_sim::bench::Bench;
+use motor_sim::plant::{MotorModel, Plant, Shaft, SpeedProfile};
 
 /// One measured figure and its criterion.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -80,7 +79,7 @@ pub struct Trace {
     pub title: String,
     /// y-axis label with unit.
     pub y_label: String,
-    /// Time points [ms].
+    /// Time points \[ms\].
     pub t_ms: Vec<f64>,
     /// The signals.
     pub series: Vec<Series>,
@@ -232,18 +231,16 @@ impl<'a> Setup<'a> {
 
     /// A plant at rest at θ_m = 0 with the nominal DC link and the given speed profile.
     pub fn plant(&self, speed: SpeedProfile) -> Plant {
-        Plant {
-            motor: self.motor.clone(),
-            speed,
-            resolver_pole_pairs: self.design.angle_observer.resolver_pole_pairs,
-            resolver_offset: controller::resolver_offset_rad(self.design),
-            ts: self.design.drive.sample_period_s,
-            t: 0.0,
-            i: [0.0, 0.0],
-            theta_m: 0.0,
-            dc_link: self.design.drive.dc_link_voltage_v,
-            pending: None,
-        }
+        let d = self.design;
+        let mut p = Plant::new(
+            self.motor.clone(),
+            Shaft::Imposed(speed),
+            d.drive.sample_period_s,
+            d.drive.dc_link_voltage_v,
+        );
+        p.resolver_pole_pairs = d.angle_observer.resolver_pole_pairs;
+        p.resolver_offset = controller::resolver_offset_rad(d);
+        p
     }
 
     /// Controller + plant at a constant mechanical speed [rad/s], observer locked.

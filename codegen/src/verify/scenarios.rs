@@ -18,12 +18,14 @@ use std::f64::consts::PI;
 use motor_control::ato::AtoState;
 use motor_control::step::Demand;
 
-use super::figures::{designed_rise_time, designed_step, settling_time, step_figures};
-use super::plant::{SpeedProfile, wrap};
-use super::sim::{Bench, angle_q31, q31_angle};
+use super::figures::{designed_rise_time, designed_step};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use crate::design::discrete_loop::step_response;
 use crate::spec::{Method, ObserverError};
+use motor_control::angle::from_radians_f64;
+use motor_sim::bench::{Bench, q31_angle};
+use motor_sim::figures::{settling_time, step_figures};
+use motor_sim::plant::{SpeedProfile, wrap};
 
 /// Most points kept per trace (the report plots them; more adds bytes, not information).
 const TRACE_POINTS: usize = 1500;
@@ -86,7 +88,7 @@ fn samples(s: &Setup<'_>, seconds: f64) -> usize {
     (seconds / s.design.drive.sample_period_s).ceil() as usize
 }
 
-/// Current step height [A]: a quarter of the current-circle radius √2·I_peak, kept so
+/// Current step height \[A\]: a quarter of the current-circle radius √2·I_peak, kept so
 /// that the proportional kick k_p·Δi stays within half the voltage circle (so the
 /// linear design is what is measured, not the voltage limit).
 pub fn step_amplitude(s: &Setup<'_>) -> f64 {
@@ -445,7 +447,7 @@ pub fn dc_link_step(s: &Setup<'_>) -> ScenarioResult {
     }
 }
 
-/// Time [s] for the continuous ATO (thesis A (4.12)–(4.14)) started `e0` rad off at rest
+/// Time \[s\] for the continuous ATO (thesis A (4.12)–(4.14)) started `e0` rad off at rest
 /// to stay within `threshold`: ë + K_p·ė + K_i·e = 0, e(0) = e0, ė(0) = −K_p·e0.
 pub fn designed_lock_time(kp: f64, ki: f64, e0: f64, threshold: f64) -> f64 {
     let wn = ki.sqrt();
@@ -469,9 +471,9 @@ pub fn designed_lock_time(kp: f64, ki: f64, e0: f64, threshold: f64) -> f64 {
     last_out
 }
 
-/// Initial observer error of [`ato_lock`] [rad].
+/// Initial observer error of [`ato_lock`] \[rad\].
 pub const LOCK_INITIAL_ERROR: f64 = PI / 2.0;
-/// Lock threshold [rad] (1°).
+/// Lock threshold \[rad\] (1°).
 pub const LOCK_THRESHOLD: f64 = PI / 180.0;
 
 /// Observer started π/2 away from the resolver angle at standstill (gates off).
@@ -479,7 +481,7 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
     let o = &s.design.angle_observer;
     let ts = s.design.drive.sample_period_s;
     let mut b = s.bench(0.0);
-    b.state.observer = AtoState::locked(angle_q31(b.plant.theta_r() - LOCK_INITIAL_ERROR), 0);
+    b.state.observer = AtoState::locked(from_radians_f64(b.plant.theta_r() - LOCK_INITIAL_ERROR), 0);
     let wn = o.natural_frequency_rad_s;
     let n = samples(s, 25.0 / (o.damping.min(1.0) * wn));
     let mut e = Vec::with_capacity(n);

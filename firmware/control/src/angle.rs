@@ -11,6 +11,24 @@ pub fn to_radians(theta: i32) -> f32 {
     theta as f32 * RADIANS_PER_LSB
 }
 
+/// Radians → π-scaled Q1.31 (4.20), truncating and saturating: for the angle increments
+/// and small angles (|θ| < π) the control step computes in `f32`.
+pub fn from_radians(rad: f32) -> i32 {
+    (rad / RADIANS_PER_LSB) as i32
+}
+
+/// Any angle [rad] → π-scaled Q1.31 stored integer (4.20), rounded to nearest and
+/// wrapped into one turn: θ and θ + 2π give the same integer, +π gives −2^31 (= −π).
+/// The host-side conversion: the code generator writes θ_off with it, and the
+/// simulations lock the observer with it.
+pub fn from_radians_f64(rad: f64) -> i32 {
+    // θ/π + 1 reduced into [0, 2) (Euclidean remainder; fmod is exact), minus 1: [−1, 1).
+    let r = libm::fmod(rad / core::f64::consts::PI + 1.0, 2.0);
+    let wrapped = if r < 0.0 { r + 2.0 } else { r } - 1.0;
+    // |wrapped·2^31| ≤ 2^31: the i64 is exact; +2^31 (θ just below +π) wraps to −2^31.
+    libm::round(wrapped * 2_147_483_648.0) as i64 as i32
+}
+
 /// Observer speed stored integer → rad/s: `ω = 2^-31·f_s·π·ω^i` (4.20), where
 /// `rad_per_s_per_lsb = π·f_s/2^31` (a configuration constant, see
 /// [`crate::step::ControllerConfig::speed_per_lsb`]).
@@ -152,6 +170,25 @@ mod tests {
     /// f64 reference: angle in turns, wrapped to [−0.5, 0.5).
     fn wrap_turns(x: f64) -> f64 {
         x - (x + 0.5).floor()
+    }
+
+    /// Hand values of (4.20): π/2 ↔ 2^30, −π/2 ↔ −2^30, π ↔ −2^31 (one turn wraps),
+    /// 3π/2 ≡ −π/2, 2π + 0.3 ≡ 0.3, and 0.6 LSB rounds to 1 LSB.
+    #[test]
+    fn radians_to_stored_integer() {
+        use core::f64::consts::PI;
+        assert_eq!(from_radians_f64(0.0), 0);
+        assert_eq!(from_radians_f64(PI / 2.0), 1 << 30);
+        assert_eq!(from_radians_f64(-PI / 2.0), -(1 << 30));
+        assert_eq!(from_radians_f64(PI), i32::MIN);
+        assert_eq!(from_radians_f64(-PI), i32::MIN);
+        assert_eq!(from_radians_f64(1.5 * PI), -(1 << 30));
+        assert_eq!(from_radians_f64(2.0 * PI + 0.3), from_radians_f64(0.3));
+        assert_eq!(from_radians_f64(0.6 * PI / 2_147_483_648.0), 1);
+        // 0.3 rad = 0.3/π·2^31 = 205 069 582.67 LSB.
+        assert_eq!(from_radians_f64(0.3), 205_069_583);
+        // The f32 form truncates, within the f32 resolution (24 bits: 2^28/2^24 = 16 LSB here).
+        assert!((from_radians(0.3) - 205_069_583).abs() < 64);
     }
 
     fn turns(i: i32) -> f64 {

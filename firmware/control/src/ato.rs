@@ -23,6 +23,7 @@
 //! constant angle error `a/K_i`. Quantisation leaves a dead zone: the integral term
 //! `K̃_i·ẽ^i` rounds to 0 while `|ẽ^i| < 2^30/K̃_i^i`.
 
+use crate::q31;
 use crate::trig::Trig;
 use fixed::types::I1F31;
 
@@ -84,11 +85,6 @@ pub struct ResolverSample {
     pub cos: i32,
 }
 
-/// `round(a·b/2^31)` in `i64`; the caller keeps |a| ≤ 2^31 and |b| ≤ 2^32.
-fn mul_q31(a: i64, b: i64) -> i64 {
-    a.saturating_mul(b).saturating_add(1 << 30) >> 31
-}
-
 impl AtoConfig {
     /// Observation error ẽ^i(n) for the measured sample and the predicted θ̂^i(n).
     pub fn observation_error<T: Trig>(&self, trig: &mut T, resolver: ResolverSample, theta_hat: i32) -> i32 {
@@ -117,8 +113,8 @@ impl AtoConfig {
         let e = self.observation_error(trig, resolver, theta);
         let e_prev = i64::from(state.error);
         // (4.22), i64 throughout, saturated once at the end.
-        let integral = mul_q31(i64::from(self.ki.to_bits()), e_prev);
-        let proportional = mul_q31(i64::from(self.kp.to_bits()), i64::from(e).saturating_sub(e_prev));
+        let integral = q31::mul(i64::from(self.ki.to_bits()), e_prev);
+        let proportional = q31::mul(i64::from(self.kp.to_bits()), i64::from(e).saturating_sub(e_prev));
         let omega = i64::from(state.omega)
             .saturating_add(integral)
             .saturating_add(proportional);

@@ -25,7 +25,7 @@
 //! carrier `V_e·cos ω_e t` (4.15) is returned for the d axis while |ω̂| ≤ 1.1·ω_hs (as in
 //! Appendix D) and is added by [`crate::step::ControllerConfig::process_at_angle`].
 
-use crate::angle::RADIANS_PER_LSB;
+use crate::angle::from_radians;
 use crate::transforms::Dq;
 use crate::trig::Trig;
 
@@ -168,11 +168,6 @@ pub struct EstimatorOutput {
     pub error: f32,
 }
 
-/// Radians → π-scaled Q1.31 (saturating cast; only increments, |x| < π, pass through).
-fn to_q31(rad: f32) -> i32 {
-    (rad / RADIANS_PER_LSB) as i32
-}
-
 impl EstimatorConfig {
     /// f_tr(ω̂) (Fig. 4.9): 1 up to ω_ls, linear to 0 at ω_hs, 0 above; 0 without injection.
     pub fn blend(&self, omega: f32) -> f32 {
@@ -227,10 +222,10 @@ impl EstimatorConfig {
         // Signal injection (4.15)–(4.20).
         let (e_si, injection) = match self.injection {
             Some(inj) => {
-                state.carrier = state.carrier.wrapping_add(to_q31(inj.frequency * ts));
+                state.carrier = state.carrier.wrapping_add(from_radians(inj.frequency * ts));
                 let carrier = trig.sin_cos(state.carrier).to_f32();
                 let demod = trig
-                    .sin_cos(state.carrier.wrapping_sub(to_q31(inj.delay * inj.frequency * ts)))
+                    .sin_cos(state.carrier.wrapping_sub(from_radians(inj.delay * inj.frequency * ts)))
                     .to_f32();
                 let (_, iq_high) = state.highpass.process(inj.highpass, ts, input.current.q);
                 let (e_si, _) = state.lowpass.process(inj.lowpass, ts, iq_high * demod.sin);
@@ -275,12 +270,12 @@ impl EstimatorConfig {
         state.omega = if omega.is_finite() { omega } else { 0.0 };
         state.theta = state
             .theta
-            .wrapping_add(to_q31(ts * (state.omega + 2.0 * self.rho * e)));
+            .wrapping_add(from_radians(ts * (state.omega + 2.0 * self.rho * e)));
 
         EstimatorOutput {
             theta: state.theta,
             omega: state.omega,
-            omega_increment: to_q31(state.omega * ts),
+            omega_increment: from_radians(state.omega * ts),
             injection,
             iq_limit: self.iq_limit(gamma0),
             gamma0,
@@ -334,7 +329,7 @@ mod tests {
     fn track(c: &EstimatorConfig, w: f32, theta_err0: f32, omega_err0: f32, seconds: f32) -> (Vec<(f32, f32)>, i32) {
         let ts = c.sample_period;
         let mut st = EstimatorState {
-            theta: to_q31(-theta_err0),
+            theta: from_radians(-theta_err0),
             omega: w - omega_err0,
             ..EstimatorState::default()
         };
@@ -491,7 +486,7 @@ mod tests {
         let mut e = 0.0;
         for n in 0..40_000u32 {
             // The carrier phase the estimator will use at this step.
-            let phase = to_radians(st.carrier.wrapping_add(to_q31(inj.frequency * ts)));
+            let phase = to_radians(st.carrier.wrapping_add(from_radians(inj.frequency * ts)));
             let iq = 2.0 * ke * libm::sinf(phase) * libm::sinf(2.0 * err) + 30.0;
             let out = c.process(
                 &mut st,

@@ -20,6 +20,7 @@
 
 use core::f32::consts::{FRAC_PI_2, FRAC_PI_4, PI};
 
+use crate::q31;
 use crate::trig::{SinCosQ31, Trig};
 
 /// Floating-point software implementation of [`Trig`] (see the module docs).
@@ -28,8 +29,6 @@ pub struct FastTrig;
 
 /// Radians per LSB of the π-scaled Q1.31 angle: π/2^31.
 const RAD_PER_LSB: f32 = PI / 2_147_483_648.0;
-/// 2^31: a real value in [−1, 1] → Q1.31 stored integer.
-const Q31_ONE: f32 = 2_147_483_648.0;
 /// 2^31/π: radians → π-scaled Q1.31 angle.
 const LSB_PER_RAD: f32 = 2_147_483_648.0 / PI;
 /// A quarter turn in the π-scaled angle (π/2 ↔ 2^30).
@@ -62,11 +61,6 @@ fn atan_poly(u: f32) -> f32 {
     u * (1.0 + u2 * tail)
 }
 
-/// A real value in [−1, 1] as a Q1.31 stored integer (saturating).
-fn to_q31(v: f32) -> i32 {
-    (v * Q31_ONE) as i32
-}
-
 /// sin θ and cos θ of the π-scaled angle `theta` (4.20), Q1.31.
 pub fn sin_cos_fast(theta: i32) -> SinCosQ31 {
     // Nearest quarter turn k and the remainder r ∈ [−2^29, 2^29) (wrapping: angles).
@@ -83,8 +77,8 @@ pub fn sin_cos_fast(theta: i32) -> SinCosQ31 {
         _ => (-c, s),
     };
     SinCosQ31 {
-        sin: to_q31(sin),
-        cos: to_q31(cos),
+        sin: q31::from_f32(sin),
+        cos: q31::from_f32(cos),
     }
 }
 

@@ -65,6 +65,33 @@ const fn wrap_acc(x: i32) -> i32 {
     (x << (32 - ACC_BITS)) >> (32 - ACC_BITS)
 }
 
+/// One output sample y(n) = Σ_k b_k·x(n−k) (Q1.15) computed as the FMAC does, from the
+/// taps and the input history newest first (`history` yields x(n), x(n−1), …): the pairs
+/// run to the shorter of the two, so a short history counts as cleared (zero) samples.
+/// `gain_shift` is the output gain R (2^R, 0..=7; larger values are treated as 7) and
+/// `clip` is CLIPEN. [`FmacFir::process`] runs this on its ring buffer; the code
+/// generator checks its filter designs and identification against it.
+pub fn output<'a>(taps: &[i16], history: impl IntoIterator<Item = &'a i16>, gain_shift: u8, clip: bool) -> i16 {
+    let mut acc: i32 = 0;
+    for (&b, &s) in taps.iter().zip(history) {
+        // Q1.15·Q1.15 = Q2.30, |product| ≤ 2^30; drop 8 LSBs → q4.22 term,
+        // |term| ≤ 2^22; acc stays within 26 bits, so neither operation can
+        // saturate — the only wrap is the accumulator's own, in `wrap_acc`.
+        let term = i32::from(b).saturating_mul(i32::from(s)) >> 8;
+        acc = wrap_acc(acc.saturating_add(term));
+    }
+    // Output stage: gain 2^R, bits \[22:7\] → Q1.15, clip or truncate.
+    let r = u32::from(gain_shift.min(7));
+    // |acc| < 2^25, so acc·2^R < 2^32 in i64.
+    let y = (i64::from(acc) << r) >> 7;
+    if clip {
+        y.clamp(i64::from(i16::MIN), i64::from(i16::MAX)) as i16
+    } else {
+        // Unused high bits dropped: keep the low 16 bits.
+        y as i16
+    }
+}
+
 impl<const N: usize> FmacFir<N> {
     /// A filter with output gain 1 (R = 0) and clipping on.
     pub const fn new(taps: [i16; N]) -> Self {
@@ -92,28 +119,7 @@ impl<const N: usize> FmacFir<N> {
             None => (&[][..], &state.samples[..]),
         };
         let history = newer.iter().rev().chain(older_wrapped.iter().rev());
-        let mut acc: i32 = 0;
-        for (&b, &s) in self.taps.iter().zip(history) {
-            // Q1.15·Q1.15 = Q2.30, |product| ≤ 2^30; drop 8 LSBs → q4.22 term,
-            // |term| ≤ 2^22; acc stays within 26 bits, so neither operation can
-            // saturate — the only wrap is the accumulator's own, in `wrap_acc`.
-            let term = i32::from(b).saturating_mul(i32::from(s)) >> 8;
-            acc = wrap_acc(acc.saturating_add(term));
-        }
-        self.output(acc)
-    }
-
-    /// Output stage: gain 2^R, bits \[22:7\] → Q1.15, clip or truncate.
-    fn output(&self, acc: i32) -> i16 {
-        let r = u32::from(self.gain_shift.min(7));
-        // |acc| < 2^25, so acc·2^R < 2^32 in i64.
-        let y = (i64::from(acc) << r) >> 7;
-        if self.clip {
-            y.clamp(i64::from(i16::MIN), i64::from(i16::MAX)) as i16
-        } else {
-            // Unused high bits dropped: keep the low 16 bits.
-            y as i16
-        }
+        output(&self.taps, history, self.gain_shift, self.clip)
     }
 
     /// Clears the sample history.
@@ -159,6 +165,23 @@ mod tests {
     fn run<const N: usize>(f: &FmacFir<N>, xs: &[i16]) -> Vec<i16> {
         let mut st = FirState::new();
         xs.iter().map(|&x| f.process(&mut st, x)).collect()
+    }
+
+    /// Hand values of the slice form: output gain, clipping, the 26-bit wrap and short
+    /// histories.
+    #[test]
+    fn gain_clip_wrap_by_hand() {
+        // Tap 0.5 (16384) × input 0.75 (24576) = 0.375; +6 dB ⇒ 0.75 = 24576.
+        assert_eq!(output(&[16384], &[24576], 1, true), 24576);
+        // +12 dB ⇒ 1.5: clipped to 32767, or truncated to 16 bits: 49152 − 65536 = −16384.
+        assert_eq!(output(&[16384], &[24576], 2, true), 32767);
+        assert_eq!(output(&[16384], &[24576], 2, false), -16384);
+        // The accumulator wraps at 26 bits: 9 products (−1)·(−1) = +1 sum to 9 ≥ 8 ⇒
+        // 9 − 16 = −7 ⇒ clipped to −1.
+        assert_eq!(output(&[i16::MIN; 9], &[i16::MIN; 9], 0, true), i16::MIN);
+        // A history shorter than the taps: the missing (older) samples count as zero.
+        assert_eq!(output(&[16384, 16384], &[8192], 0, true), 4096);
+        assert_eq!(output(&[], &[], 0, true), 0);
     }
 
     #[test]

@@ -13,6 +13,7 @@
 //! | module | computes |
 //! |---|---|
 //! | [`transforms`] | Clarke (2.7), Park (2.8) and their inverses, `f32` |
+//! | [`q31`] | Q1.31 products and conversions (saturating) |
 //! | [`trig`] | Q1.31 sin/cos/atan2 behind the [`trig::Trig`] trait (CORDIC on target) |
 //! | [`angle`] | θ_e = n_p/n_r·(θ_r − θ_off) (4.5), angle lead (4.23), Q1.31 |
 //! | [`ato`] | angle tracking observer (4.19), (4.22), two error architectures |
@@ -59,6 +60,7 @@ pub mod field_weakening;
 pub mod fir;
 pub mod modulation;
 pub mod pi;
+pub mod q31;
 pub mod setpoint;
 pub mod step;
 pub mod transforms;

@@ -16,6 +16,8 @@
 //! Both use only `i64` integer arithmetic (Taylor polynomials in Horner form after
 //! octant reduction) and never panic.
 
+use crate::q31;
+
 /// sin θ and cos θ as Q1.31 stored integers (value = `i/2^31`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SinCosQ31 {
@@ -35,13 +37,8 @@ impl SinCosQ31 {
     }
 }
 
-/// `2^-31` as `f32` (exact).
-pub const Q31_LSB_F32: f32 = 1.0 / 2_147_483_648.0;
-
-/// Q1.31 stored integer → real value `i·2^-31`.
-pub fn q31_to_f32(i: i32) -> f32 {
-    i as f32 * Q31_LSB_F32
-}
+pub use q31::LSB_F32 as Q31_LSB_F32;
+pub use q31::to_f32 as q31_to_f32;
 
 /// Trigonometric primitives the control core needs, in the CORDIC's Q1.31 format.
 ///
@@ -79,19 +76,6 @@ const PI_Q32: u64 = 13_493_037_705;
 const INV_PI_Q32: i64 = 1_367_130_551;
 /// tan(π/8)·2^31, rounded: octant split point of the atan series.
 const TAN_PI_8_Q31: i64 = 889_516_852;
-
-/// `round(a·b/2^31)` for unsigned Q.31 magnitudes a, b ≤ 2^31: the product of two
-/// `u32` cannot overflow `u64` (≤ 2^62) and the rounded result is ≤ 2^31, so the
-/// saturating forms never saturate (the compiler reduces them to one UMULL).
-fn mul_q31_u(a: u32, b: u32) -> u32 {
-    let p = u64::from(a).saturating_mul(u64::from(b)).saturating_add(1 << 30) >> 31;
-    u32::try_from(p).unwrap_or(u32::MAX)
-}
-
-/// `round(a·b/2^31)` on `i64`, saturating (operands here are ≤ 2^32 in magnitude).
-fn mul_q31(a: i64, b: i64) -> i64 {
-    a.saturating_mul(b).saturating_add(1 << 30) >> 31
-}
 
 /// `round(n/d)` for `d > 0` (0 if `d` is not positive).
 fn div_round(n: i64, d: i64) -> i64 {
@@ -131,16 +115,16 @@ const INV_FACT: [u32; 13] = [
 /// is positive on this interval, so unsigned arithmetic suffices.
 fn sin_cos_octant(z: u32) -> (u32, u32) {
     let [c0, c1, c2, c3, c4, c5, c6, c7, c8, c9, c10, c11, c12] = INV_FACT;
-    let z2 = mul_q31_u(z, z);
+    let z2 = q31::mul_unsigned(z, z);
     let mut s = c11;
     for c in [c9, c7, c5, c3, c1] {
-        s = c.saturating_sub(mul_q31_u(z2, s));
+        s = c.saturating_sub(q31::mul_unsigned(z2, s));
     }
     let mut c = c12;
     for k in [c10, c8, c6, c4, c2, c0] {
-        c = k.saturating_sub(mul_q31_u(z2, c));
+        c = k.saturating_sub(q31::mul_unsigned(z2, c));
     }
-    (mul_q31_u(z, s), c)
+    (q31::mul_unsigned(z, s), c)
 }
 
 /// Saturates an `i64` Q.31 value to the `i32` range (1.0 → `i32::MAX`).
@@ -208,12 +192,12 @@ fn atan_first_octant(num: i64, den: i64) -> i64 {
         113_025_455,   // 1/19
         102_261_126,   // 1/21
     ];
-    let t2 = mul_q31(t, t);
+    let t2 = q31::mul(t, t);
     let mut p = 0;
     for c in INV_ODD.iter().rev() {
-        p = c.saturating_sub(mul_q31(t2, p));
+        p = c.saturating_sub(q31::mul(t2, p));
     }
-    let radians = mul_q31(t, p);
+    let radians = q31::mul(t, p);
     // radians (Q.31, |.| ≤ π/4·2^31) × 2^32/π → π-scaled angle.
     let scaled = radians.saturating_mul(INV_PI_Q32).saturating_add(1 << 31) >> 32;
     offset.saturating_add(scaled)

@@ -29,11 +29,11 @@ fn run_step(
             feed_forward,
         });
     }
-    let (mut d, mut q) = (vec![bench.plant.id], vec![bench.plant.iq]);
+    let (mut d, mut q) = (vec![bench.plant.i[0]], vec![bench.plant.i[1]]);
     for _ in 0..steps {
         bench.step(Demand::Current { id, iq, feed_forward });
-        d.push(bench.plant.id);
-        q.push(bench.plant.iq);
+        d.push(bench.plant.i[0]);
+        q.push(bench.plant.i[1]);
     }
     (d, q)
 }
@@ -77,7 +77,7 @@ fn imc_fischer_rise_time_and_no_overshoot() {
     assert!((kp - 0.393).abs() < 1e-12 && (ki - 126.0).abs() < 1e-9);
     for (axis, id, iq) in [("Fischer IMC α=1000 q", 0.0, 20.0), ("Fischer IMC α=1000 d", 20.0, 0.0)] {
         let cfg = config(m, current_loop(pi(alpha * m.ld, alpha * m.r), pi(kp, ki)));
-        let mut bench = Bench::new(cfg, Plant::new(m, Mechanics::FixedSpeed(0.0)));
+        let mut bench = Bench::new(cfg, plant(m, fixed_speed(0.0)));
         let (d, q) = run_step(&mut bench, 200, 600, id, iq, true);
         let samples = if id != 0.0 { d } else { q };
         assert_first_order(axis, &samples, 20.0, alpha);
@@ -95,7 +95,7 @@ fn imc_unimotor_rise_time_and_no_overshoot() {
     assert!((kpd - 0.54).abs() < 1e-12 && (kpq - 0.76).abs() < 1e-12 && (ki - 65.0).abs() < 1e-9);
     for (axis, id, iq) in [("Unimotor IMC α=100 q", 0.0, 5.0), ("Unimotor IMC α=100 d", 5.0, 0.0)] {
         let cfg = config(m, current_loop(pi(kpd, ki), pi(kpq, ki)));
-        let mut bench = Bench::new(cfg, Plant::new(m, Mechanics::FixedSpeed(0.0)));
+        let mut bench = Bench::new(cfg, plant(m, fixed_speed(0.0)));
         let (d, q) = run_step(&mut bench, 200, 4000, id, iq, true);
         let samples = if id != 0.0 { d } else { q };
         assert_first_order(axis, &samples, 5.0, alpha);
@@ -117,7 +117,7 @@ fn imc_active_damping_fischer() {
         ..pi(alpha * m.lq, alpha * (m.r + ra))
     };
     let cfg = config(m, current_loop(axis, axis));
-    let mut bench = Bench::new(cfg, Plant::new(m, Mechanics::FixedSpeed(0.0)));
+    let mut bench = Bench::new(cfg, plant(m, fixed_speed(0.0)));
     let (_, q) = run_step(&mut bench, 200, 600, 0.0, 20.0, true);
     assert_first_order("Fischer IMC+R_a α=1000 q", &q, 20.0, alpha);
 }
@@ -160,7 +160,7 @@ fn pole_placement_overshoot() {
             let mut overshoot = [0.0; 2];
             for shaped in [false, true] {
                 let cl = current_loop(design(m.ld, m.r, alpha, shaped), design(m.lq, m.r, alpha, shaped));
-                let mut bench = Bench::new(config(m, cl), Plant::new(m, Mechanics::FixedSpeed(0.0)));
+                let mut bench = Bench::new(config(m, cl), plant(m, fixed_speed(0.0)));
                 let (d, q) = run_step(&mut bench, 200, steps, id as f32, iq as f32, true);
                 let samples = if axis == "d" { d } else { q };
                 let f = step_figures(&samples, 0.0, target);
@@ -190,7 +190,7 @@ fn decoupling_cuts_id_excursion() {
     let wm = 3000.0 / f64::from(m.np);
     let mut excursion = [0.0f64; 2];
     for ff in [false, true] {
-        let mut bench = Bench::new(config(m, cl), Plant::new(m, Mechanics::FixedSpeed(wm)));
+        let mut bench = Bench::new(config(m, cl), plant(m, fixed_speed(wm)));
         // 0.1 s at i = 0 lets the integrators take over the back EMF without
         // feed-forward.
         let (d, q) = run_step(&mut bench, 2000, 600, 0.0, 50.0, ff);
@@ -215,7 +215,7 @@ fn imc_at_speed_with_feed_forward() {
     let m = FISCHER;
     let alpha = 1000.0;
     let cl = current_loop(pi(alpha * m.ld, alpha * m.r), pi(alpha * m.lq, alpha * m.r));
-    let mut bench = Bench::new(config(m, cl), Plant::new(m, Mechanics::FixedSpeed(2000.0 / 4.0)));
+    let mut bench = Bench::new(config(m, cl), plant(m, fixed_speed(2000.0 / 4.0)));
     let (_, q) = run_step(&mut bench, 2000, 600, 0.0, 20.0, true);
     assert_first_order("Fischer IMC α=1000 q at ω_e = 2000 rad/s", &q, 20.0, alpha);
 }
@@ -226,7 +226,7 @@ fn imc_at_speed_with_feed_forward() {
 fn electrical_angle_follows_rotor() {
     let m = FISCHER;
     let cl = current_loop(pi(0.393, 126.0), pi(0.393, 126.0));
-    let mut bench = Bench::new(config(m, cl), Plant::new(m, Mechanics::FixedSpeed(500.0)));
+    let mut bench = Bench::new(config(m, cl), plant(m, fixed_speed(500.0)));
     let mut worst = 0.0f64;
     for _ in 0..4000 {
         let th_true = bench.plant.theta_e();

@@ -9,11 +9,11 @@ use motor_control::commissioning::*;
 use motor_control::fir::{FirState, FmacFir};
 use motor_control::step::Demand;
 
-fn fischer_bench(mech: Mechanics) -> Bench {
+fn fischer_bench(shaft: Shaft) -> Bench {
     let m = FISCHER;
     let alpha = 1000.0;
     let cl = current_loop(pi(alpha * m.ld, alpha * m.r), pi(alpha * m.lq, alpha * m.r));
-    Bench::new(config(m, cl), Plant::new(m, mech))
+    Bench::new(config(m, cl), plant(m, shaft))
 }
 
 /// §6.2 on the Unimotor (Table 6.1), blocked rotor, 4 V step on q then on d:
@@ -25,7 +25,7 @@ fn blocked_rotor_step_identifies_r_and_l() {
     let m = UNIMOTOR;
     let cl = current_loop(pi(0.54, 65.0), pi(0.76, 65.0));
     for (axis, l_true) in [(Axis::Q, m.lq), (Axis::D, m.ld)] {
-        let mut bench = Bench::new(config(m, cl), Plant::new(m, Mechanics::FixedSpeed(0.0)));
+        let mut bench = Bench::new(config(m, cl), plant(m, fixed_speed(0.0)));
         let routine = VoltageStep {
             axis,
             voltage: 4.0,
@@ -57,7 +57,7 @@ fn blocked_rotor_step_identifies_r_and_l() {
         assert!((f64::from(est.inductance) / l_true - 1.0).abs() < 0.02);
     }
 
-    let mut bench = Bench::new(config(m, cl), Plant::new(m, Mechanics::FixedSpeed(0.0)));
+    let mut bench = Bench::new(config(m, cl), plant(m, fixed_speed(0.0)));
     let routine = VoltageStep {
         axis: Axis::Q,
         voltage: 10.0,
@@ -92,7 +92,7 @@ fn blocked_rotor_step_identifies_r_and_l() {
 fn filtered_step_identifies_r_and_l() {
     let m = UNIMOTOR;
     let cl = current_loop(pi(0.54, 65.0), pi(0.76, 65.0));
-    let mut bench = Bench::new(config(m, cl), Plant::new(m, Mechanics::FixedSpeed(0.0)));
+    let mut bench = Bench::new(config(m, cl), plant(m, fixed_speed(0.0)));
     let routine = VoltageStep {
         axis: Axis::Q,
         voltage: 4.0,
@@ -141,10 +141,7 @@ fn filtered_step_identifies_r_and_l() {
 /// With the identified offset, n_p·(θ_r − θ_off) equals the true θ_e.
 #[test]
 fn resolver_offset_by_alignment() {
-    let mut bench = fischer_bench(Mechanics::Free {
-        inertia: 1e-3,
-        damping: 0.05,
-    });
+    let mut bench = fischer_bench(free(1e-3, 0.05));
     bench.plant.theta_m = 1.0 / 4.0;
     bench.plant.resolver_offset = -2.0;
     bench.state.observer = motor_control::ato::AtoState::locked((bench.plant.theta_r() / PI * Q31) as i32, 0);
@@ -186,13 +183,10 @@ fn resolver_offset_by_alignment() {
 /// reversed resolver the directions disagree.
 #[test]
 fn pole_pair_ratio_and_direction() {
-    for (nr, sign, expected, agree) in [(1.0, 1.0, 4.0, true), (2.0, 1.0, 2.0, true), (1.0, -1.0, 4.0, false)] {
-        let mut bench = fischer_bench(Mechanics::Free {
-            inertia: 1e-3,
-            damping: 0.05,
-        });
+    for (nr, sign, expected, agree) in [(1, 1.0, 4.0, true), (2, 1.0, 2.0, true), (1, -1.0, 4.0, false)] {
+        let mut bench = fischer_bench(free(1e-3, 0.05));
         bench.plant.resolver_pole_pairs = nr;
-        bench.plant.resolver_sign = sign;
+        bench.plant.resolver_reversed = sign < 0.0;
         bench.state.observer = motor_control::ato::AtoState::locked((bench.plant.theta_r() / PI * Q31) as i32, 0);
         let routine = PolePairRatio {
             voltage: 1.0,
@@ -222,7 +216,7 @@ fn pole_pair_ratio_and_direction() {
 /// A locked rotor does not turn: the routine reports it.
 #[test]
 fn pole_pair_ratio_without_rotation() {
-    let mut bench = fischer_bench(Mechanics::FixedSpeed(0.0));
+    let mut bench = fischer_bench(fixed_speed(0.0));
     let routine = PolePairRatio {
         voltage: 1.0,
         step: 1 << 22,
@@ -244,7 +238,7 @@ fn pole_pair_ratio_without_rotation() {
 /// off: ψ_M = Σu_q/Σω_e (6.10) within 1 % of the plant's 0.058 Wb.
 #[test]
 fn flux_linkage_at_zero_current() {
-    let mut bench = fischer_bench(Mechanics::FixedSpeed(200.0));
+    let mut bench = fischer_bench(fixed_speed(200.0));
     let routine = FluxLinkage {
         settle_samples: 4000,
         average_samples: 4000,
@@ -265,7 +259,7 @@ fn flux_linkage_at_zero_current() {
     eprintln!("ψ_M estimate {psi:.5} Wb (plant 0.058)");
     assert!((f64::from(psi) / FISCHER.psi - 1.0).abs() < 0.01);
 
-    let mut bench = fischer_bench(Mechanics::FixedSpeed(5.0));
+    let mut bench = fischer_bench(fixed_speed(5.0));
     let mut st = FluxLinkageState::default();
     let (mut uq, mut we) = (0.0, 0.0);
     let r = loop {
@@ -284,7 +278,7 @@ fn flux_linkage_at_zero_current() {
 /// `Demand::Off` gives zero voltage: all duties 1/2, compare = round(0.5·4250).
 #[test]
 fn off_is_zero_voltage() {
-    let mut bench = fischer_bench(Mechanics::FixedSpeed(0.0));
+    let mut bench = fischer_bench(fixed_speed(0.0));
     let out = bench.step(Demand::Off);
     assert_eq!(out.duties, [0.5; 3]);
     assert_eq!(out.compare, [2125; 3]);

@@ -20,14 +20,16 @@
 //! else the repository `motorgen` was built from.
 
 use std::fmt::Write as _;
+use std::io::{BufRead, BufReader, Read};
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode, Stdio};
+use std::process::{Command, Stdio};
 
 use object::elf;
 use object::read::elf::{ElfFile32, FileHeader, ProgramHeader, SectionHeader};
 use object::{Endianness, Object, ObjectSection, ObjectSymbol};
 
-use crate::output::{err, errln, out};
+use crate::exit::{Exit, Failure};
+use crate::output::{errln, out};
 
 /// The firmware's target triple.
 const TARGET: &str = "thumbv7em-none-eabihf";
@@ -248,9 +250,15 @@ pub struct Target<'a> {
     pub boards: &'a Path,
 }
 
-/// Runs cargo for `stem`; returns the built ELF's path (from cargo's JSON messages).
-fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, String> {
+/// Runs cargo for `stem` on the board, relaying its progress (stderr) line by line as it
+/// comes; returns the built ELF's path (from cargo's JSON messages on stdout).
+fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, Failure> {
     let cargo = std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into());
+    let command = format!(
+        "MOTOR={stem} BOARD={} cargo build --release --target {TARGET} -p {PACKAGE}",
+        t.board
+    );
+    errln!("{stem}: {command} (in firmware/; a first build takes minutes)");
     let child = Command::new(&cargo)
         .args(["build", "--release", "--target", TARGET, "-p", PACKAGE])
         .args(["--message-format=json-render-diagnostics"])
@@ -262,30 +270,53 @@ fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, Strin
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn();
-    let output = match child.and_then(|c| c.wait_with_output()) {
-        Ok(o) => o,
+    let io = |what: String| Failure::new(Exit::Io, what);
+    let mut child = match child {
+        Ok(c) => c,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
-            return Err(format!(
-                "`{}` was not found: install Rust with rustup (https://rustup.rs), then \
+            return Err(io(format!(
+                "error: `{}` was not found: install Rust with rustup (https://rustup.rs), then \
                  `rustup target add {TARGET}`",
                 cargo.to_string_lossy()
-            ));
+            )));
         }
-        Err(e) => return Err(format!("cannot run {}: {e}", cargo.to_string_lossy())),
+        Err(e) => return Err(io(format!("error: cannot run {}: {e}", cargo.to_string_lossy()))),
     };
-    let stderr = String::from_utf8_lossy(&output.stderr);
-    if !output.status.success() {
+    let (Some(out), Some(err)) = (child.stdout.take(), child.stderr.take()) else {
+        return Err(io(format!(
+            "error: cannot read the output of {}",
+            cargo.to_string_lossy()
+        )));
+    };
+    // Progress and rendered diagnostics go to our stderr as they come; a copy is kept
+    // for the hint below. The JSON messages on stdout are read meanwhile.
+    let relay = std::thread::spawn(move || {
+        let mut seen = String::new();
+        for line in BufReader::new(err).lines().map_while(Result::ok) {
+            errln!("{line}");
+            seen.push_str(&line);
+            seen.push('\n');
+        }
+        seen
+    });
+    let mut stdout = String::new();
+    let read = BufReader::new(out).read_to_string(&mut stdout);
+    let status = child.wait();
+    let stderr = relay.join().unwrap_or_default();
+    let status = status
+        .and_then(|s| read.map(|_| s))
+        .map_err(|e| io(format!("error: {command}: {e}")))?;
+    if !status.success() {
         let hint = if stderr.contains("target may not be installed") || stderr.contains("can't find crate for `core`") {
             format!("\n  the {TARGET} target is missing: install it with `rustup target add {TARGET}`")
         } else {
             String::new()
         };
-        return Err(format!(
-            "MOTOR={stem} BOARD={} cargo build --release --target {TARGET} -p {PACKAGE} failed ({}):\n{stderr}{hint}",
-            t.board, output.status
+        return Err(Failure::new(
+            Exit::BuildFailed,
+            format!("error: {command} failed ({status}; its messages are above){hint}"),
         ));
     }
-    let stdout = String::from_utf8_lossy(&output.stdout);
     stdout
         .lines()
         .filter_map(|l| serde_json::from_str::<serde_json::Value>(l).ok())
@@ -293,21 +324,31 @@ fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, Strin
             m["reason"] == "compiler-artifact" && m["target"]["name"] == PACKAGE && m["target"]["kind"][0] == "bin"
         })
         .find_map(|m| m["executable"].as_str().map(PathBuf::from))
-        .ok_or_else(|| format!("cargo built no `{PACKAGE}` executable (is firmware/app a binary crate?)"))
+        .ok_or_else(|| {
+            Failure::new(
+                Exit::BuildFailed,
+                format!("error: cargo built no `{PACKAGE}` executable (is firmware/app a binary crate?)"),
+            )
+        })
 }
 
 /// Builds, checks and writes one motor's image (its spec designs); returns its report.
-fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, String> {
+fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, Failure> {
     let elf_path = cargo_build(root, t, stem)?;
-    let bytes = std::fs::read(&elf_path).map_err(|e| format!("cannot read {}: {e}", elf_path.display()))?;
-    let image = image(&bytes).map_err(|e| format!("{}: {e}", elf_path.display()))?;
+    let io = |what: String| Failure::new(Exit::Io, what);
+    let bytes = std::fs::read(&elf_path).map_err(|e| io(format!("error: cannot read {}: {e}", elf_path.display())))?;
+    let image =
+        image(&bytes).map_err(|e| Failure::new(Exit::BuildFailed, format!("error: {}: {e}", elf_path.display())))?;
     let mut report = report(stem, &image.usage);
     if image.usage.flash > FLASH_LIMIT {
-        return Err(format!(
-            "{report}{stem}: the image needs {} bytes of flash, more than the 64 KiB ({FLASH_LIMIT} bytes) \
-             allowed; nothing written (the ELF is {})",
-            image.usage.flash,
-            elf_path.display()
+        return Err(Failure::new(
+            Exit::VerificationFailed,
+            format!(
+                "{report}error: {stem}: the image needs {} bytes of flash, more than the 64 KiB ({FLASH_LIMIT} \
+                 bytes) budget; nothing written (the ELF is {})",
+                image.usage.flash,
+                elf_path.display()
+            ),
         ));
     }
     let mut out = root.join("target").join("firmware");
@@ -317,8 +358,7 @@ fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, String> 
     let elf_out = out.join(format!("{stem}.elf"));
     let bin_out = out.join(format!("{stem}.bin"));
     // The pair is replaced together or not at all.
-    crate::atomic::write_set(&out, &[(elf_out.clone(), bytes), (bin_out.clone(), image.bin.clone())])
-        .map_err(|e| e.to_string())?;
+    crate::atomic::write_set(&out, &[(elf_out.clone(), bytes), (bin_out.clone(), image.bin.clone())])?;
     let _ = writeln!(
         report,
         "{stem}: wrote {} and {} (load address {:#010x})",
@@ -329,68 +369,68 @@ fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, String> 
     Ok(report)
 }
 
-/// The `firmware` subcommand.
-pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode {
-    let known = match stems(motors, "motors") {
-        Ok(k) => k,
-        Err(e) => {
-            errln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+/// The `firmware` subcommand. Every selected spec must design on the board before cargo
+/// runs; every motor is built even if one fails, and the exit code is the gravest failure's.
+pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<(), Failure> {
+    let known = stems(motors, "motors").map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
     let selected = match which {
         Which::All if known.is_empty() => {
-            errln!(
-                "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
-                motors.display()
-            );
-            return ExitCode::FAILURE;
+            return Err(Failure::new(
+                Exit::BadInput,
+                format!(
+                    "error: no motor specs (*.toml) in {}\n  accepted: a folder of motor specs (`motorgen new <stem>` writes one)",
+                    motors.display()
+                ),
+            ));
         }
         Which::All => known,
         Which::One(stem) if known.contains(&stem) => vec![stem],
         Which::One(stem) => {
-            errln!(
-                "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
-                motors.display(),
-                accepted(&known)
-            );
-            return ExitCode::FAILURE;
+            return Err(Failure::new(
+                Exit::BadInput,
+                format!(
+                    "error: no motor `{stem}` in {} (no {stem}.toml)\n  accepted: {}",
+                    motors.display(),
+                    accepted(&known)
+                ),
+            ));
         }
     };
-    let root = match repo_root(motors) {
-        Ok(r) => r,
-        Err(e) => {
-            errln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+    let root = repo_root(motors).map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
     let motors = motors.canonicalize().unwrap_or_else(|_| motors.to_path_buf());
+    let gravest = |failed: &[Exit]| failed.iter().copied().max_by_key(|e| *e as u8);
     let boards = boards.canonicalize().unwrap_or_else(|_| boards.to_path_buf());
     let board_file = boards.join(format!("{board}.toml"));
     if !board_file.is_file() {
-        errln!(
-            "error: no board `{board}` in {} (no {board}.toml)\n  accepted: {}",
-            boards.display(),
-            accepted(&stems(&boards, "boards").unwrap_or_default())
-        );
-        return ExitCode::FAILURE;
+        return Err(Failure::new(
+            Exit::BadInput,
+            format!(
+                "error: no board `{board}` in {} (no {board}.toml)\n  accepted: {}",
+                boards.display(),
+                accepted(&stems(&boards, "boards").unwrap_or_default())
+            ),
+        ));
     }
     // Every selected spec must design on the board before cargo runs (located
     // diagnostics); what does not fit is a warning.
     let mut designs = Vec::new();
+    let mut failed = Vec::new();
     for stem in &selected {
         match super::design_on(&motors.join(format!("{stem}.toml")), Some(&board_file)) {
             Ok(d) => {
                 for w in d.board.iter().flat_map(|b| &b.warnings) {
-                    errln!("warning: {stem} on {board}: {w}");
+                    crate::output::warn(format_args!("{stem} on {board}: {w}"));
                 }
                 designs.push(d);
             }
-            Err(d) => err!("{d}"),
+            Err(f) => {
+                failed.push(f.exit);
+                f.report();
+            }
         }
     }
-    if designs.len() != selected.len() {
-        return ExitCode::FAILURE;
+    if let Some(exit) = gravest(&failed) {
+        return Err(Failure::new(exit, "firmware: nothing built (a spec has problems)"));
     }
     let target = Target {
         motors: &motors,
@@ -401,18 +441,20 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> ExitCode 
     if let [d] = designs.as_slice() {
         out!("{}", codegen::summary::summary(d));
     }
-    let mut ok = true;
     for stem in &selected {
         match build_one(&root, &target, stem) {
             Ok(report) => out!("{report}"),
-            Err(e) => {
-                ok = false;
-                err!("error: {e}");
-                if !e.ends_with('\n') {
-                    errln!();
-                }
+            Err(f) => {
+                failed.push(f.exit);
+                f.report();
             }
         }
     }
-    if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+    match gravest(&failed) {
+        None => Ok(()),
+        Some(exit) => Err(Failure::new(
+            exit,
+            format!("firmware: {} of {} images not built", failed.len(), selected.len()),
+        )),
+    }
 }

@@ -9,7 +9,6 @@
 //! the lock and prints the change instead.
 
 use std::path::{Path, PathBuf};
-use std::process::ExitCode;
 
 use clap::{Args, Subcommand, ValueEnum};
 use codegen::identify::recording::{self, Recording, RecordingKind};
@@ -21,8 +20,9 @@ use codegen::units::{self, Kind};
 use codegen::{Design, Diagnostic, Diagnostics, Source};
 use motor_control::commissioning::Axis;
 
-use crate::atomic::{IoFailure, LockedSpec};
-use crate::output::{err, errln, out, outln};
+use crate::atomic::LockedSpec;
+use crate::exit::{Exit, Failure};
+use crate::output::{out, outln};
 
 /// What to identify.
 #[derive(Subcommand)]
@@ -93,39 +93,6 @@ pub enum AxisArg {
     Q,
 }
 
-/// Why an identification failed: bad input (located) or a file that cannot be written.
-enum Failure {
-    Input(Diagnostics),
-    Io(IoFailure),
-}
-
-impl From<Diagnostics> for Failure {
-    fn from(d: Diagnostics) -> Failure {
-        Failure::Input(d)
-    }
-}
-
-impl From<IoFailure> for Failure {
-    fn from(e: IoFailure) -> Failure {
-        Failure::Io(e)
-    }
-}
-
-/// Runs one identification; prints results or located errors.
-pub fn run(what: What) -> ExitCode {
-    match run_inner(what) {
-        Ok(()) => ExitCode::SUCCESS,
-        Err(Failure::Input(e)) => {
-            err!("{e}");
-            ExitCode::FAILURE
-        }
-        Err(Failure::Io(e)) => {
-            errln!("error: {e}");
-            crate::output::io_failure()
-        }
-    }
-}
-
 fn plain_error(file: &str, problem: String, accepted: &str) -> Diagnostics {
     Diagnostics(vec![Diagnostic {
         file: file.to_string(),
@@ -179,9 +146,11 @@ fn load(spec: &Path, common: &Common) -> Result<Loaded, Failure> {
 }
 
 /// Reads and parses every recording; all problems are reported together.
-fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Recording>, Diagnostics> {
+/// An unreadable recording makes it an I/O failure, otherwise bad input.
+fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Recording>, Failure> {
     let mut out = Vec::new();
     let mut errors = Vec::new();
+    let mut unreadable = false;
     for f in files {
         let name = f.display().to_string();
         match std::fs::read_to_string(f) {
@@ -189,32 +158,36 @@ fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Rec
                 Ok(r) => out.push(r),
                 Err(e) => errors.extend(e.0),
             },
-            Err(e) => errors.extend(
-                plain_error(
-                    &name,
-                    format!("cannot read the recording: {e}"),
-                    "a readable UTF-8 CSV recording",
+            Err(e) => {
+                unreadable = true;
+                errors.extend(
+                    plain_error(
+                        &name,
+                        format!("cannot read the recording: {e}"),
+                        "a readable UTF-8 CSV recording",
+                    )
+                    .0,
                 )
-                .0,
-            ),
+            }
         }
     }
     if errors.is_empty() {
         Ok(out)
     } else {
-        Err(Diagnostics(errors))
+        let exit = if unreadable { Exit::Io } else { Exit::BadInput };
+        Err(Failure::new(exit, Diagnostics(errors).to_string()))
     }
 }
 
-fn sample_period(common: &Common, design: &Design) -> Result<f64, Diagnostics> {
+fn sample_period(common: &Common, design: &Design) -> Result<f64, Failure> {
     match &common.sample_period {
         None => Ok(design.drive.sample_period_s),
         Some(s) => units::parse(Kind::Time, s).ok().filter(|t| *t > 0.0).ok_or_else(|| {
-            plain_error(
+            Failure::from(plain_error(
                 "--sample-period",
                 format!("`{s}` is not a positive time"),
                 Kind::Time.accepted(),
-            )
+            ))
         }),
     }
 }
@@ -328,7 +301,9 @@ fn write_back(spec: &Path, loaded: Loaded, entries: &[Entry], origin: &Origin<'_
     Ok(())
 }
 
-fn run_inner(what: What) -> Result<(), Failure> {
+/// Runs one identification; prints results, or fails with located errors (bad input) or
+/// an I/O failure.
+pub fn run(what: What) -> Result<(), Failure> {
     match what {
         What::Step {
             spec,

@@ -1,6 +1,7 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
 mod atomic;
+mod exit;
 mod firmware;
 mod identify;
 mod output;
@@ -12,12 +13,12 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand, ValueEnum};
 use codegen::render::{Output, render_with};
-use codegen::{Diagnostic, Diagnostics};
-use output::{err, errln, out, outln};
+use exit::{Exit, Failure};
+use output::{out, outln};
 
 /// Motor description (TOML) → tuned motor-controller constants.
 #[derive(Parser)]
-#[command(name = "motorgen", version, about)]
+#[command(name = "motorgen", version, about, after_help = exit::HELP)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -28,14 +29,15 @@ enum Command {
     /// Print the whole design of one motor.
     Design {
         /// The motor spec, e.g. motors/fischer-ti085.toml.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
         /// Output format.
         #[arg(long, value_enum, default_value_t = Format::Summary)]
         format: Format,
         /// Directory with replacement templates (for rust, c, markdown).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
-        /// A board file (boards/<name>.toml): adds the `board` constants and the checks
+        /// A board file (boards/NAME.toml): adds the `board` constants and the checks
         /// of the motor on that board.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
@@ -44,65 +46,71 @@ enum Command {
     /// (files are only rewritten when their bytes change).
     Generate {
         /// The motor spec.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
         /// Output directory (created if missing).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         out: PathBuf,
         /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
         /// A board file: adds its `board` constants (as `design --board`).
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
     /// Validate motor specs and board files (a file with a top-level `chip` is a board);
-    /// exit non-zero if any has a problem.
+    /// warnings go to stderr; exit 1 if any has a problem.
     Check {
         /// One or more motor specs or board files.
-        #[arg(required = true)]
+        #[arg(required = true, value_name = "FILE")]
         specs: Vec<PathBuf>,
     },
-    /// Write a commented starting spec to motors/<stem>.toml (never overwrites).
+    /// Write a commented starting spec to DIR/STEM.toml, DIR defaulting to motors/
+    /// (never overwrites).
     New {
         /// File stem: lowercase letters, digits and '-'.
+        #[arg(value_name = "STEM")]
         stem: String,
         /// Directory of motor specs.
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
     /// Build the STM32G474 image of one motor (or --all) on a board into
-    /// target/firmware/<stem>.elf and .bin (target/firmware/<board>/… for a board other
-    /// than the default) and print its flash and RAM use (fails above 64 KiB of flash).
+    /// target/firmware/STEM.elf and .bin (target/firmware/BOARD/… for a board other than
+    /// the default) and print its flash and RAM use (fails above the 64 KiB flash
+    /// budget); cargo's build progress is shown on stderr.
     Firmware {
         /// Motor file stem in the motors folder, e.g. fischer-ti085.
-        #[arg(required_unless_present = "all", conflicts_with = "all")]
+        #[arg(required_unless_present = "all", conflicts_with = "all", value_name = "STEM")]
         stem: Option<String>,
         /// Every motor in the motors folder.
         #[arg(long)]
         all: bool,
         /// Directory of motor specs (default: motors/).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
         /// Board file stem in the boards folder (default: motorgen-reference).
-        #[arg(long, default_value = codegen::board::DEFAULT_BOARD)]
+        #[arg(long, value_name = "BOARD", default_value = codegen::board::DEFAULT_BOARD)]
         board: String,
         /// Directory of board files (default: boards/ beside the motors folder).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         boards_dir: Option<PathBuf>,
     },
     /// Simulate the firmware's current loop and observer with the motor and print a
-    /// pass/fail table of measured vs designed figures (non-zero exit on a failure).
+    /// pass/fail table of measured vs designed figures (exit 3 on a failure).
     Verify {
         /// The motor spec.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
     },
     /// Write a self-contained HTML report (verification table, SVG plots, every constant
-    /// with formula and provenance) to DIR/<stem>.html.
+    /// with formula and provenance) to DIR/STEM.html (exit 3 if a figure fails).
     Report {
         /// The motor spec.
+        #[arg(value_name = "SPEC")]
         spec: PathBuf,
         /// Output directory (created if missing).
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
     /// Identify R, L, ψ_M or the resolver offset from recorded commissioning runs
@@ -114,7 +122,7 @@ enum Command {
     /// List the motors in a directory (default: motors/).
     List {
         /// Directory of motor specs.
-        #[arg(long)]
+        #[arg(long, value_name = "DIR")]
         dir: Option<PathBuf>,
     },
 }
@@ -145,41 +153,45 @@ impl Format {
 }
 
 /// Renders `out` with the template from `dir` if given, else the built-in one.
-fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String, String> {
+fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String, Failure> {
+    let bad_template = |e: codegen::render::RenderError| Failure::new(Exit::BadInput, e.to_string());
     match dir {
         Some(dir) => {
             let path = dir.join(out.template());
             let source = std::fs::read_to_string(&path)
-                .map_err(|e| format!("error: cannot read template {}: {e}", path.display()))?;
-            render_with(d, &path.display().to_string(), &source).map_err(|e| e.to_string())
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read template {}: {e}", path.display())))?;
+            render_with(d, &path.display().to_string(), &source).map_err(bad_template)
         }
-        None => codegen::render::render(d, out).map_err(|e| e.to_string()),
+        None => codegen::render::render(d, out).map_err(bad_template),
     }
 }
 
-/// Reads a spec as UTF-8 text, or a diagnostic naming the file.
-fn read_spec(path: &Path) -> Result<String, Diagnostics> {
+/// Reads a spec as UTF-8 text: an unreadable file is an I/O failure, invalid UTF-8 bad
+/// input; both name the file.
+fn read_spec(path: &Path) -> Result<String, Failure> {
+    let file = path.display().to_string();
     let bytes = std::fs::read(path).map_err(|e| {
-        Diagnostics(vec![Diagnostic {
-            file: path.display().to_string(),
+        let d = codegen::Diagnostic {
+            file: file.clone(),
             line: 1,
             column: 1,
             key: String::new(),
             problem: format!("cannot read the file: {e}"),
             accepted: "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)".into(),
             excerpt: String::new(),
-        }])
+        };
+        Failure::new(Exit::Io, codegen::Diagnostics(vec![d]).to_string())
     })?;
     spec_text(path, bytes)
 }
 
-/// A spec's bytes as UTF-8 text, or a diagnostic at the first invalid byte.
-fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, Diagnostics> {
+/// A spec's bytes as UTF-8 text, or bad input located at the first invalid byte.
+fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, Failure> {
     let file = path.display().to_string();
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
         let text = String::from_utf8_lossy(e.as_bytes());
-        codegen::Source {
+        let d = codegen::Source {
             file: &file,
             text: &text,
         }
@@ -188,29 +200,29 @@ fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, Diagnostics> {
             "",
             format!("the file is not valid UTF-8 (byte {at})"),
             "a UTF-8 text file; save the spec as UTF-8",
-        )
-        .into()
+        );
+        Failure::from(codegen::Diagnostics::from(d))
     })
 }
 
-fn design(path: &Path) -> Result<codegen::Design, Diagnostics> {
+fn design(path: &Path) -> Result<codegen::Design, Failure> {
     let text = read_spec(path)?;
-    codegen::design_source(&path.display().to_string(), &text)
+    Ok(codegen::design_source(&path.display().to_string(), &text)?)
 }
 
 /// The design of a motor, on `board` if given (its constants and checks added).
-fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Diagnostics> {
+fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failure> {
     let Some(board) = board else {
         return design(path);
     };
     let text = read_spec(path)?;
     let board_text = read_spec(board)?;
-    codegen::design_with_board(
+    Ok(codegen::design_with_board(
         &path.display().to_string(),
         &text,
         &board.display().to_string(),
         &board_text,
-    )
+    )?)
 }
 
 /// `motors/` in the working directory, else the one in this repository.
@@ -226,67 +238,41 @@ fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
 }
 
 fn main() -> ExitCode {
-    let code = run(Cli::parse());
+    let code = match run(Cli::parse().command) {
+        Ok(()) => Exit::Success.into(),
+        Err(f) => f.report(),
+    };
     output::flush();
     code
 }
 
-fn run(cli: Cli) -> ExitCode {
-    match cli.command {
+fn run(command: Command) -> Result<(), Failure> {
+    match command {
         Command::Design {
             spec,
             format,
             templates,
             board,
-        } => match design_on(&spec, board.as_deref()) {
-            Ok(d) => {
-                let out = match format {
-                    Format::Rust | Format::C | Format::Markdown => {
-                        let Some(o) = format.output() else {
-                            return ExitCode::FAILURE;
-                        };
-                        match render(&d, o, templates.as_deref()) {
-                            Ok(s) => s,
-                            Err(e) => {
-                                errln!("{e}");
-                                return ExitCode::FAILURE;
-                            }
-                        }
-                    }
-                    Format::Summary => codegen::summary::summary(&d),
-                    Format::Json => match serde_json::to_string_pretty(&d) {
-                        Ok(s) => s + "\n",
-                        Err(e) => {
-                            errln!("error: cannot serialise the design: {e}");
-                            return ExitCode::FAILURE;
-                        }
-                    },
-                };
-                out!("{out}");
-                ExitCode::SUCCESS
-            }
-            Err(e) => {
-                err!("{e}");
-                ExitCode::FAILURE
-            }
-        },
+        } => {
+            let d = design_on(&spec, board.as_deref())?;
+            let out = match format.output() {
+                Some(o) => render(&d, o, templates.as_deref())?,
+                None if matches!(format, Format::Json) => serde_json::to_string_pretty(&d)
+                    .map(|s| s + "\n")
+                    .map_err(|e| Failure::new(Exit::Io, format!("error: cannot serialise the design: {e}")))?,
+                None => codegen::summary::summary(&d),
+            };
+            out!("{out}");
+            Ok(())
+        }
         Command::Generate {
             spec,
             out,
             templates,
             board,
         } => {
-            if let Err(e) = atomic::check_out_dir(&out) {
-                errln!("{e}");
-                return ExitCode::FAILURE;
-            }
-            let d = match design_on(&spec, board.as_deref()) {
-                Ok(d) => d,
-                Err(e) => {
-                    err!("{e}");
-                    return ExitCode::FAILURE;
-                }
-            };
+            atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+            let d = design_on(&spec, board.as_deref())?;
             let stem = spec
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -294,37 +280,29 @@ fn run(cli: Cli) -> ExitCode {
             // Render everything first: nothing is written unless every output renders.
             let mut files = Vec::new();
             for o in Output::ALL {
-                match render(&d, o, templates.as_deref()) {
-                    Ok(text) => files.push((out.join(o.file_name(&stem)), text.into_bytes())),
-                    Err(e) => {
-                        errln!("{e}");
-                        return ExitCode::FAILURE;
-                    }
-                }
+                let text = render(&d, o, templates.as_deref())?;
+                files.push((out.join(o.file_name(&stem)), text.into_bytes()));
             }
-            match atomic::write_set(&out, &files) {
-                Ok(written) => {
-                    for ((path, _), w) in files.iter().zip(written) {
-                        outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
-                    }
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    errln!("error: {e}");
-                    output::io_failure()
-                }
+            // All or nothing, each file rewritten only when its bytes change.
+            let written = atomic::write_set(&out, &files)?;
+            for ((path, _), w) in files.iter().zip(written) {
+                outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
             }
+            Ok(())
         }
         Command::Check { specs } => {
-            let mut ok = true;
+            // Every spec is checked; the exit code is the gravest failure's (I/O over bad input).
+            let mut failed = Vec::new();
             for path in &specs {
                 let is_board = std::fs::read_to_string(path).is_ok_and(|t| codegen::board::is_board_file(&t));
                 if is_board {
-                    match read_spec(path).and_then(|t| codegen::board_source(&path.display().to_string(), &t)) {
+                    let board =
+                        read_spec(path).and_then(|t| Ok(codegen::board_source(&path.display().to_string(), &t)?));
+                    match board {
                         Ok(b) => outln!("ok: {} (board: {}, {} {})", path.display(), b.name, b.chip, b.package),
-                        Err(e) => {
-                            ok = false;
-                            err!("{e}");
+                        Err(f) => {
+                            failed.push(f.exit);
+                            f.report();
                         }
                     }
                     continue;
@@ -333,16 +311,22 @@ fn run(cli: Cli) -> ExitCode {
                     Ok(d) => {
                         outln!("ok: {} ({})", path.display(), d.name);
                         for w in &d.warnings {
-                            outln!("  warning: {w}");
+                            output::warn(format_args!("{}: {w}", path.display()));
                         }
                     }
-                    Err(e) => {
-                        ok = false;
-                        err!("{e}");
+                    Err(f) => {
+                        failed.push(f.exit);
+                        f.report();
                     }
                 }
             }
-            if ok { ExitCode::SUCCESS } else { ExitCode::FAILURE }
+            match failed.iter().max_by_key(|e| **e as u8) {
+                None => Ok(()),
+                Some(&exit) => Err(Failure::new(
+                    exit,
+                    format!("check: {} of {} files failed", failed.len(), specs.len()),
+                )),
+            }
         }
         Command::New { stem, dir } => {
             if stem.is_empty()
@@ -351,41 +335,32 @@ fn run(cli: Cli) -> ExitCode {
                     .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
                 || stem.starts_with('-')
             {
-                errln!(
-                    "error: `{stem}` is not a valid motor stem\n  accepted: lowercase letters, digits and '-', e.g. my-motor-80kw"
-                );
-                return ExitCode::FAILURE;
+                return Err(Failure::new(
+                    Exit::BadInput,
+                    format!(
+                        "error: `{stem}` is not a valid motor stem\n  accepted: lowercase letters, digits and '-', e.g. my-motor-80kw"
+                    ),
+                ));
             }
             let dir = motors_dir(dir);
             let path = dir.join(format!("{stem}.toml"));
             if path.exists() {
-                errln!(
-                    "error: {} already exists\n  accepted: a new stem, or edit the existing file",
-                    path.display()
-                );
-                return ExitCode::FAILURE;
-            }
-            let text = match codegen::render::new_spec(&stem) {
-                Ok(t) => t,
-                Err(e) => {
-                    errln!("{e}");
-                    return ExitCode::FAILURE;
-                }
-            };
-            match atomic::create_new(&path, text.as_bytes()) {
-                Ok(()) => {
-                    outln!(
-                        "wrote {}; edit it, then run `motorgen check {}`",
-                        path.display(),
+                return Err(Failure::new(
+                    Exit::BadInput,
+                    format!(
+                        "error: {} already exists\n  accepted: a new stem, or edit the existing file",
                         path.display()
-                    );
-                    ExitCode::SUCCESS
-                }
-                Err(e) => {
-                    errln!("error: {e}");
-                    output::io_failure()
-                }
+                    ),
+                ));
             }
+            let text = codegen::render::new_spec(&stem).map_err(|e| Failure::new(Exit::BadInput, e.to_string()))?;
+            atomic::create_new(&path, text.as_bytes())?;
+            outln!(
+                "wrote {}; edit it, then run `motorgen check {}`",
+                path.display(),
+                path.display()
+            );
+            Ok(())
         }
         Command::Firmware {
             stem,
@@ -414,16 +389,11 @@ fn run(cli: Cli) -> ExitCode {
         Command::Identify { what } => identify::run(what),
         Command::List { dir } => {
             let dir = motors_dir(dir);
-            let mut entries: Vec<PathBuf> = match std::fs::read_dir(&dir) {
-                Ok(rd) => rd
-                    .filter_map(|e| e.ok().map(|e| e.path()))
-                    .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-                    .collect(),
-                Err(e) => {
-                    errln!("error: cannot read {}: {e}", dir.display());
-                    return ExitCode::FAILURE;
-                }
-            };
+            let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read {}: {e}", dir.display())))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect();
             entries.sort();
             for path in entries {
                 let stem = path
@@ -432,14 +402,10 @@ fn run(cli: Cli) -> ExitCode {
                     .unwrap_or_default();
                 match design(&path) {
                     Ok(d) => outln!("{stem:<24} {}", d.name),
-                    Err(e) => outln!(
-                        "{stem:<24} INVALID ({} problem{})",
-                        e.0.len(),
-                        if e.0.len() == 1 { "" } else { "s" }
-                    ),
+                    Err(_) => outln!("{stem:<24} INVALID (`motorgen check {}` says why)", path.display()),
                 }
             }
-            ExitCode::SUCCESS
+            Ok(())
         }
     }
 }

@@ -12,15 +12,10 @@
 
 use std::fmt::Arguments;
 use std::io::{self, Write};
-use std::process::ExitCode;
 
-/// Exit code of an I/O failure (output, spec or file not writable): sysexits' EX_IOERR.
+/// Exit code of an I/O failure (output, spec or file not writable): sysexits' EX_IOERR
+/// ([`crate::exit::Exit::Io`]).
 pub const EXIT_IO: u8 = 74;
-
-/// [`EXIT_IO`] as an [`ExitCode`].
-pub fn io_failure() -> ExitCode {
-    ExitCode::from(EXIT_IO)
-}
 
 /// Ends the program after stdout failed with `e` (see the module doc).
 fn stdout_failed(e: &io::Error) -> ! {

@@ -2,59 +2,35 @@
 //! self-contained HTML report `DIR/<stem>.html`.
 
 use std::path::Path;
-use std::process::ExitCode;
 
-use crate::output::{err, errln, outln};
+use crate::exit::{Exit, Failure};
+use crate::output::outln;
 
-/// Writes the report; non-zero exit (and no file) on a bad spec or a write error. A
-/// failing verification is reported in the page and on stderr, and the exit is non-zero.
-pub fn run(spec: &Path, out: &Path) -> ExitCode {
-    if let Err(e) = crate::atomic::check_out_dir(out) {
-        errln!("{e}");
-        return ExitCode::FAILURE;
-    }
-    let text = match crate::read_spec(spec) {
-        Ok(t) => t,
-        Err(e) => {
-            err!("{e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    let (design, verification) = match codegen::verify::verify_source(&spec.display().to_string(), &text) {
-        Ok(x) => x,
-        Err(e) => {
-            err!("{e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    let page = match codegen::report::report(&design, &verification) {
-        Ok(p) => p,
-        Err(e) => {
-            errln!("error: {e}");
-            return ExitCode::FAILURE;
-        }
-    };
+/// Writes the report; no file on a bad spec or a write error. A failing verification
+/// is reported in the page and on stderr, with the verification-failed exit code.
+pub fn run(spec: &Path, out: &Path) -> Result<(), Failure> {
+    crate::atomic::check_out_dir(out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+    let text = crate::read_spec(spec)?;
+    let (design, verification) = codegen::verify::verify_source(&spec.display().to_string(), &text)?;
+    let page = codegen::report::report(&design, &verification)
+        .map_err(|e| Failure::new(Exit::Io, format!("error: cannot draw the report: {e}")))?;
     let stem = spec
         .file_stem()
         .map(|s| s.to_string_lossy().into_owned())
         .unwrap_or_else(|| "motor".into());
     let path = out.join(format!("{stem}.html"));
     // Written whole into a temporary file, then renamed: never a partial page.
-    if let Err(e) = crate::atomic::write_set(out, &[(path.clone(), page.into_bytes())]) {
-        errln!("error: {e}");
-        return crate::output::io_failure();
-    }
+    crate::atomic::write_set(out, &[(path.clone(), page.into_bytes())])?;
     outln!("wrote {}", path.display());
     if verification.passed() {
-        ExitCode::SUCCESS
+        Ok(())
     } else {
-        let failed: Vec<&str> = verification
-            .scenarios
-            .iter()
-            .filter(|s| !s.passed())
-            .map(|s| s.id)
-            .collect();
-        errln!("verification failed: {} (see the report's table)", failed.join(", "));
-        ExitCode::FAILURE
+        Err(Failure::new(
+            Exit::VerificationFailed,
+            format!(
+                "{} (see the report's table)",
+                crate::verify::failed_message(&verification)
+            ),
+        ))
     }
 }

@@ -2,32 +2,25 @@
 //! in closed loop with the simulated motor and prints the pass/fail table.
 
 use std::path::Path;
-use std::process::ExitCode;
 
-use crate::output::{err, out};
+use crate::exit::{Exit, Failure};
+use crate::output::out;
 
-/// Reads, designs and verifies `spec`; prints the table; non-zero exit if a scenario fails
-/// or the spec is bad (with the located message).
-pub fn run(spec: &Path) -> ExitCode {
-    let text = match crate::read_spec(spec) {
-        Ok(t) => t,
-        Err(e) => {
-            err!("{e}");
-            return ExitCode::FAILURE;
-        }
-    };
-    match codegen::verify::verify_source(&spec.display().to_string(), &text) {
-        Ok((_, v)) => {
-            out!("{}", v.table());
-            if v.passed() {
-                ExitCode::SUCCESS
-            } else {
-                ExitCode::FAILURE
-            }
-        }
-        Err(e) => {
-            err!("{e}");
-            ExitCode::FAILURE
-        }
+/// Reads, designs and verifies `spec`; prints the table. A bad spec is bad input (with
+/// the located message), a failing scenario a failed verification.
+pub fn run(spec: &Path) -> Result<(), Failure> {
+    let text = crate::read_spec(spec)?;
+    let (_, v) = codegen::verify::verify_source(&spec.display().to_string(), &text)?;
+    out!("{}", v.table());
+    if v.passed() {
+        Ok(())
+    } else {
+        Err(Failure::new(Exit::VerificationFailed, failed_message(&v)))
     }
+}
+
+/// `verification failed: <scenario ids>`.
+pub fn failed_message(v: &codegen::verify::Verification) -> String {
+    let failed: Vec<&str> = v.scenarios.iter().filter(|s| !s.passed()).map(|s| s.id).collect();
+    format!("verification failed: {}", failed.join(", "))
 }

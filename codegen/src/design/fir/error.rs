@@ -8,7 +8,7 @@ use super::{FMAC_MAX_TAPS, FMAC_MEMORY_WORDS, MIN_ORDER};
 
 /// Why no filter was designed; [`FirError::key`] names the spec key to point at.
 ///
-/// Every `Display` message has the form "<what is wrong>; accepted: <what is accepted>".
+/// Every `Display` message has the form "`<what is wrong>; accepted: <what is accepted>`".
 #[derive(Debug, Clone, PartialEq)]
 pub enum FirError {
     /// An input is NaN, infinite, zero or negative.
@@ -20,30 +20,30 @@ pub enum FirError {
     },
     /// pass_edge ≥ stop_edge.
     EdgesOutOfOrder {
-        /// Pass edge [Hz].
+        /// Pass edge \[Hz\].
         pass_edge_hz: f64,
-        /// Stop edge [Hz].
+        /// Stop edge \[Hz\].
         stop_edge_hz: f64,
     },
     /// An edge at or beyond the Nyquist frequency f_s/2.
     BeyondNyquist {
         /// `"pass_edge"` or `"stop_edge"`.
         key: &'static str,
-        /// The edge [Hz].
+        /// The edge \[Hz\].
         edge_hz: f64,
-        /// f_s/2 [Hz].
+        /// f_s/2 \[Hz\].
         nyquist_hz: f64,
     },
-    /// pass_edge below [`MIN_PASS_EDGE_NORMALISED`]·f_s, where the exchange does not converge.
+    /// pass_edge below 1e-6·f_s (`MIN_PASS_EDGE_NORMALISED`), where the exchange does not converge.
     PassEdgeTooLow {
-        /// The pass edge given [Hz].
+        /// The pass edge given \[Hz\].
         pass_edge_hz: f64,
-        /// The lowest accepted pass edge [Hz].
+        /// The lowest accepted pass edge \[Hz\].
         min_hz: f64,
     },
     /// pass_ripple outside (0, 0.5) or NaN.
     RippleOutOfRange {
-        /// The value given [linear].
+        /// The value given \[linear\].
         ripple: f64,
     },
     /// Order below [`MIN_ORDER`] or more taps than the FMAC holds.
@@ -53,20 +53,20 @@ pub enum FirError {
     },
     /// No stop weight at this order keeps the quantised pass-band deviation within the request.
     RippleInfeasible {
-        /// Requested pass ripple [linear].
+        /// Requested pass ripple \[linear\].
         requested: f64,
         /// Order [taps − 1].
         order: usize,
-        /// Smallest quantised pass-band deviation reached at this order, if any design quantised [linear].
+        /// Smallest quantised pass-band deviation reached at this order, if any design quantised \[linear\].
         best: Option<f64>,
     },
     /// The design meeting the ripple at this order does not attenuate the stop band at all.
     NoAttenuation {
         /// Order [taps − 1].
         order: usize,
-        /// Requested pass ripple [linear].
+        /// Requested pass ripple \[linear\].
         ripple: f64,
-        /// Achieved quantised stop-band attenuation [dB].
+        /// Achieved quantised stop-band attenuation \[dB\].
         attenuation_db: f64,
     },
     /// The order is so high for these band edges that the equiripple design falls below f64 resolution.
@@ -75,28 +75,28 @@ pub enum FirError {
         order: usize,
         /// Highest order designable for these band edges [taps − 1].
         max_order: usize,
-        /// Kaiser's −10·log10(δ_p·δ_s) at the given order [dB].
+        /// Kaiser's −10·log10(δ_p·δ_s) at the given order \[dB\].
         kaiser_db: f64,
     },
     /// More attenuation than Q1.15 taps can hold.
     AttenuationBeyondQ15 {
-        /// Requested attenuation [dB].
+        /// Requested attenuation \[dB\].
         requested_db: f64,
     },
     /// No order up to the FMAC limit meets the requested attenuation.
     AttenuationInfeasible {
-        /// Longest filter tried [taps].
+        /// Longest filter tried \[taps\].
         taps: usize,
-        /// Requested attenuation [dB].
+        /// Requested attenuation \[dB\].
         requested_db: f64,
-        /// Best quantised attenuation at 127 taps within the pass ripple, if that design exists [dB].
+        /// Best quantised attenuation at 127 taps within the pass ripple, if that design exists \[dB\].
         best_db: Option<f64>,
     },
     /// A tap falls outside the Q1.15 range [−1, 1 − 2^−15].
     TapOverflow {
         /// Order [taps − 1].
         order: usize,
-        /// The offending tap [1].
+        /// The offending tap \[1\].
         tap: f64,
     },
     /// The Parks–McClellan exchange failed (numerically degenerate bands).

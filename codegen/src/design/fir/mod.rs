@@ -47,10 +47,10 @@
 //! shift by 0–7) is applied at the output, which is then clipped to q1.15 if
 //! CLIPEN is set or else truncated to its 16 low bits. An N-tap FIR needs
 //! 2N + 1 of the 256 words of local memory, so N ≤ 127 ([`FMAC_MAX_TAPS`]).
-//! See [`fmac_fir_output`] for the bit-level model this module assumes.
+//! The bit-level model this module designs for is the firmware's own,
+//! [`motor_control::fir::output`] (the filter checks in the tests run on it).
 
 mod error;
-mod fmac;
 mod quantise;
 mod remez;
 mod response;
@@ -62,21 +62,20 @@ mod validate;
 use serde::Serialize;
 
 pub use error::FirError;
-pub use fmac::{fmac_fir_output, fmac_fir_output_with};
 pub use response::magnitude;
 pub use search::{MAX_ATTENUATION_DB, MAX_KAISER_DB};
 
 /// Words of FMAC local memory (RM0440 §17.3.8) [16-bit words].
 pub const FMAC_MEMORY_WORDS: usize = 256;
-/// Largest tap count the FMAC holds: 2N + 1 ≤ 256 ⇒ N ≤ 127 [taps].
+/// Largest tap count the FMAC holds: 2N + 1 ≤ 256 ⇒ N ≤ 127 \[taps\].
 pub const FMAC_MAX_TAPS: usize = (FMAC_MEMORY_WORDS - 1) / 2;
 /// Smallest accepted filter order [taps − 1].
 pub const MIN_ORDER: usize = 2;
-/// Q1.15 representation of 1.0 [LSB]; the quantised taps sum to exactly this.
+/// Q1.15 representation of 1.0 \[LSB\]; the quantised taps sum to exactly this.
 pub const Q15_ONE: i32 = 1 << 15;
 /// Dense-grid points per tap and per band used to measure ripple and attenuation [points/tap].
 pub const GRID_POINTS_PER_TAP: usize = 64;
-/// Upper bound on the Remez runs of the stop-weight search at a given order [runs].
+/// Upper bound on the Remez runs of the stop-weight search at a given order \[runs\].
 pub const MAX_WEIGHT_EVALUATIONS: usize = 24;
 
 /// How the filter length is chosen.
@@ -91,11 +90,11 @@ pub enum FirLength {
 /// What the user asked for.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FirRequest {
-    /// Sampling frequency f_s [Hz].
+    /// Sampling frequency f_s \[Hz\].
     pub sample_rate_hz: f64,
-    /// Pass-band edge; the pass band is [0, pass_edge] [Hz].
+    /// Pass-band edge; the pass band is [0, pass_edge] \[Hz\].
     pub pass_edge_hz: f64,
-    /// Stop-band edge; the stop band is [stop_edge, f_s/2] [Hz].
+    /// Stop-band edge; the stop band is [stop_edge, f_s/2] \[Hz\].
     pub stop_edge_hz: f64,
     /// Maximal relative pass-band deviation ||H| − 1| [linear, e.g. 0.001].
     pub pass_ripple: f64,
@@ -106,33 +105,33 @@ pub struct FirRequest {
 /// The designed filter.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FirDesign {
-    /// Requested pass-band edge [Hz].
+    /// Requested pass-band edge \[Hz\].
     pub pass_edge_hz: f64,
-    /// Requested stop-band edge [Hz].
+    /// Requested stop-band edge \[Hz\].
     pub stop_edge_hz: f64,
-    /// Requested maximal pass-band deviation [linear].
+    /// Requested maximal pass-band deviation \[linear\].
     pub pass_ripple: f64,
     /// Filter order N − 1 [taps − 1].
     pub order: usize,
-    /// Floating-point equiripple taps, symmetric, Σ = 1 (to f64 rounding) [1].
+    /// Floating-point equiripple taps, symmetric, Σ = 1 (to f64 rounding) \[1\].
     pub taps: Vec<f64>,
     /// Q1.15 taps for the FMAC: symmetric, Σ = 32768 exactly (DC gain 1) [LSB of 2^−15].
     pub taps_q15: Vec<i16>,
-    /// Achieved max ||H| − 1| over [0, pass_edge], float taps [linear].
+    /// Achieved max ||H| − 1| over [0, pass_edge], float taps \[linear\].
     pub pass_ripple_design: f64,
-    /// Same for the Q1.15 taps; ≤ the requested `pass_ripple` [linear].
+    /// Same for the Q1.15 taps; ≤ the requested `pass_ripple` \[linear\].
     pub pass_ripple_quantised: f64,
-    /// Achieved min attenuation −20·log10|H| over [stop_edge, f_s/2], float taps [dB].
+    /// Achieved min attenuation −20·log10|H| over [stop_edge, f_s/2], float taps \[dB\].
     pub stop_attenuation_db_design: f64,
-    /// Same for the Q1.15 taps [dB].
+    /// Same for the Q1.15 taps \[dB\].
     pub stop_attenuation_db_quantised: f64,
-    /// Group delay order/2 (exact, linear phase) [samples].
+    /// Group delay order/2 (exact, linear phase) \[samples\].
     pub group_delay_samples: f64,
-    /// Group delay order/(2·f_s) [s].
+    /// Group delay order/(2·f_s) \[s\].
     pub group_delay_s: f64,
     /// FMAC local-memory words used, 2N + 1 [16-bit words].
     pub fmac_memory_words: usize,
-    /// Stop-band/pass-band weight ratio w of the Remez design [1].
+    /// Stop-band/pass-band weight ratio w of the Remez design \[1\].
     pub stop_weight: f64,
 }
 

@@ -6,8 +6,8 @@ use std::f64::consts::PI;
 use super::validate::Spec;
 use super::{GRID_POINTS_PER_TAP, Q15_ONE};
 
-/// Magnitude response |H(f)| = |Σ h[n]·e^(−j2πfn/f_s)| of arbitrary taps at `f_hz` [Hz]
-/// for sample rate `fs_hz` [Hz]; returns a linear gain [1] (NaN for non-finite inputs).
+/// Magnitude response |H(f)| = |Σ h\[n\]·e^(−j2πfn/f_s)| of arbitrary taps at `f_hz` \[Hz\]
+/// for sample rate `fs_hz` \[Hz\]; returns a linear gain \[1\] (NaN for non-finite inputs).
 pub fn magnitude(taps: &[f64], f_hz: f64, fs_hz: f64) -> f64 {
     let w = 2.0 * PI * f_hz / fs_hz;
     let (s, c) = (-w).sin_cos();

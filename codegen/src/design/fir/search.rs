@@ -54,11 +54,11 @@ pub(super) fn kaiser_db(spec: &Spec, order: f64) -> f64 {
     14.6 * (spec.fst - spec.fp) * order + 13.0
 }
 
-/// Kaiser's −10·log10(δ_p·δ_s) [dB] above which an order is refused: the equiripple design
+/// Kaiser's −10·log10(δ_p·δ_s) \[dB\] above which an order is refused: the equiripple design
 /// would need ripples near 1e−7 and below, where the f64 Remez exchange stalls (seen at
 /// δ_s ≈ 5e−9); Q1.15 rounding caps the attenuation near 90 dB long before.
 pub const MAX_KAISER_DB: f64 = 120.0;
-/// Largest stop-band attenuation accepted in minimum-order mode [dB]; Q1.15 rounding
+/// Largest stop-band attenuation accepted in minimum-order mode \[dB\]; Q1.15 rounding
 /// (±2^−16 per tap) leaves a floor near −90 dB.
 pub const MAX_ATTENUATION_DB: f64 = 100.0;
 /// Smallest ripple (pass or stop) the weight search lets the exact design aim for [linear].

@@ -39,7 +39,7 @@ pub struct ObserverOut {
     pub resolver_pole_pairs: u32,
     /// n_p/n_r of (4.5).
     pub electrical_per_resolver: f64,
-    /// θ_off [rad] of (4.5), if known.
+    /// θ_off \[rad\] of (4.5), if known.
     pub resolver_offset_rad: Option<f64>,
     /// θ_off as a Q1.31 stored integer (angle/π), if known.
     pub resolver_offset_q31: Option<i32>,
@@ -49,7 +49,7 @@ pub struct ObserverOut {
     pub lead_samples_source: Provenance,
     /// k in Q16.16: θ_e,lead^i = θ_e^i + (ω_e^i·LEAD) >> 16, ω_e^i the per-sample electrical angle step (4.19), (4.23).
     pub lead_q16: i32,
-    /// Lag k·ω_e,max·T_s at maximum speed [deg] (4.23).
+    /// Lag k·ω_e,max·T_s at maximum speed \[deg\] (4.23).
     pub lead_at_max_speed_deg: f64,
     /// The error form as the generated `observer::ERROR_FORM`: 0 = trig identity (4.8),
     /// 1 = atan2 (CORDIC phase, normalised by π).
@@ -111,10 +111,8 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
         resolver_pole_pairs: nr,
         electrical_per_resolver: f64::from(np) / f64::from(nr),
         resolver_offset_rad: offset,
-        resolver_offset_q31: offset.map(|a| {
-            let wrapped = (a / PI + 1.0).rem_euclid(2.0) - 1.0; // [−1, 1)
-            ((wrapped * angle_observer::Q31_ONE).round() as i64).clamp(i64::from(i32::MIN), i64::from(i32::MAX)) as i32
-        }),
+        // θ_off wrapped into one turn, π-scaled Q1.31 (4.20): the control core's own conversion.
+        resolver_offset_q31: offset.map(motor_control::angle::from_radians_f64),
         lead_samples: lead,
         lead_samples_source: o.lead_samples.source,
         lead_q16: (lead * 65_536.0).round() as i32,

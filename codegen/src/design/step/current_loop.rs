@@ -15,11 +15,11 @@ use crate::spec::{Method, Spec};
 /// Decoupling and back-EMF feed-forward constants (5.3), torque → i_q (2.34).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FeedForward {
-    /// L_d in u_q,ff = ω_e·(L_d·i_d + ψ_M) [H].
+    /// L_d in u_q,ff = ω_e·(L_d·i_d + ψ_M) \[H\].
     pub d_inductance_h: f64,
-    /// L_q in u_d,ff = −ω_e·L_q·i_q [H].
+    /// L_q in u_d,ff = −ω_e·L_q·i_q \[H\].
     pub q_inductance_h: f64,
-    /// ψ_M in the back-EMF term [Wb]; null when unknown (term omitted).
+    /// ψ_M in the back-EMF term \[Wb\]; null when unknown (term omitted).
     pub flux_linkage_wb: Option<f64>,
     /// K_t = 3/2·n_p·ψ_M per peak ampere [N·m/A] (2.34).
     pub torque_constant_nm_per_a: Option<f64>,
@@ -40,9 +40,9 @@ pub struct CurrentLoopOut {
     pub natural_frequency_rad_s: Option<f64>,
     /// Guideline ceiling for α [rad/s]: 30 % (1st order) or 17 % (2nd order) of f_s.
     pub bandwidth_limit_rad_s: f64,
-    /// Designed 10–90 % rise time [s]: ln 9/α for first-order loops.
+    /// Designed 10–90 % rise time \[s\]: ln 9/α for first-order loops.
     pub rise_time_s: Option<f64>,
-    /// 10–90 % rise time [s] of the sampled d- and q-axis loops with the 1.5·T_s delay
+    /// 10–90 % rise time \[s\] of the sampled d- and q-axis loops with the 1.5·T_s delay
     /// (`discrete_loop`), first-order methods.
     pub sampled_rise_time_s: Option<[f64; 2]>,
     /// Each axis designed for a lower α so that the sampled loop rises in ln 9/α.
@@ -55,7 +55,7 @@ pub struct CurrentLoopOut {
     pub q: AxisGains,
     /// The same design with R at the maximum winding temperature (thesis B 2.24), if `[thermal]` is given.
     pub hot: Option<HotVariant>,
-    /// Voltage limit of the PI output vector, U_dc/√3 [V] (thesis B 2.50).
+    /// Voltage limit of the PI output vector, U_dc/√3 \[V\] (thesis B 2.50).
     pub voltage_limit_v: f64,
     /// Feed-forward constants.
     pub feedforward: FeedForward,
@@ -66,7 +66,7 @@ pub struct CurrentLoopOut {
 pub struct HotVariant {
     /// Winding temperature [°C].
     pub temperature_c: f64,
-    /// R_s(T) [Ω].
+    /// R_s(T) \[Ω\].
     pub phase_resistance_ohm: f64,
     /// d-axis gains.
     pub d: AxisGains,

@@ -8,19 +8,19 @@ use crate::design::{dead_time, sampling};
 /// Inverter operating point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct DriveOut {
-    /// f_s [Hz].
+    /// f_s \[Hz\].
     pub switching_frequency_hz: f64,
-    /// T_s = 1/f_s [s].
+    /// T_s = 1/f_s \[s\].
     pub sample_period_s: f64,
-    /// 12·f_e,max [Hz] (1.1).
+    /// 12·f_e,max \[Hz\] (1.1).
     pub min_switching_frequency_hz: f64,
-    /// U_dc [V].
+    /// U_dc \[V\].
     pub dc_link_voltage_v: f64,
-    /// Lowest U_dc [V].
+    /// Lowest U_dc \[V\].
     pub dc_link_voltage_min_v: f64,
-    /// Dead time [s] (`drive.dead_time`).
+    /// Dead time \[s\] (`drive.dead_time`).
     pub dead_time_s: Option<f64>,
-    /// Its average voltage error U_dc·t_d·f_s [V] (see [`dead_time`]).
+    /// Its average voltage error U_dc·t_d·f_s \[V\] (see [`dead_time`]).
     pub dead_time_voltage_error_v: Option<f64>,
 }
 

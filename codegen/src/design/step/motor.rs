@@ -37,35 +37,35 @@ impl From<&Param> for Origin {
 pub struct MotorOut {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub phase_resistance_ohm: f64,
-    /// R_s at the maximum winding temperature [Ω] (thesis B 2.24), if `[thermal]` is given.
+    /// R_s at the maximum winding temperature \[Ω\] (thesis B 2.24), if `[thermal]` is given.
     pub phase_resistance_hot_ohm: Option<f64>,
-    /// L_d [H].
+    /// L_d \[H\].
     pub d_inductance_h: f64,
-    /// L_q [H].
+    /// L_q \[H\].
     pub q_inductance_h: f64,
-    /// ψ_M [Wb], null if unknown.
+    /// ψ_M \[Wb\], null if unknown.
     pub flux_linkage_wb: Option<f64>,
     /// Every redundant pair the spec gives, compared (tolerance 5 %).
     pub cross_checks: Vec<CrossCheck>,
-    /// τ_d = L_d/R [s].
+    /// τ_d = L_d/R \[s\].
     pub d_time_constant_s: f64,
-    /// τ_q = L_q/R [s].
+    /// τ_q = L_q/R \[s\].
     pub q_time_constant_s: f64,
-    /// Peak phase current, rms [A].
+    /// Peak phase current, rms \[A\].
     pub peak_current_a_rms: f64,
-    /// Nominal phase current, rms [A].
+    /// Nominal phase current, rms \[A\].
     pub nominal_current_a_rms: Option<f64>,
     /// Maximum shaft speed [rad/s].
     pub max_speed_rad_s: f64,
-    /// Maximum shaft speed [rpm].
+    /// Maximum shaft speed \[rpm\].
     pub max_speed_rpm: f64,
-    /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).
+    /// f_e,max = n_p·n_max/60 \[Hz\] (Table 1.2).
     pub max_electrical_frequency_hz: f64,
     /// ω_e,max = 2π·f_e,max [rad/s] (2.19).
     pub max_electrical_speed_rad_s: f64,
-    /// Peak phase-current amplitude √2·I_peak,rms [A] (current-circle radius, thesis B 2.51).
+    /// Peak phase-current amplitude √2·I_peak,rms \[A\] (current-circle radius, thesis B 2.51).
     pub peak_current_a: f64,
     /// Where each value came from.
     pub provenance: BTreeMap<&'static str, Origin>,

@@ -15,9 +15,11 @@
 //! `v_q = R·i_q + L_q·di_q/dt + ω·(L_d·i_d + ψ_M)`. With a saturation curve, L_q is
 //! L_q(|i_q|) (thesis B (2.25)), interpolated linearly between the spec's points.
 //!
-//! The shaft follows an imposed speed profile (the current loop is much faster than the
-//! mechanics, thesis B §2.2). Inverter: the phase voltages are `(duty − 1/2)·U_dc`,
-//! constant over a period (volt-second average, thesis A (3.3)); the currents are
+//! The shaft ([`Shaft`]) either follows an imposed speed profile (the current loop is
+//! much faster than the mechanics, thesis B §2.2) or turns freely: J·dω_m/dt = T_e − b·ω_m
+//! with T_e = 3/2·n_p·i_q·(ψ_M + (L_d − L_q)·i_d) (thesis A (2.33), (2.34); harmonic
+//! torque is not modelled). Inverter: the phase voltages are `(duty − 1/2)·U_dc`,
+//! constant over a period (volt-second average, thesis A (3.3)); the state is
 //! integrated with RK4 on [`SUBSTEPS`] sub-steps while the rotor turns.
 
 use std::f64::consts::PI;
@@ -30,26 +32,26 @@ pub const SUBSTEPS: usize = 4;
 pub struct MotorModel {
     /// n_p.
     pub pole_pairs: u32,
-    /// R_s [Ω].
+    /// R_s \[Ω\].
     pub resistance: f64,
-    /// L_d [H].
+    /// L_d \[H\].
     pub ld: f64,
-    /// L_q [H] (unsaturated).
+    /// L_q \[H\] (unsaturated).
     pub lq: f64,
-    /// ψ_M [Wb] (0 when the spec does not know it).
+    /// ψ_M \[Wb\] (0 when the spec does not know it).
     pub psi: f64,
-    /// L_6 [H] (2.16c).
+    /// L_6 \[H\] (2.16c).
     pub l6: f64,
-    /// ψ_d,6, ψ_d,12 [Wb] (2.16e).
+    /// ψ_d,6, ψ_d,12 \[Wb\] (2.16e).
     pub psi_d: [f64; 2],
-    /// ψ_q,6, ψ_q,12 [Wb] (2.16f).
+    /// ψ_q,6, ψ_q,12 \[Wb\] (2.16f).
     pub psi_q: [f64; 2],
-    /// L_q(|i_q|) points ([A], [H]), sorted by current; empty = constant L_q.
+    /// L_q(|i_q|) points (\[A\], \[H\]), sorted by current; empty = constant L_q.
     pub q_saturation: Vec<(f64, f64)>,
 }
 
 impl MotorModel {
-    /// L_q at `iq` [A]: the saturation curve (2.25), constant beyond its ends.
+    /// L_q at `iq` \[A\]: the saturation curve (2.25), constant beyond its ends.
     pub fn lq_at(&self, iq: f64) -> f64 {
         let pts = &self.q_saturation;
         let x = iq.abs();
@@ -107,7 +109,7 @@ pub struct SpeedProfile {
     pub from: f64,
     /// Speed after the ramp [rad/s].
     pub to: f64,
-    /// Ramp start [s].
+    /// Ramp start \[s\].
     pub start: f64,
     /// |acceleration| [rad/s²] (ignored when `from == to`).
     pub acceleration: f64,
@@ -141,12 +143,28 @@ impl SpeedProfile {
 /// What the ADCs and the resolver demodulator deliver (before quantisation).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Measured {
-    /// Phase currents u, v, w [A].
+    /// Phase currents u, v, w \[A\].
     pub phase_currents: [f64; 3],
-    /// Resolver angle θ_r [rad].
+    /// Resolver angle θ_r \[rad\].
     pub theta_r: f64,
-    /// DC-link voltage [V].
+    /// DC-link voltage \[V\].
     pub dc_link: f64,
+}
+
+/// How the shaft moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shaft {
+    /// The shaft follows a speed profile (a dynamometer, or a blocked rotor at 0).
+    Imposed(SpeedProfile),
+    /// Free rotor: J·dω_m/dt = T_e − b·ω_m (thesis A (2.33)).
+    Free {
+        /// J [kg·m²].
+        inertia: f64,
+        /// b [N·m·s/rad].
+        damping: f64,
+        /// ω_m now [rad/s] (the mechanical state).
+        speed: f64,
+    },
 }
 
 /// The drive's state: currents, rotor angle, DC link, pending duties.
@@ -154,40 +172,76 @@ pub struct Measured {
 pub struct Plant {
     /// Machine parameters.
     pub motor: MotorModel,
-    /// Shaft speed profile.
-    pub speed: SpeedProfile,
+    /// How the shaft moves.
+    pub shaft: Shaft,
     /// Resolver pole pairs n_r (4.4).
     pub resolver_pole_pairs: u32,
-    /// Resolver offset θ_off [rad] (4.5): θ_r = n_r·θ_m + θ_off.
+    /// Resolver mounted the other way round: θ_r = −n_r·θ_m + θ_off.
+    pub resolver_reversed: bool,
+    /// Resolver offset θ_off \[rad\] (4.5): θ_r = n_r·θ_m + θ_off.
     pub resolver_offset: f64,
-    /// PWM period T_s [s].
+    /// PWM period T_s \[s\].
     pub ts: f64,
-    /// Time [s].
+    /// Time \[s\].
     pub t: f64,
-    /// i_d, i_q [A].
+    /// i_d, i_q \[A\].
     pub i: [f64; 2],
-    /// Mechanical angle θ_m [rad], unwrapped.
+    /// Mechanical angle θ_m \[rad\], unwrapped.
     pub theta_m: f64,
-    /// Actual DC-link voltage [V] (a scenario may change it between periods).
+    /// Actual DC-link voltage \[V\] (a scenario may change it between periods).
     pub dc_link: f64,
     /// Duties loaded for the next period (computed at the previous sample); `None` = gates off.
     pub pending: Option<[f32; 3]>,
 }
 
 impl Plant {
-    /// Electrical angle θ_e = n_p·θ_m (thesis A (2.19)) [rad].
+    /// A drive at rest at θ_m = 0, t = 0, without current, gates off, with a one-pole-pair
+    /// resolver at zero offset.
+    pub fn new(motor: MotorModel, shaft: Shaft, ts: f64, dc_link: f64) -> Self {
+        Self {
+            motor,
+            shaft,
+            resolver_pole_pairs: 1,
+            resolver_reversed: false,
+            resolver_offset: 0.0,
+            ts,
+            t: 0.0,
+            i: [0.0, 0.0],
+            theta_m: 0.0,
+            dc_link,
+            pending: None,
+        }
+    }
+
+    /// Electrical angle θ_e = n_p·θ_m (thesis A (2.19)) \[rad\].
     pub fn theta_e(&self) -> f64 {
         f64::from(self.motor.pole_pairs) * self.theta_m
     }
 
-    /// Resolver angle θ_r = n_r·θ_m + θ_off [rad] (4.4), (4.5).
+    /// Resolver turns per mechanical turn, signed: ±n_r.
+    pub fn resolver_ratio(&self) -> f64 {
+        let nr = f64::from(self.resolver_pole_pairs);
+        if self.resolver_reversed { -nr } else { nr }
+    }
+
+    /// Resolver angle θ_r = ±n_r·θ_m + θ_off \[rad\] (4.4), (4.5).
     pub fn theta_r(&self) -> f64 {
-        f64::from(self.resolver_pole_pairs) * self.theta_m + self.resolver_offset
+        self.resolver_ratio() * self.theta_m + self.resolver_offset
     }
 
     /// Mechanical speed now [rad/s].
     pub fn omega_m(&self) -> f64 {
-        self.speed.at(self.t)
+        match self.shaft {
+            Shaft::Imposed(p) => p.at(self.t),
+            Shaft::Free { speed, .. } => speed,
+        }
+    }
+
+    /// Electromagnetic torque T_e = 3/2·n_p·i_q·(ψ_M + (L_d − L_q(i_q))·i_d) [N·m]
+    /// (thesis A (2.33)) at the currents `i`.
+    pub fn torque(&self, i: [f64; 2]) -> f64 {
+        let m = &self.motor;
+        1.5 * f64::from(m.pole_pairs) * i[1] * (m.psi + (m.ld - m.lq_at(i[1])) * i[0])
     }
 
     /// The sampled quantities at the current instant.
@@ -204,49 +258,66 @@ impl Plant {
         }
     }
 
-    /// Advances one PWM period with the pending duties.
+    /// Advances one PWM period with the pending duties (`None` = gates off: no current,
+    /// as long as the back EMF stays below U_dc; the rotor keeps turning).
     pub fn advance(&mut self) {
         let np = f64::from(self.motor.pole_pairs);
-        let Some(d) = self.pending else {
-            // Gates off: no current (back EMF below U_dc); the rotor keeps turning.
-            // θ_m integrates the piecewise-linear speed exactly (Simpson's rule).
+        let u_ab = self.pending.map(|d| {
+            let ph = d.map(|x| (f64::from(x) - 0.5) * self.dc_link);
+            let k = 3f64.sqrt() / 2.0;
+            // Amplitude-invariant Clarke (thesis A (2.7)); the common mode drops out.
+            [
+                2.0 / 3.0 * (ph[0] - 0.5 * ph[1] - 0.5 * ph[2]),
+                2.0 / 3.0 * k * (ph[1] - ph[2]),
+            ]
+        });
+        if u_ab.is_none() {
             self.i = [0.0, 0.0];
-            let (t, h) = (self.t, self.ts);
-            self.theta_m += h / 6.0 * (self.speed.at(t) + 4.0 * self.speed.at(t + h / 2.0) + self.speed.at(t + h));
-            self.t += h;
-            return;
+            if let Shaft::Imposed(p) = self.shaft {
+                // θ_m integrates the piecewise-linear speed exactly (Simpson's rule).
+                let (t, h) = (self.t, self.ts);
+                self.theta_m += h / 6.0 * (p.at(t) + 4.0 * p.at(t + h / 2.0) + p.at(t + h));
+                self.t += h;
+                return;
+            }
+        }
+        // State [i_d, i_q, θ_m, ω_m]; ω_m is a state only for the free shaft.
+        let f = |t: f64, s: [f64; 4]| -> [f64; 4] {
+            let (wm, dw) = match self.shaft {
+                Shaft::Imposed(p) => (p.at(t), 0.0),
+                Shaft::Free { inertia, damping, .. } => (s[3], (self.torque([s[0], s[1]]) - damping * s[3]) / inertia),
+            };
+            let di = match u_ab {
+                Some(u) => {
+                    let th = np * s[2];
+                    let (sn, cs) = th.sin_cos();
+                    let v = [cs * u[0] + sn * u[1], -sn * u[0] + cs * u[1]];
+                    self.motor.current_derivative(th, np * wm, [s[0], s[1]], v)
+                }
+                None => [0.0, 0.0],
+            };
+            [di[0], di[1], wm, dw]
         };
-        let ph = d.map(|x| (f64::from(x) - 0.5) * self.dc_link);
-        let k = 3f64.sqrt() / 2.0;
-        // Amplitude-invariant Clarke (thesis A (2.7)); the common mode drops out.
-        let u_ab = [
-            2.0 / 3.0 * (ph[0] - 0.5 * ph[1] - 0.5 * ph[2]),
-            2.0 / 3.0 * k * (ph[1] - ph[2]),
-        ];
+        let add =
+            |a: [f64; 4], b: [f64; 4], k: f64| [a[0] + k * b[0], a[1] + k * b[1], a[2] + k * b[2], a[3] + k * b[3]];
         let h = self.ts / SUBSTEPS as f64;
-        let f = |t: f64, s: [f64; 3]| -> [f64; 3] {
-            let th = np * s[2];
-            let wm = self.speed.at(t);
-            let (sn, cs) = th.sin_cos();
-            let v = [cs * u_ab[0] + sn * u_ab[1], -sn * u_ab[0] + cs * u_ab[1]];
-            let di = self.motor.current_derivative(th, np * wm, [s[0], s[1]], v);
-            [di[0], di[1], wm]
-        };
-        let add = |a: [f64; 3], b: [f64; 3], k: f64| [a[0] + k * b[0], a[1] + k * b[1], a[2] + k * b[2]];
-        let mut s = [self.i[0], self.i[1], self.theta_m];
+        let mut s = [self.i[0], self.i[1], self.theta_m, self.omega_m()];
         let mut t = self.t;
         for _ in 0..SUBSTEPS {
             let k1 = f(t, s);
             let k2 = f(t + h / 2.0, add(s, k1, h / 2.0));
             let k3 = f(t + h / 2.0, add(s, k2, h / 2.0));
             let k4 = f(t + h, add(s, k3, h));
-            for j in 0..3 {
+            for j in 0..4 {
                 s[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
             }
             t += h;
         }
         self.i = [s[0], s[1]];
         self.theta_m = s[2];
+        if let Shaft::Free { speed, .. } = &mut self.shaft {
+            *speed = s[3];
+        }
         self.t += self.ts;
     }
 }
@@ -310,24 +381,43 @@ mod tests {
         assert_eq!(m.lq_at(400.0), 0.42e-3);
     }
 
+    /// (2.33) by hand: n_p = 2, ψ = 0.1 Wb, L_d − L_q = −1 mH, i = (−10, 20) A:
+    /// T_e = 1.5·2·20·(0.1 + (−1e-3)·(−10)) = 60·0.11 = 6.6 N·m.
+    #[test]
+    fn torque_by_hand() {
+        let p = Plant::new(motor(), Shaft::Imposed(SpeedProfile::constant(0.0)), 50e-6, 100.0);
+        assert!((p.torque([-10.0, 20.0]) - 6.6).abs() < 1e-12);
+    }
+
+    /// A free shaft with the gates off spins down as J·dω/dt = −b·ω:
+    /// ω(t) = ω_0·e^(−bt/J), θ(t) = ω_0·J/b·(1 − e^(−bt/J)). J = 1e-3 kg·m², b = 0.05 N·m·s,
+    /// ω_0 = 100 rad/s, t = 200·50 µs = 10 ms: ω = 100·e^(−0.5) = 60.65 rad/s,
+    /// θ = 2·(1 − e^(−0.5)) = 0.7869 rad.
+    #[test]
+    fn free_shaft_spins_down() {
+        let shaft = Shaft::Free {
+            inertia: 1e-3,
+            damping: 0.05,
+            speed: 100.0,
+        };
+        let mut p = Plant::new(motor(), shaft, 50e-6, 100.0);
+        for _ in 0..200 {
+            p.advance();
+        }
+        let decay = (-0.5f64).exp();
+        assert!((p.omega_m() - 100.0 * decay).abs() < 1e-9, "{}", p.omega_m());
+        assert!((p.theta_m - 2.0 * (1.0 - decay)).abs() < 1e-9, "{}", p.theta_m);
+        assert_eq!(p.i, [0.0, 0.0]);
+    }
+
     /// A constant voltage step at standstill gives i = V/R·(1 − e^(−tR/L)) exactly.
     #[test]
     fn rl_step_matches_the_exact_solution() {
         let m = motor();
-        let mut p = Plant {
-            motor: m.clone(),
-            speed: SpeedProfile::constant(0.0),
-            resolver_pole_pairs: 1,
-            resolver_offset: 0.0,
-            ts: 50e-6,
-            t: 0.0,
-            i: [0.0, 0.0],
-            theta_m: 0.0,
-            dc_link: 100.0,
-            // Phase voltages (d − 1/2)·100 V = (3, −1.5, −1.5) V → u_α = 2/3·(3 + 0.75 + 0.75)
-            // = 3 V, u_β = 0; at θ = 0 that is u_d (f32 duties: computed from them below).
-            pending: Some([0.53, 0.485, 0.485]),
-        };
+        let mut p = Plant::new(m.clone(), Shaft::Imposed(SpeedProfile::constant(0.0)), 50e-6, 100.0);
+        // Phase voltages (d − 1/2)·100 V = (3, −1.5, −1.5) V → u_α = 2/3·(3 + 0.75 + 0.75)
+        // = 3 V, u_β = 0; at θ = 0 that is u_d (f32 duties: computed from them below).
+        p.pending = Some([0.53, 0.485, 0.485]);
         for _ in 0..40 {
             p.advance();
         }

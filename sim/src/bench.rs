@@ -7,10 +7,11 @@
 use std::f64::consts::PI;
 
 use motor_control::SoftTrig;
+use motor_control::angle;
 use motor_control::ato::{AtoState, ResolverSample};
 use motor_control::step::{AdcSample, ControllerConfig, ControllerState, Demand, StepOutput};
 
-use super::plant::{Plant, wrap};
+use crate::plant::Plant;
 
 /// 2^31: one Q1.31 unit.
 pub const Q31: f64 = 2_147_483_648.0;
@@ -31,13 +32,13 @@ pub struct Bench {
 /// One recorded period.
 #[derive(Clone, Copy, Debug)]
 pub struct Sample {
-    /// Time of the sample t_n [s].
+    /// Time of the sample t_n \[s\].
     pub t: f64,
-    /// True i_d, i_q at t_n [A].
+    /// True i_d, i_q at t_n \[A\].
     pub i: [f64; 2],
     /// The controller's output at t_n.
     pub out: StepOutput,
-    /// True resolver angle θ_r(t_n) [rad].
+    /// True resolver angle θ_r(t_n) \[rad\].
     pub theta_r: f64,
     /// True mechanical speed [rad/s].
     pub omega_m: f64,
@@ -48,10 +49,11 @@ impl Bench {
     /// takes a first atan2 of the resolver signals); state at n = −1.
     pub fn new(cfg: ControllerConfig, plant: Plant) -> Self {
         let mut state = ControllerState::new();
-        let nr = f64::from(plant.resolver_pole_pairs);
-        let w_r = nr * plant.omega_m() * plant.ts; // rad per sample
-        let th = wrap(plant.theta_r() - w_r);
-        state.observer = AtoState::locked(angle_q31(th), (w_r / PI * Q31).round() as i32);
+        let w_r = plant.resolver_ratio() * plant.omega_m() * plant.ts; // rad per sample
+        state.observer = AtoState::locked(
+            angle::from_radians_f64(plant.theta_r() - w_r),
+            (w_r / PI * Q31).round() as i32,
+        );
         Self {
             cfg,
             state,
@@ -106,12 +108,7 @@ impl Bench {
     }
 }
 
-/// Angle [rad] → π-scaled Q1.31 stored integer (wrapping).
-pub fn angle_q31(theta: f64) -> i32 {
-    (wrap(theta) / PI * Q31).round() as i64 as i32
-}
-
-/// π-scaled Q1.31 stored integer → angle [rad].
+/// π-scaled Q1.31 stored integer → angle \[rad\].
 pub fn q31_angle(bits: i32) -> f64 {
     f64::from(bits) * PI / Q31
 }

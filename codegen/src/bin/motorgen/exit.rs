@@ -1,0 +1,115 @@
+//! The exit codes of `motorgen`, one per kind of failure, so that scripts and CI can
+//! tell a bad spec from a failed verification or a full disk. Documented in `--help`
+//! ([`HELP`]) and in the README.
+
+use std::process::ExitCode;
+
+use codegen::Diagnostics;
+
+use crate::atomic::IoFailure;
+use crate::output::{err, errln};
+
+/// Why `motorgen` stopped.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exit {
+    /// 0: done.
+    Success = 0,
+    /// 1: the input is wrong — a spec, recording, template or motor name; the message
+    /// names the file, line:column and key, and what would be accepted.
+    BadInput = 1,
+    /// 2: the command line is wrong (clap's own exit code for usage errors).
+    Usage = 2,
+    /// 3: the design was made but does not hold up: `verify`/`report` measured a
+    /// failing figure, or the `firmware` image exceeds its flash budget.
+    VerificationFailed = 3,
+    /// 74 (sysexits' EX_IOERR, [`crate::output::EXIT_IO`]): a file or directory could
+    /// not be read or written (standard output included), or cargo could not be run.
+    Io = crate::output::EXIT_IO as isize,
+    /// 5: the firmware build (cargo) failed.
+    BuildFailed = 5,
+}
+
+impl From<Exit> for ExitCode {
+    fn from(e: Exit) -> Self {
+        ExitCode::from(e as u8)
+    }
+}
+
+/// The exit-code table shown at the end of `motorgen --help`.
+pub const HELP: &str = "\
+Exit codes:
+  0  success
+  1  bad input: a spec, recording, template or motor name is wrong (located message on stderr)
+  2  usage: the command line is wrong
+  3  verification failed: a simulated figure failed, or the image exceeds its flash budget
+  5  the firmware build (cargo) failed
+  74 I/O: a file, directory or standard output could not be read or written, or cargo could not be run";
+
+/// A failed command: the message for stderr and the exit code.
+#[derive(Debug)]
+pub struct Failure {
+    /// Exit code.
+    pub exit: Exit,
+    /// Printed on stderr (a trailing newline is added if missing).
+    pub message: String,
+}
+
+impl Failure {
+    /// A failure of kind `exit` with `message`.
+    pub fn new(exit: Exit, message: impl Into<String>) -> Self {
+        Self {
+            exit,
+            message: message.into(),
+        }
+    }
+
+    /// Prints the message on stderr and returns the exit code.
+    pub fn report(self) -> ExitCode {
+        if self.message.ends_with('\n') {
+            err!("{}", self.message);
+        } else {
+            errln!("{}", self.message);
+        }
+        self.exit.into()
+    }
+}
+
+/// A file that could not be written is an I/O failure.
+impl From<IoFailure> for Failure {
+    fn from(e: IoFailure) -> Self {
+        Failure::new(Exit::Io, format!("error: {e}"))
+    }
+}
+
+/// Located diagnostics are bad input.
+impl From<Diagnostics> for Failure {
+    fn from(d: Diagnostics) -> Self {
+        Failure::new(Exit::BadInput, d.to_string())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The table in `--help` lists every code with its number.
+    #[test]
+    fn help_lists_every_code() {
+        for e in [
+            Exit::Success,
+            Exit::BadInput,
+            Exit::Usage,
+            Exit::VerificationFailed,
+            Exit::Io,
+            Exit::BuildFailed,
+        ] {
+            let code = e as u8;
+            let row = if code < 10 {
+                format!("\n  {code}  ")
+            } else {
+                format!("\n  {code} ")
+            };
+            assert!(HELP.contains(&row), "{e:?}");
+        }
+    }
+}
