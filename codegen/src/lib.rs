@@ -10,6 +10,7 @@ pub mod board;
 pub mod constants;
 pub mod design;
 pub mod diagnostic;
+pub mod escape;
 pub mod files;
 #[cfg(feature = "identify")]
 pub mod identify;

@@ -11,6 +11,7 @@ use serde::Serialize;
 
 use crate::Design;
 use crate::constants::{Constant, Group, constants};
+use crate::escape::{Target, escape, markdown_code};
 
 /// Output formats and their template file names.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -173,7 +174,18 @@ pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, Rende
         .build()
         .map_err(|e| render_error(&e, name))?;
     env.set_syntax(syntax);
-    env.add_filter("rust_const", |k: Serde<Constant>, indent: usize| rust_const(&k, indent));
+    // Generated code is marked safe; every other interpolated value is spec-derived text
+    // and goes through `escape` for the template's target (issue 18).
+    env.add_filter("rust_const", |k: Serde<Constant>, indent: usize| {
+        Value::from_safe_string(rust_const(&k, indent))
+    });
+    env.add_filter("md_code", |s: String| Value::from_safe_string(markdown_code(&s)));
+    let target = Target::of_template(name);
+    env.set_formatter(move |out, _state, value| {
+        let text = value.to_string();
+        let shown = if value.is_safe() { text } else { escape(&text, target) };
+        out.write_str(&shown).map_err(minijinja::Error::from)
+    });
     env.add_template(name, source).map_err(|e| render_error(&e, name))?;
     let groups: Vec<Group> = constants(d);
     let tmpl = env.get_template(name).map_err(|e| render_error(&e, name))?;

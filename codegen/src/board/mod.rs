@@ -1,6 +1,6 @@
 //! Inverter boards: one TOML file per board in `boards/`, resolved into SI values and
 //! checked against the microcontroller's own pin data ([`chip`]) before anything is
-//! built. Every problem is a located [`Diagnostic`] like a motor spec's: file,
+//! built. Every problem is a located [`Diagnostic`](crate::Diagnostic) like a motor spec's: file,
 //! line:column, key, what is wrong, what would be accepted.
 //!
 //! What is checked: the chip is one we carry data for; every pin exists in its package;

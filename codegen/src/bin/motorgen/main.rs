@@ -37,7 +37,7 @@ enum Command {
         /// Directory with replacement templates (for rust, c, markdown).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
-        /// A board file (boards/<name>.toml): adds the `board` constants and the checks
+        /// A board file (boards/NAME.toml): adds the `board` constants and the checks
         /// of the motor on that board.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,

@@ -3,6 +3,7 @@
 use std::fmt;
 
 use super::search::{MAX_ATTENUATION_DB, MAX_KAISER_DB};
+use super::validate::MIN_PASS_EDGE_NORMALISED;
 use super::{FMAC_MAX_TAPS, FMAC_MEMORY_WORDS, MIN_ORDER};
 
 /// Why no filter was designed; [`FirError::key`] names the spec key to point at.
@@ -32,6 +33,13 @@ pub enum FirError {
         edge_hz: f64,
         /// f_s/2 \[Hz\].
         nyquist_hz: f64,
+    },
+    /// pass_edge below 1e-6·f_s (`MIN_PASS_EDGE_NORMALISED`), where the exchange does not converge.
+    PassEdgeTooLow {
+        /// The pass edge given \[Hz\].
+        pass_edge_hz: f64,
+        /// The lowest accepted pass edge \[Hz\].
+        min_hz: f64,
     },
     /// pass_ripple outside (0, 0.5) or NaN.
     RippleOutOfRange {
@@ -111,7 +119,7 @@ impl FirError {
             FirError::OrderOutOfRange { .. } | FirError::NoAttenuation { .. } | FirError::Remez { .. } => "order",
             FirError::OrderBeyondPrecision { .. } => "order",
             FirError::AttenuationInfeasible { .. } | FirError::AttenuationBeyondQ15 { .. } => "stop_attenuation",
-            FirError::TapOverflow { .. } => "pass_edge",
+            FirError::TapOverflow { .. } | FirError::PassEdgeTooLow { .. } => "pass_edge",
         }
     }
 }
@@ -157,6 +165,13 @@ impl fmt::Display for FirError {
                 "{key} {} is at or beyond the Nyquist frequency {}; accepted: pass_edge < stop_edge < f_s/2",
                 hz(*edge_hz),
                 hz(*nyquist_hz)
+            ),
+            FirError::PassEdgeTooLow { pass_edge_hz, min_hz } => write!(
+                f,
+                "pass_edge {} is below {MIN_PASS_EDGE_NORMALISED:e}·f_s = {}: the Parks–McClellan exchange does not converge on so narrow a pass band; accepted: {} ≤ pass_edge < stop_edge < f_s/2",
+                hz(*pass_edge_hz),
+                hz(*min_hz),
+                hz(*min_hz)
             ),
             FirError::RippleOutOfRange { ripple } => write!(
                 f,

@@ -509,3 +509,27 @@ proptest! {
         prop_assert!(exact_lsb - y >= 0.0 && exact_lsb - y <= bound, "exact {} out {} bound {}", exact_lsb, y, bound);
     }
 }
+
+/// Issue 18: `[fir] pass_edge = "0.001 Hz"` stalled the exchange for minutes; it is
+/// refused at pass_edge with the range that works, and the lowest accepted edge designs.
+#[test]
+fn pass_edge_too_low_for_the_exchange_is_refused_and_its_minimum_designs() {
+    let low = FirRequest {
+        pass_edge_hz: 0.001,
+        ..thesis()
+    };
+    let e = design_fir(&low).unwrap_err();
+    assert_eq!(e.key(), "pass_edge");
+    // 1e-6 · 20 kHz = 0.02 Hz.
+    assert_eq!(
+        e.to_string(),
+        "pass_edge 0.001 Hz is below 1e-6·f_s = 0.02 Hz: the Parks–McClellan exchange does not converge on so narrow a pass band; accepted: 0.02 Hz ≤ pass_edge < stop_edge < f_s/2"
+    );
+    let d = design_fir(&FirRequest {
+        pass_edge_hz: 0.02,
+        ..thesis()
+    })
+    .unwrap();
+    assert_eq!(d.order, 20);
+    assert_eq!(d.taps_q15.iter().map(|&t| i32::from(t)).sum::<i32>(), Q15_ONE);
+}

@@ -3,6 +3,15 @@
 use super::error::FirError;
 use super::{FMAC_MAX_TAPS, FirLength, FirRequest, MIN_ORDER};
 
+/// Lowest pass_edge/f_s accepted [cycles/sample]. Below it the pass band (0.01·f_p, f_p)
+/// of the Parks–McClellan exchange is so narrow (its weight (1 − cos ω) ≈ 2π²f² < 2e−11)
+/// that one exchange iteration's extrema search stalls: measured on the thesis-A request
+/// (f_s = 20 kHz, stop_edge 2 kHz, order 20), pass_edge/f_s = 2.5e−7 designs in 0.6 s
+/// (debug build) and 1e−7 runs past 15 s (issue 18). 1e−6 keeps a factor 4 from the
+/// last good point; at it, orders up to 70 and the 60 dB minimum-order search design in
+/// under a second.
+pub const MIN_PASS_EDGE_NORMALISED: f64 = 1e-6;
+
 /// Validated request in normalised frequency (cycles/sample).
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Spec {
@@ -31,6 +40,13 @@ pub(super) fn validate(req: &FirRequest) -> Result<Spec, FirError> {
     if !(req.pass_ripple > 0.0 && req.pass_ripple < 0.5) {
         return Err(FirError::RippleOutOfRange {
             ripple: req.pass_ripple,
+        });
+    }
+    let min_pass_hz = MIN_PASS_EDGE_NORMALISED * req.sample_rate_hz;
+    if req.pass_edge_hz < min_pass_hz {
+        return Err(FirError::PassEdgeTooLow {
+            pass_edge_hz: req.pass_edge_hz,
+            min_hz: min_pass_hz,
         });
     }
     let nyquist_hz = req.sample_rate_hz / 2.0;
