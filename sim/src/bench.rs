@@ -40,7 +40,7 @@ pub struct Sample {
     pub out: StepOutput,
     /// True resolver angle θ_r(t_n) \[rad\].
     pub theta_r: f64,
-    /// True electrical angle θ_e(t_n) = n_p·θ_m [rad].
+    /// True electrical angle θ_e(t_n) = n_p·θ_m \[rad\].
     pub theta_e: f64,
     /// True mechanical speed [rad/s].
     pub omega_m: f64,

@@ -17,7 +17,7 @@
 
 use serde::Serialize;
 
-/// Run-up time from standstill to the maximum speed of the default acceleration [s].
+/// Run-up time from standstill to the maximum speed of the default acceleration \[s\].
 pub const DEFAULT_RUN_UP_S: f64 = 10.0;
 
 /// Where the acceleration came from.

@@ -85,7 +85,7 @@ pub struct Pi {
     pub kp: f64,
     /// K_i [V/(A·s)].
     pub ki: f64,
-    /// R_a [Ω].
+    /// R_a \[Ω\].
     pub active_damping_ohm: f64,
     /// Reference prefilter (pole placement).
     pub prefilter: Option<Prefilter>,
@@ -102,7 +102,7 @@ impl Pi {
     }
 
     /// Series form, anti-windup, K_i·T_s and the sampled-loop figures for the plant
-    /// `r` [Ω], `l` [H] at `ts` [s].
+    /// `r` \[Ω\], `l` \[H\] at `ts` \[s\].
     pub fn finish(self, r: f64, l: f64, ts: f64) -> AxisGains {
         let sampled = sampled_loop::analyse(&self.loop_gains(), r, l, ts);
         AxisGains {
@@ -156,8 +156,8 @@ pub fn overshoot(zeta: f64) -> f64 {
     }
 }
 
-/// Designs one axis with resistance `r` [Ω], inductance `l` [H], bandwidth `alpha` [rad/s],
-/// damping `zeta` (pole placement), sample period `ts` [s], by the continuous rules of the
+/// Designs one axis with resistance `r` \[Ω\], inductance `l` \[H\], bandwidth `alpha` [rad/s],
+/// damping `zeta` (pole placement), sample period `ts` \[s\], by the continuous rules of the
 /// module documentation, and analyses it on the sampled loop.
 pub fn design_axis(
     method: Method,

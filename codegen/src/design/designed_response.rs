@@ -4,7 +4,7 @@
 
 use super::discrete_loop::rise_time;
 
-/// Unit step response of the designed closed loop at `t` [s]: first order
+/// Unit step response of the designed closed loop at `t` \[s\]: first order
 /// `1 − e^(−αt)` (thesis A (5.8), thesis B (2.41)) when `zeta` is `None`, else the
 /// second-order system of thesis A (4.14) with ω_n, ζ (the prefilter (5.16) having
 /// cancelled the zero).
@@ -24,7 +24,7 @@ pub fn designed_step(t: f64, alpha: f64, second_order: Option<(f64, f64)>) -> f6
     }
 }
 
-/// 10–90 % rise time of [`designed_step`] [s], found on a grid of 1/(2000·α).
+/// 10–90 % rise time of [`designed_step`] \[s\], found on a grid of 1/(2000·α).
 pub fn designed_rise_time(alpha: f64, second_order: Option<(f64, f64)>) -> f64 {
     let dt = 1.0 / (2000.0 * alpha);
     let y: Vec<f64> = (0..40_000)

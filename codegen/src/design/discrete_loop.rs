@@ -182,7 +182,7 @@ pub fn pole_placement(axis: char, r: f64, l: f64, alpha: f64, zeta: f64, ts: f64
     })
 }
 
-/// The sampled loop's lag behind a reference ramp [s]: the steady error to a unit ramp of
+/// The sampled loop's lag behind a reference ramp \[s\]: the steady error to a unit ramp of
 /// the type-1 loop, Σ T_s·(1 − y(n)) over its unit step y (the velocity-error constant
 /// 1/K_v; delays included), for gains `g` designed at bandwidth `alpha` [rad/s].
 pub fn ramp_lag(g: &LoopGains, r: f64, l: f64, ts: f64, alpha: f64) -> f64 {
@@ -235,13 +235,13 @@ pub fn promise(method: Method, alpha: f64, zeta: f64, compensate: bool) -> Promi
 pub struct Request {
     /// Tuning method.
     pub method: Method,
-    /// R [Ω].
+    /// R \[Ω\].
     pub r: f64,
-    /// L_d, L_q [H].
+    /// L_d, L_q \[H\].
     pub l: [f64; 2],
     /// ζ (pole placement).
     pub zeta: f64,
-    /// T_s [s].
+    /// T_s \[s\].
     pub ts: f64,
     /// `compensate_delay`.
     pub compensate: bool,

@@ -55,7 +55,7 @@ pub fn onset_speed(m: &LossModel, v_prime: f64) -> f64 {
     (-b + (b * b - 4.0 * a * c).max(0.0).sqrt()) / (2.0 * a)
 }
 
-/// How far |v| rises above V'_max [V] while the speed rises at `acceleration`
+/// How far |v| rises above V'_max \[V\] while the speed rises at `acceleration`
 /// [rad/s², electrical] into field weakening at `onset` [rad/s] ([`onset_speed`]), with
 /// the full torque demand on the current circle (Mode B (2.57), i_q = √(I_max² − i_d²)).
 ///
@@ -65,7 +65,7 @@ pub fn onset_speed(m: &LossModel, v_prime: f64) -> f64 {
 /// ∂v_q/∂i_d = ω·L_d − R·i_d/i_q. With γ of (2.60) (ω_fw = max(ω_base, ω)) the loop's
 /// bandwidth is α = α_fw·s/(ω_fw·L_d) — below α_fw, since (2.60) assumes s = ω·L_d. The
 /// speed drives δ at ψ_s·ω̇_e (ψ_s = V'_max/ω, the stator flux), so dδ/dt = −α·δ + ψ_s·ω̇_e,
-/// and the current loop follows i_d^ref a ramp lag `lag` [s] behind
+/// and the current loop follows i_d^ref a ramp lag `lag` \[s\] behind
 /// (`discrete_loop::ramp_lag`): δ = ψ_s·ω̇_e·(1/α + τ_v). The onset is where δ is largest
 /// and α smallest (deeper in field weakening v_q/|v| → 1 and s → ω·L_d), so the estimate
 /// is on the safe side.
@@ -94,7 +94,7 @@ pub fn voltage_sensitivity(m: &LossModel, w: f64) -> f64 {
     (vd * dvd + vq * dvq) / vd.hypot(vq)
 }
 
-/// The smallest α_fw [rad/s] whose [`voltage_overshoot`] stays within `allowed` [V];
+/// The smallest α_fw [rad/s] whose [`voltage_overshoot`] stays within `allowed` \[V\];
 /// `None` when the current loop's lag alone uses it up.
 pub fn min_bandwidth_for_overshoot(
     m: &LossModel,
@@ -204,7 +204,7 @@ pub struct FieldWeakeningOut {
     pub mtpa: MtpaTable,
     /// Loss-minimising table, when R_c or inverter losses are given.
     pub loss_minimisation: Option<LossMinimisation>,
-    /// Predicted rise of |v| above V'_max at the drive's largest acceleration [V]
+    /// Predicted rise of |v| above V'_max at the drive's largest acceleration \[V\]
     /// ([`voltage_overshoot`]); null when the current loop is not designed.
     pub voltage_overshoot_at_max_acceleration_v: Option<f64>,
 }

@@ -66,7 +66,7 @@ use serde::Serialize;
 
 /// Smallest accepted phase margin [°] (Åström & Murray §10.3: 30°–60° typical).
 pub const MIN_PHASE_MARGIN_DEG: f64 = 45.0;
-/// Smallest accepted gain margin [dB]: a factor 2 (Åström & Murray §10.3: 2–5 typical).
+/// Smallest accepted gain margin \[dB\]: a factor 2 (Åström & Murray §10.3: 2–5 typical).
 pub const MIN_GAIN_MARGIN_DB: f64 = 6.0;
 /// Largest accepted step overshoot above the method's designed one [percentage points].
 pub const OVERSHOOT_ALLOWANCE_PCT: f64 = 2.0;
@@ -79,7 +79,7 @@ pub const RISE_TOLERANCE: f64 = 0.10;
 pub struct Promise {
     /// Designed overshoot [%].
     pub overshoot_pct: f64,
-    /// Designed 10–90 % rise time [s], when the design promises it (delay compensation).
+    /// Designed 10–90 % rise time \[s\], when the design promises it (delay compensation).
     pub rise_time_s: Option<f64>,
 }
 
@@ -90,7 +90,7 @@ pub struct LoopGains {
     pub kp: f64,
     /// k_i [V/(A·s)].
     pub ki: f64,
-    /// R_a [Ω] (0 without active damping).
+    /// R_a \[Ω\] (0 without active damping).
     pub active_damping: f64,
     /// Prefilter coefficient c of r_f += c·(r − r_f) (1: no prefilter).
     pub prefilter: f64,
@@ -103,7 +103,7 @@ pub struct SampledPlant {
     pub a: f64,
     /// b = (1 − a)/R [A/V].
     pub b: f64,
-    /// T_s [s].
+    /// T_s \[s\].
     pub ts: f64,
 }
 
@@ -122,7 +122,7 @@ impl SampledPlant {
 /// The sampled loop's figures for one axis (all with the 1.5·T_s delay).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SampledLoop {
-    /// Gain margin [dB] at the phase crossover; null when the phase never reaches −180°
+    /// Gain margin \[dB\] at the phase crossover; null when the phase never reaches −180°
     /// below the Nyquist frequency (infinite margin).
     pub gain_margin_db: Option<f64>,
     /// Frequency of that phase crossover [rad/s].
@@ -134,7 +134,7 @@ pub struct SampledLoop {
     pub gain_crossover_rad_s: Option<f64>,
     /// Step overshoot [%] of the reference step (with prefilter); null when unstable.
     pub overshoot_pct: Option<f64>,
-    /// 10–90 % rise time of that step [s]; null when unstable or never reaching 90 %.
+    /// 10–90 % rise time of that step \[s\]; null when unstable or never reaching 90 %.
     pub rise_time_s: Option<f64>,
     /// Closed-loop poles in the z-plane, [re, im] (roots of 1 + L(z) = 0).
     pub poles: Vec<[f64; 2]>,
@@ -166,9 +166,9 @@ pub enum FloorBreach {
     },
     /// Rise time more than [`RISE_TOLERANCE`] off the designed one (None: never reaches 90 %).
     Rise {
-        /// Of the sampled loop [s].
+        /// Of the sampled loop \[s\].
         sampled_s: Option<f64>,
-        /// Designed [s].
+        /// Designed \[s\].
         designed_s: f64,
     },
 }
@@ -310,7 +310,7 @@ fn bisect(mut lo: f64, mut hi: f64, f: impl Fn(f64) -> f64) -> f64 {
 /// A margin and the frequency it is read at: (margin, ω [rad/s]).
 pub type Margin = Option<(f64, f64)>;
 
-/// The margins of the module documentation: (gain margin [dB], phase-crossover ω),
+/// The margins of the module documentation: (gain margin \[dB\], phase-crossover ω),
 /// (phase margin [°], gain-crossover ω).
 pub fn margins(g: &LoopGains, p: &SampledPlant) -> (Margin, Margin) {
     let w = grid(p.ts);
@@ -364,8 +364,8 @@ fn step_length(radius: f64) -> usize {
     ((1e-4f64).ln() / radius.ln()).ceil().clamp(200.0, 400_000.0) as usize
 }
 
-/// The figures of one axis with gains `g`, resistance `r` [Ω], inductance `l` [H],
-/// sample period `ts` [s].
+/// The figures of one axis with gains `g`, resistance `r` \[Ω\], inductance `l` \[H\],
+/// sample period `ts` \[s\].
 pub fn analyse(g: &LoopGains, r: f64, l: f64, ts: f64) -> SampledLoop {
     let p = SampledPlant::new(r, l, ts);
     let poles = cubic_roots(characteristic(g, &p));

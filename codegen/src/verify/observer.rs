@@ -25,7 +25,7 @@ use motor_sim::bench::{Bench, q31_angle};
 use motor_sim::figures::settling_time;
 use motor_sim::plant::{SpeedProfile, wrap};
 
-/// Time [s] for the continuous ATO (thesis A (4.12)–(4.14)) started `e0` rad off at rest
+/// Time \[s\] for the continuous ATO (thesis A (4.12)–(4.14)) started `e0` rad off at rest
 /// to stay within `threshold`: ë + K_p·ė + K_i·e = 0, e(0) = e0, ė(0) = −K_p·e0.
 pub fn designed_lock_time(kp: f64, ki: f64, e0: f64, threshold: f64) -> f64 {
     let wn = ki.sqrt();
@@ -49,9 +49,9 @@ pub fn designed_lock_time(kp: f64, ki: f64, e0: f64, threshold: f64) -> f64 {
     last_out
 }
 
-/// Initial observer error of [`ato_lock`] [rad].
+/// Initial observer error of [`ato_lock`] \[rad\].
 pub const LOCK_INITIAL_ERROR: f64 = PI / 2.0;
-/// Lock threshold [rad] (1°).
+/// Lock threshold \[rad\] (1°).
 pub const LOCK_THRESHOLD: f64 = PI / 180.0;
 
 /// Observer started π/2 away from the resolver angle at standstill (gates off).

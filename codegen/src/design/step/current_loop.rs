@@ -58,7 +58,7 @@ pub struct CurrentLoopOut {
     pub overshoot: f64,
     /// The floors every axis's sampled loop meets (`design::sampled_loop`).
     pub floors: Floors,
-    /// Lag of the sampled loop behind a reference ramp [s], the larger axis
+    /// Lag of the sampled loop behind a reference ramp \[s\], the larger axis
     /// (`discrete_loop::ramp_lag`): a current reference moving at di/dt is followed
     /// τ_v·di/dt behind.
     pub ramp_lag_s: f64,
