@@ -33,8 +33,8 @@ mod tests {
     use super::motor;
 
     /// The default motor is the Fischer TI085: thesis A §4.4.2 observer gains in Q1.31
-    /// (4 784 957 and 8 374, hand calculation in codegen's angle_observer tests) and
-    /// IMC gains K_p = L·α = 0.0393 V/A (5.9), delay-compensated.
+    /// (4 784 957 and 8 374, hand calculation in codegen's angle_observer tests); its
+    /// current-loop gains are checked in `config::tests::fischer_numbers`.
     #[test]
     fn default_image_carries_the_fischer_constants() {
         if option_env!("MOTOR").is_some_and(|m| m != "fischer-ti085") {
@@ -42,8 +42,6 @@ mod tests {
         }
         assert_eq!(motor::observer::KP.to_bits(), 4_784_957);
         assert_eq!(motor::observer::KI.to_bits(), 8_374);
-        // Delay-compensated (the default): under 1 % below the continuous 0.0393.
-        assert!(motor::current_loop::D_KP < 0.0393 && motor::current_loop::D_KP > 0.99 * 0.0393);
         assert_eq!(
             motor::filter::TAPS_Q15.iter().map(|&t| i32::from(t)).sum::<i32>(),
             32768
