@@ -29,6 +29,14 @@ pub enum Exit {
     BuildFailed = 5,
 }
 
+impl Exit {
+    /// The exit code of a run that went on after failures: the gravest one (the largest
+    /// code: I/O over a failed build over a failed verification over bad input).
+    pub fn gravest(failed: &[Exit]) -> Option<Exit> {
+        failed.iter().copied().max_by_key(|e| *e as u8)
+    }
+}
+
 impl From<Exit> for ExitCode {
     fn from(e: Exit) -> Self {
         ExitCode::from(e as u8)

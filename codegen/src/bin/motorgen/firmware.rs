@@ -398,7 +398,6 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<()
     };
     let root = repo_root(motors).map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
     let motors = motors.canonicalize().unwrap_or_else(|_| motors.to_path_buf());
-    let gravest = |failed: &[Exit]| failed.iter().copied().max_by_key(|e| *e as u8);
     let boards = boards.canonicalize().unwrap_or_else(|_| boards.to_path_buf());
     let board_file = boards.join(format!("{board}.toml"));
     if !board_file.is_file() {
@@ -429,7 +428,7 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<()
             }
         }
     }
-    if let Some(exit) = gravest(&failed) {
+    if let Some(exit) = Exit::gravest(&failed) {
         return Err(Failure::new(exit, "firmware: nothing built (a spec has problems)"));
     }
     let target = Target {
@@ -450,7 +449,7 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<()
             }
         }
     }
-    match gravest(&failed) {
+    match Exit::gravest(&failed) {
         None => Ok(()),
         Some(exit) => Err(Failure::new(
             exit,

@@ -294,35 +294,29 @@ fn run(command: Command) -> Result<(), Failure> {
             // Every spec is checked; the exit code is the gravest failure's (I/O over bad input).
             let mut failed = Vec::new();
             for path in &specs {
-                let is_board = std::fs::read_to_string(path).is_ok_and(|t| codegen::board::is_board_file(&t));
-                if is_board {
-                    let board =
-                        read_spec(path).and_then(|t| Ok(codegen::board_source(&path.display().to_string(), &t)?));
-                    match board {
-                        Ok(b) => outln!("ok: {} (board: {}, {} {})", path.display(), b.name, b.chip, b.package),
-                        Err(f) => {
-                            failed.push(f.exit);
-                            f.report();
-                        }
-                    }
-                    continue;
-                }
-                match design(path) {
-                    Ok(d) => {
-                        outln!("ok: {} ({})", path.display(), d.name);
+                // Read once; a file with a top-level `chip` is a board, anything else a motor.
+                let name = path.display().to_string();
+                let checked = read_spec(path).and_then(|text| {
+                    if codegen::board::is_board_file(&text) {
+                        let b = codegen::board_source(&name, &text)?;
+                        outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
+                    } else {
+                        let d = codegen::design_source(&name, &text)?;
+                        outln!("ok: {name} ({})", d.name);
                         for w in &d.warnings {
-                            output::warn(format_args!("{}: {w}", path.display()));
+                            output::warn(format_args!("{name}: {w}"));
                         }
                     }
-                    Err(f) => {
-                        failed.push(f.exit);
-                        f.report();
-                    }
+                    Ok(())
+                });
+                if let Err(f) = checked {
+                    failed.push(f.exit);
+                    f.report();
                 }
             }
-            match failed.iter().max_by_key(|e| **e as u8) {
+            match Exit::gravest(&failed) {
                 None => Ok(()),
-                Some(&exit) => Err(Failure::new(
+                Some(exit) => Err(Failure::new(
                     exit,
                     format!("check: {} of {} files failed", failed.len(), specs.len()),
                 )),
