@@ -46,6 +46,20 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
         (Err(e), _) | (_, Err(e)) => return Err(e),
     };
     let (out, warnings) = board::design::design(&board, board_text, &design);
+    if let Some((path, x)) = design::finite::first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&out))) {
+        let src = Source {
+            file: board_file,
+            text: board_text,
+        };
+        return Err(src
+            .error(
+                0..0,
+                "",
+                format!("the board design's `board.{path}` comes out as {x}: the board's values with this motor overflow f64"),
+                "board values in their physically sensible ranges (see boards/nucleo-g474re.toml)",
+            )
+            .into());
+    }
     design.warnings.extend(warnings);
     design.board = Some(out);
     Ok(design)

@@ -15,6 +15,7 @@ pub mod discrete_loop;
 pub mod sampled_loop;
 
 pub mod field_weakening;
+pub mod finite;
 pub mod fir;
 pub mod flux_linkage;
 pub mod loss_minimisation;
@@ -82,7 +83,8 @@ pub struct Design {
     pub warnings: Vec<String>,
 }
 
-/// Computes the design, or every rule it breaks, each at its key.
+/// Computes the design, or every rule it breaks, each at its key; a design with a
+/// non-finite number is never returned ([`finite`]).
 pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     let mut cx = Context {
         spec,
@@ -110,7 +112,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         }
         Err(e) => return Err(Diagnostics(vec![*e])),
     };
-    Ok(Design {
+    let design = Design {
         schema_version: SCHEMA_VERSION,
         spec_file: src.file.to_string(),
         name: spec.name.clone(),
@@ -127,5 +129,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         sensorless,
         board: None,
         warnings: cx.warnings,
-    })
+    };
+    finite::check(&design, spec, src).map_err(|e| Diagnostics(vec![*e]))?;
+    Ok(design)
 }

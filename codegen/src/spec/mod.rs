@@ -16,6 +16,7 @@ mod flux_linkage;
 mod inductance;
 mod inverter;
 mod motor;
+mod plausible;
 mod raw;
 mod resolve;
 mod resolver;

@@ -8,7 +8,7 @@
 use std::ops::Range;
 
 use super::raw::{RawSpec, Val};
-use super::{Param, Provenance, Spec};
+use super::{Param, Provenance, Spec, plausible};
 use crate::diagnostic::{Diagnostic, Source};
 use crate::units::{self, Kind};
 
@@ -92,6 +92,7 @@ impl<'a> Resolver_<'a> {
                 );
                 None
             }
+            Ok(value) if !self.plausible(key, span.clone(), value, kind, positive, text) => None,
             Ok(value) => Some(Param {
                 value,
                 source,
@@ -109,6 +110,37 @@ impl<'a> Resolver_<'a> {
                 None
             }
         }
+    }
+
+    /// Whether `value` (written `text`) of `key` lies in its physically sensible range
+    /// ([`super::plausible`]); if not, the error names the range and why.
+    pub(crate) fn plausible(
+        &mut self,
+        key: &str,
+        span: Range<usize>,
+        value: f64,
+        kind: Kind,
+        positive: bool,
+        text: &str,
+    ) -> bool {
+        let Some(p) = plausible::plausible(key, kind) else {
+            return true;
+        };
+        if plausible::contains(&p, value, positive) {
+            return true;
+        }
+        let (_, range) = plausible::interval(&p, positive);
+        self.err(
+            span,
+            key,
+            format!(
+                "{} must be in {range}: {}; found \"{text}\"",
+                key.rsplit('.').next().unwrap_or(key),
+                p.reason
+            ),
+            format!("{} in {range}", kind.name()),
+        );
+        false
     }
 
     /// A plain positive number (ratios, damping); integers are accepted as floats.

@@ -79,7 +79,12 @@ impl Resolver_<'_> {
             }
         };
         let value = match units::parse(kind, text) {
-            Ok(x) if x > 0.0 => x,
+            Ok(x) if x > 0.0 => {
+                if !self.plausible(key, span.clone(), x * factor, kind, true, text) {
+                    return None;
+                }
+                x
+            }
             Ok(_) => {
                 self.err(
                     span,
