@@ -92,6 +92,18 @@ pub enum FirError {
         /// Best quantised attenuation at 127 taps within the pass ripple, if that design exists \[dB\].
         best_db: Option<f64>,
     },
+    /// The minimum-order walk stopped: the quantised attenuation stopped improving
+    /// ([`super::search::STALL_ORDERS`] orders without progress), the Q1.15 floor.
+    AttenuationFloor {
+        /// Requested attenuation \[dB\].
+        requested_db: f64,
+        /// Order with the best quantised attenuation [taps − 1].
+        order: usize,
+        /// Last order tried [taps − 1].
+        last_order: usize,
+        /// Best quantised attenuation at `order` within the pass ripple, if that design exists \[dB\].
+        best_db: Option<f64>,
+    },
     /// A tap falls outside the Q1.15 range [−1, 1 − 2^−15].
     TapOverflow {
         /// Order [taps − 1].
@@ -118,7 +130,9 @@ impl FirError {
             FirError::RippleOutOfRange { .. } | FirError::RippleInfeasible { .. } => "pass_ripple",
             FirError::OrderOutOfRange { .. } | FirError::NoAttenuation { .. } | FirError::Remez { .. } => "order",
             FirError::OrderBeyondPrecision { .. } => "order",
-            FirError::AttenuationInfeasible { .. } | FirError::AttenuationBeyondQ15 { .. } => "stop_attenuation",
+            FirError::AttenuationInfeasible { .. }
+            | FirError::AttenuationBeyondQ15 { .. }
+            | FirError::AttenuationFloor { .. } => "stop_attenuation",
             FirError::TapOverflow { .. } | FirError::PassEdgeTooLow { .. } => "pass_edge",
         }
     }
@@ -240,6 +254,25 @@ impl fmt::Display for FirError {
             } => write!(
                 f,
                 "stop_attenuation {requested_db} dB cannot be met within {taps} taps (the FMAC holds at most {FMAC_MAX_TAPS}), and no {taps}-tap design meets pass_ripple; accepted: a lower stop_attenuation, a wider transition band or a larger pass_ripple"
+            ),
+            FirError::AttenuationFloor {
+                requested_db,
+                order,
+                last_order,
+                best_db: Some(best),
+            } => write!(
+                f,
+                "stop_attenuation {requested_db} dB is below the Q1.15 rounding floor of these band edges: the quantised attenuation peaks at {best:.1} dB (order {order}) and orders up to {last_order} add only rounding noise; accepted: stop_attenuation ≤ {:.1} dB, a wider transition band or a larger pass_ripple",
+                (best * 10.0).floor() / 10.0
+            ),
+            FirError::AttenuationFloor {
+                requested_db,
+                order,
+                last_order,
+                best_db: None,
+            } => write!(
+                f,
+                "stop_attenuation {requested_db} dB is below the Q1.15 rounding floor of these band edges: no design from order {order} to {last_order} improves the quantised attenuation, and none at order {order} meets pass_ripple; accepted: a lower stop_attenuation, a wider transition band or a larger pass_ripple"
             ),
             FirError::TapOverflow { order, tap } => write!(
                 f,

@@ -12,6 +12,12 @@ use super::validate::Spec;
 /// Largest relative spread (max − min)/max of the error extrema accepted as converged [1].
 const MAX_FLATNESS: f64 = 1e-2;
 
+#[cfg(test)]
+thread_local! {
+    /// Parks–McClellan runs on this thread, so a test can bound a search's work.
+    pub(super) static RUNS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
 /// Runs the Parks–McClellan exchange for a symmetric filter of `num_taps` taps on
 /// `bands` (cycles/sample), turning panics, NaN and an unlevelled ripple into errors.
 pub(super) fn remez<D, W>(num_taps: usize, bands: Vec<(f64, f64)>, desired: D, weight: W) -> Result<Vec<f64>, String>
@@ -19,6 +25,8 @@ where
     D: Fn(f64) -> f64,
     W: Fn(f64) -> f64,
 {
+    #[cfg(test)]
+    RUNS.with(|r| r.set(r.get() + 1));
     let bands = bands
         .into_iter()
         .map(|(a, b)| Band::new(a, b).map_err(|e| e.to_string()))

@@ -184,18 +184,35 @@ pub(super) fn design_order(spec: &Spec, order: usize) -> Result<FirDesign, FirEr
     }
 }
 
-/// Fixed order and weight: the quantised design and whether it meets ripple and attenuation.
-pub(super) fn design_weighted(spec: &Spec, order: usize, weight: f64, attenuation_db: f64) -> Option<FirDesign> {
+/// Orders the upward walk of [`design_min_order`] tries past the best quantised attenuation
+/// seen before it stops: once Q1.15 rounding sets the stop-band floor, more taps only add
+/// rounding noise (the thesis-A band edges peak near 72 dB at order ≈ 50, issue 18), so the
+/// walk ends there instead of running every order up to the FMAC limit.
+pub const STALL_ORDERS: usize = 6;
+/// Smallest gain in quantised attenuation that counts as progress in the walk \[dB\].
+const PROGRESS_DB: f64 = 0.05;
+
+/// Fixed order and weight: the quantised design, if it meets the pass ripple.
+fn weighted(spec: &Spec, order: usize, weight: f64) -> Option<FirDesign> {
     let grid = Grid::new(spec, order + 1);
     let t = trial(spec, &grid, order, weight).ok()?;
-    if t.ripple_q > spec.ripple {
-        return None;
-    }
-    let d = finish(spec, &grid, t);
-    (d.stop_attenuation_db_quantised >= attenuation_db).then_some(d)
+    (t.ripple_q <= spec.ripple).then(|| finish(spec, &grid, t))
 }
 
-/// Minimum order meeting `attenuation_db` with w = pass_ripple/δ_s.
+/// Fixed order and weight: the quantised design, if it meets ripple and attenuation.
+pub(super) fn design_weighted(spec: &Spec, order: usize, weight: f64, attenuation_db: f64) -> Option<FirDesign> {
+    weighted(spec, order, weight).filter(|d| d.stop_attenuation_db_quantised >= attenuation_db)
+}
+
+fn meets(d: &Option<FirDesign>, attenuation_db: f64) -> bool {
+    d.as_ref()
+        .is_some_and(|d| d.stop_attenuation_db_quantised >= attenuation_db)
+}
+
+/// Minimum order meeting `attenuation_db` with w = pass_ripple/δ_s. The walk is bounded:
+/// at most [`FMAC_MAX_TAPS`] orders, and it stops [`STALL_ORDERS`] orders after the
+/// quantised attenuation last improved; the refusal then names the best attenuation (by
+/// the stop-weight search at the best order) as the accepted bound.
 pub(super) fn design_min_order(spec: &Spec, attenuation_db: f64) -> Result<FirDesign, FirError> {
     let ds = 10f64.powf(-attenuation_db / 20.0);
     let weight = spec.ripple / ds;
@@ -212,7 +229,9 @@ pub(super) fn design_min_order(spec: &Spec, attenuation_db: f64) -> Result<FirDe
     } else {
         max_order
     };
-    if let Some(mut best) = design_weighted(spec, start, weight, attenuation_db) {
+    let first = weighted(spec, start, weight);
+    if meets(&first, attenuation_db) {
+        let mut best = first.expect("meets() implies a design");
         // Already meets it: walk down to the first order that does not.
         for order in (MIN_ORDER..start).rev() {
             match design_weighted(spec, order, weight, attenuation_db) {
@@ -222,17 +241,38 @@ pub(super) fn design_min_order(spec: &Spec, attenuation_db: f64) -> Result<FirDe
         }
         return Ok(best);
     }
+    let mut best: (f64, usize) = (
+        first.map_or(f64::NEG_INFINITY, |d| d.stop_attenuation_db_quantised),
+        start,
+    );
+    let mut last = start;
     for order in start + 1..=max_order {
-        if let Some(d) = design_weighted(spec, order, weight, attenuation_db) {
-            return Ok(d);
+        last = order;
+        let d = weighted(spec, order, weight);
+        if meets(&d, attenuation_db) {
+            return Ok(d.expect("meets() implies a design"));
+        }
+        let db = d.map_or(f64::NEG_INFINITY, |d| d.stop_attenuation_db_quantised);
+        if db > best.0 + PROGRESS_DB {
+            best = (db, order);
+        } else if order - best.1 >= STALL_ORDERS {
+            break;
         }
     }
-    let best_db = design_order(spec, max_order)
-        .ok()
-        .map(|d| d.stop_attenuation_db_quantised);
-    Err(FirError::AttenuationInfeasible {
-        taps: max_order + 1,
-        requested_db: attenuation_db,
-        best_db,
+    let at = if last < max_order { best.1 } else { max_order };
+    let best_db = design_order(spec, at).ok().map(|d| d.stop_attenuation_db_quantised);
+    Err(if last < max_order {
+        FirError::AttenuationFloor {
+            requested_db: attenuation_db,
+            order: at,
+            last_order: last,
+            best_db,
+        }
+    } else {
+        FirError::AttenuationInfeasible {
+            taps: max_order + 1,
+            requested_db: attenuation_db,
+            best_db,
+        }
     })
 }

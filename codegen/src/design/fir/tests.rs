@@ -533,3 +533,60 @@ fn pass_edge_too_low_for_the_exchange_is_refused_and_its_minimum_designs() {
     assert_eq!(d.order, 20);
     assert_eq!(d.taps_q15.iter().map(|&t| i32::from(t)).sum::<i32>(), Q15_ONE);
 }
+
+/// Issue 18: `stop_attenuation = "99 dB"` on the thesis-A band edges lies below the Q1.15
+/// rounding floor. It is refused with the attenuation that works (the same bound a request
+/// just below it is designed with), and the order walk stops at the floor instead of
+/// running every order to the FMAC limit: the work is bounded in Parks–McClellan runs
+/// (a count, not a time). Kaiser starts the walk at order 45; the floor (≈ 72 dB) is
+/// reached near order 50, so the walk ends by order 50 + STALL_ORDERS and the final
+/// stop-weight search adds at most MAX_WEIGHT_EVALUATIONS runs.
+#[test]
+fn attenuation_beyond_the_q15_floor_is_refused_after_a_bounded_walk() {
+    use super::remez::RUNS;
+    use super::search::STALL_ORDERS;
+    RUNS.with(|r| r.set(0));
+    let err = design_fir(&FirRequest {
+        length: FirLength::StopAttenuationDb(99.0),
+        ..thesis()
+    })
+    .unwrap_err();
+    let runs = RUNS.with(|r| r.get());
+    assert_eq!(err.key(), "stop_attenuation");
+    let FirError::AttenuationFloor {
+        order,
+        last_order,
+        best_db: Some(best),
+        ..
+    } = err
+    else {
+        panic!("expected the Q1.15 floor refusal, got {err:?}")
+    };
+    assert_eq!(last_order, order + STALL_ORDERS);
+    assert!(last_order < FMAC_MAX_TAPS - 1, "walked to order {last_order}");
+    assert!(best > 60.0 && best < 90.0, "best {best} dB");
+    // Walk from the Kaiser start plus the weight search at the best order: far below the
+    // ~80 orders + 24 runs at 127 taps of an unbounded walk.
+    assert!(
+        runs <= (last_order - 45 + 1) + MAX_WEIGHT_EVALUATIONS + 1,
+        "{runs} Parks–McClellan runs"
+    );
+    let msg = err_text(99.0);
+    assert!(msg.contains(&format!("accepted: stop_attenuation ≤ {:.1} dB", (best * 10.0).floor() / 10.0)), "{msg}");
+    // The bound it names is designable: 3 dB below it, the minimum-order search succeeds.
+    let d = design_fir(&FirRequest {
+        length: FirLength::StopAttenuationDb(best - 3.0),
+        ..thesis()
+    })
+    .unwrap();
+    assert!(d.stop_attenuation_db_quantised >= best - 3.0);
+}
+
+fn err_text(db: f64) -> String {
+    design_fir(&FirRequest {
+        length: FirLength::StopAttenuationDb(db),
+        ..thesis()
+    })
+    .unwrap_err()
+    .to_string()
+}
