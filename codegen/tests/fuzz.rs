@@ -244,7 +244,7 @@ fn mutate(rng: &mut Rng, text: &str) -> String {
         7 => {
             let i = rng.below(lines.len() + 1);
             let mut out: Vec<&str> = lines[..i].to_vec();
-            out.push(rng.pick(LINES));
+            out.push(*rng.pick(LINES));
             out.extend(&lines[i..]);
             out.join("\n")
         }
@@ -286,8 +286,8 @@ fn located(e: &Diagnostics, file: &str) -> Result<(), String> {
     Ok(())
 }
 
-/// An `Ok` design is all-finite and renders; an `Err` is located.
-fn judge_design(result: Result<Design, Diagnostics>, file: &str) -> Result<(), String> {
+/// An `Ok` design is all-finite and renders; an `Err` is located. `Ok(true)`: accepted.
+fn judge_design(result: Result<Design, Diagnostics>, file: &str) -> Result<bool, String> {
     match result {
         Ok(d) => {
             if let Some((path, x)) = first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&d))) {
@@ -299,9 +299,9 @@ fn judge_design(result: Result<Design, Diagnostics>, file: &str) -> Result<(), S
                     return Err(format!("{out:?} output holds a non-finite number"));
                 }
             }
-            Ok(())
+            Ok(true)
         }
-        Err(e) => located(&e, file),
+        Err(e) => located(&e, file).map(|()| false),
     }
 }
 
@@ -316,9 +316,10 @@ fn seeds() -> Vec<(String, String)> {
 }
 
 /// Runs `n` cases of `one` from seed `base`, printing counts and the slowest case.
-fn run(name: &str, n: usize, mut one: impl FnMut(u64) -> (String, Result<(), String>)) {
+fn run(name: &str, n: usize, mut one: impl FnMut(u64) -> (String, Result<bool, String>)) {
     let started = Instant::now();
     let mut failures = Vec::new();
+    let mut accepted = 0usize;
     let mut slowest = (0.0f64, 0u64);
     for k in 0..n as u64 {
         let seed = seed_base() + k;
@@ -328,6 +329,9 @@ fn run(name: &str, n: usize, mut one: impl FnMut(u64) -> (String, Result<(), Str
         if dt > slowest.0 {
             slowest = (dt, seed);
         }
+        if verdict == Ok(true) {
+            accepted += 1;
+        }
         if let Err(why) = verdict {
             failures.push(format!("seed {seed}: {why}\n--- input ---\n{input}\n---"));
             if failures.len() >= 5 {
@@ -336,7 +340,7 @@ fn run(name: &str, n: usize, mut one: impl FnMut(u64) -> (String, Result<(), Str
         }
     }
     eprintln!(
-        "{name}: {n} cases in {:.1} s, slowest {:.2} s (seed {}), {} failures",
+        "{name}: {n} cases ({accepted} accepted, the rest refused with a located error) in {:.1} s, slowest {:.2} s (seed {}), {} failures",
         started.elapsed().as_secs_f64(),
         slowest.0,
         slowest.1,
@@ -452,7 +456,7 @@ fn mutate_recording(rng: &mut Rng, text: &str) -> String {
             let i = *rng.pick(&data);
             let mut cells: Vec<&str> = lines[i].split(',').collect();
             let c = rng.below(cells.len());
-            cells[c] = rng.pick(CELLS);
+            cells[c] = *rng.pick(CELLS);
             replace_line(&lines, i, &cells.join(","))
         }
         // Every row's time offset by a huge amount (or the time scaled).
@@ -490,7 +494,7 @@ fn mutate_recording(rng: &mut Rng, text: &str) -> String {
         _ if !data.is_empty() => {
             let width = lines[data[0]].split(',').count();
             let c = rng.below(width);
-            let v = rng.pick(CELLS);
+            let v = *rng.pick(CELLS);
             let mut out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
             for &i in &data {
                 let mut cells: Vec<&str> = lines[i].split(',').collect();
@@ -505,16 +509,16 @@ fn mutate_recording(rng: &mut Rng, text: &str) -> String {
     }
 }
 
-/// Every finite identified number, or a located error.
-fn judge_identification(d: &Design, kind: RecordingKind, text: &str) -> Result<(), String> {
+/// Every finite identified number, or a located error. `Ok(true)`: identified.
+fn judge_identification(d: &Design, kind: RecordingKind, text: &str) -> Result<bool, String> {
     let file = "fuzz.csv";
     let rec = match recording::parse(file, text, kind, d.drive.sample_period_s) {
         Ok(r) => r,
-        Err(e) => return located(&e, file),
+        Err(e) => return located(&e, file).map(|()| false),
     };
     let finite = |xs: &[f64]| {
         if xs.iter().all(|x| x.is_finite()) {
-            Ok(())
+            Ok(true)
         } else {
             Err(format!("an identified value is not finite: {xs:?}"))
         }
@@ -540,7 +544,7 @@ fn judge_identification(d: &Design, kind: RecordingKind, text: &str) -> Result<(
                 e.crossing_5_samples,
                 e.delay_samples,
             ]),
-            Err(e) => located(&e, file),
+            Err(e) => located(&e, file).map(|()| false),
         },
         RecordingKind::Flux => match identify_flux(
             &rec,
@@ -553,15 +557,15 @@ fn judge_identification(d: &Design, kind: RecordingKind, text: &str) -> Result<(
             },
         ) {
             Ok(e) => finite(&[e.flux_linkage_wb, e.mean_speed_rad_s, e.correction_wb]),
-            Err(e) => located(&e, file),
+            Err(e) => located(&e, file).map(|()| false),
         },
         RecordingKind::ResolverOffset => match identify_offset(&rec, 3, 1) {
             Ok(e) => finite(&[e.offset_rad, e.deviation_rad]),
-            Err(e) => located(&e, file),
+            Err(e) => located(&e, file).map(|()| false),
         },
         RecordingKind::PolePairRatio => match identify_ratio(&rec) {
             Ok(e) => finite(&[e.ratio, e.electrical_travel_rad, e.resolver_travel_rad]),
-            Err(e) => located(&e, file),
+            Err(e) => located(&e, file).map(|()| false),
         },
     }
 }

@@ -262,7 +262,7 @@ impl fmt::Display for FirError {
                 best_db: Some(best),
             } => write!(
                 f,
-                "stop_attenuation {requested_db} dB is below the Q1.15 rounding floor of these band edges: the quantised attenuation peaks at {best:.1} dB (order {order}) and orders up to {last_order} add only rounding noise; accepted: stop_attenuation ≤ {:.1} dB, a wider transition band or a larger pass_ripple",
+                "stop_attenuation {requested_db} dB is below the Q1.15 rounding floor of these band edges: the quantised attenuation peaks at {0:.1} dB (order {order}) and orders up to {last_order} add only rounding noise; accepted: stop_attenuation ≤ {0:.1} dB, a wider transition band or a larger pass_ripple",
                 (best * 10.0).floor() / 10.0
             ),
             FirError::AttenuationFloor {
