@@ -300,3 +300,53 @@ fn sampled_loop_refusal_names_the_hand_figures() {
     let best = number_after("a bandwidth up to ");
     assert!((best / 6239.0 - 1.0).abs() < 0.02, "{best}\n{err}");
 }
+
+/// Issue 18's non-finite examples: each is refused at its key with the accepted range
+/// (exit 1, located on stderr), `design --format json` prints nothing (no `null` where a
+/// number is promised) and `generate` writes no file.
+#[test]
+fn values_beyond_physical_ranges_are_refused_at_their_key_and_nothing_is_written() {
+    for (from, to, key, range) in [
+        (
+            "peak_current = \"61 A\"",
+            "peak_current = \"6.1e201 A\"",
+            "motor.datasheet.peak_current",
+            "[1 mA, 100 kA]",
+        ),
+        (
+            "dc_link_voltage = \"600 V\"",
+            "dc_link_voltage = \"1.7976931348623157e308 V\"",
+            "drive.dc_link_voltage",
+            "[1 V, 2000 V]",
+        ),
+        (
+            "bandwidth = \"100 rad/s\"",
+            "bandwidth = \"1e-308 rad/s\"",
+            "current_loop.bandwidth",
+            "[1 rad/s, 1e6 rad/s]",
+        ),
+    ] {
+        let text = fischer().replacen(from, to, 1);
+        assert_ne!(text, fischer(), "{from} not in the Fischer spec");
+        let line = line_of(&text, to);
+        let path = write(&format!("range-{}.toml", key.replace('.', "-")), text.as_bytes());
+        let p = path.to_str().unwrap();
+        let out = motorgen(&["design", p, "--format", "json"]);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{key}\n{stderr}");
+        assert!(out.stdout.is_empty(), "{key}: printed a design");
+        assert!(stderr.contains(&format!("{p}:{line}:")), "{key}: not located\n{stderr}");
+        assert!(
+            stderr.contains(&format!("`{key}`")) && stderr.contains(range),
+            "{stderr}"
+        );
+        let dir = common::tmp("ranges", key);
+        let out = motorgen(&["generate", p, "--out", dir.to_str().unwrap()]);
+        assert_eq!(out.status.code(), Some(1), "{key}");
+        assert_eq!(
+            std::fs::read_dir(&dir).unwrap().count(),
+            0,
+            "{key}: generate wrote files"
+        );
+    }
+}

@@ -29,9 +29,9 @@ use common::recordings::{Noise, step_recording};
 use motor_control::commissioning::Axis;
 
 /// Spec cases in CI (debug build).
-const SPEC_CASES: usize = 160;
+const SPEC_CASES: usize = 800;
 /// Recording cases in CI (debug build).
-const RECORDING_CASES: usize = 400;
+const RECORDING_CASES: usize = 3000;
 
 fn cases(default: usize) -> usize {
     std::env::var("MOTORGEN_FUZZ_CASES")
@@ -100,8 +100,8 @@ const NUMBERS: &[&str] = &[
 
 const UNITS: &[&str] = &[
     "", "A", "mA", "kA", "V", "kV", "Hz", "kHz", "MHz", "rad/s", "rpm", "krpm", "Ω", "mΩ", "H", "mH", "µH", "Wb",
-    "mWb", "N·m", "N·m/A", "V·s/rad", "rpm/V", "kg·m²", "g·cm²", "dB", "s", "ms", "µs", "°C", "K", "°", "rad",
-    "rpm/s", "F", "J", "W", "%", "furlong",
+    "mWb", "N·m", "N·m/A", "V·s/rad", "rpm/V", "kg·m²", "g·cm²", "dB", "s", "ms", "µs", "°C", "K", "°", "rad", "rpm/s",
+    "F", "J", "W", "%", "furlong",
 ];
 
 /// Whole values a key may be set to (wrong types and structures included).
@@ -369,8 +369,10 @@ fn mutated_specs_never_panic_and_every_design_is_finite() {
             text = mutate(&mut rng, &text);
         }
         let file = "fuzz.toml";
-        let verdict = catch_unwind(AssertUnwindSafe(|| judge_design(codegen::design_source(file, &text), file)))
-            .unwrap_or_else(|p| Err(format!("panic: {}", panic_text(p))));
+        let verdict = catch_unwind(AssertUnwindSafe(|| {
+            judge_design(codegen::design_source(file, &text), file)
+        }))
+        .unwrap_or_else(|p| Err(format!("panic: {}", panic_text(p))));
         (text, verdict)
     });
 }
@@ -393,7 +395,11 @@ fn recording_seeds(d: &Design) -> Vec<(RecordingKind, String)> {
     }
     let mut offset = String::from("# motorgen recording: resolver_offset\nsample,u_alpha_v,theta_r_rad\n");
     for n in 0..200 {
-        offset.push_str(&format!("{n},{},{}\n", if n < 20 { 0.0 } else { 5.0 }, 0.42 + 1e-4 * n as f64));
+        offset.push_str(&format!(
+            "{n},{},{}\n",
+            if n < 20 { 0.0 } else { 5.0 },
+            0.42 + 1e-4 * n as f64
+        ));
     }
     let mut ratio = String::from("# motorgen recording: pole_pair_ratio\nsample,theta_e_rad,theta_r_rad\n");
     for n in 0..400 {

@@ -532,3 +532,85 @@ fn estimator_without_rated_current_names_the_key() {
         &["I_base = √2·I_n", "(4.35)"],
     );
 }
+
+/// Issue 18 at the library level: values that overflow or underflow the design are refused
+/// at their key with the accepted range and why (the CLI test checks exit code and files).
+#[test]
+fn values_beyond_physical_ranges_name_the_range_at_their_key() {
+    for (from, to, key, range) in [
+        (
+            "peak_current = \"61 A\"",
+            "peak_current = \"6.1e201 A\"",
+            "motor.datasheet.peak_current",
+            "[1 mA, 100 kA]",
+        ),
+        (
+            "dc_link_voltage = \"600 V\"",
+            "dc_link_voltage = \"1.7976931348623157e308 V\"",
+            "drive.dc_link_voltage",
+            "[1 V, 2000 V]",
+        ),
+        (
+            "bandwidth = \"100 rad/s\"",
+            "bandwidth = \"1e-308 rad/s\"",
+            "current_loop.bandwidth",
+            "[1 rad/s, 1e6 rad/s]",
+        ),
+        (
+            "switching_frequency = \"20 kHz\"",
+            "switching_frequency = \"1e300 Hz\"",
+            "drive.switching_frequency",
+            "[1 kHz, 200 kHz]",
+        ),
+        (
+            "inductance = \"0.393 mH\"",
+            "inductance = \"1e-300 H\"",
+            "motor.datasheet.inductance",
+            "[1 nH, 10 H]",
+        ),
+        (
+            "phase_resistance = \"0.126 Ω\"",
+            "phase_resistance = \"1e300 Ω\"",
+            "motor.datasheet.phase_resistance",
+            "[1 µΩ, 1 MΩ]",
+        ),
+        (
+            "max_speed = \"20000 rpm\"",
+            "max_speed = \"1e300 rpm\"",
+            "motor.datasheet.max_speed",
+            "1e5 rad/s",
+        ),
+    ] {
+        let text = fischer().replacen(from, to, 1);
+        assert_ne!(text, fischer(), "{from} not in the Fischer spec");
+        let e = codegen::design_source("m.toml", &text).unwrap_err();
+        let d = &e.0[0];
+        assert_eq!((d.line, d.key.as_str()), (line_of(&text, to), key), "{e}");
+        assert!(d.problem.contains(range) && d.accepted.contains(range), "{e}");
+        let field = key.rsplit('.').next().unwrap();
+        assert!(d.problem.starts_with(&format!("{field} must be in ")), "{e}");
+    }
+}
+
+/// The last gate: a design with a non-finite number (here planted in a real design) is an
+/// error naming the JSON path and the keys that decide it, located at the first of them.
+#[test]
+fn a_non_finite_design_value_is_an_error_with_its_path() {
+    let text = fischer();
+    let src = codegen::Source {
+        file: "f.toml",
+        text: &text,
+    };
+    let spec = codegen::spec::parse(src).unwrap();
+    let mut d = codegen::design::design(&spec, src).unwrap();
+    assert!(codegen::design::finite::check(&d, &spec, src).is_ok());
+    d.current_loop.q.ki = f64::NAN;
+    let e = codegen::design::finite::check(&d, &spec, src).unwrap_err();
+    assert!(e.problem.contains("`current_loop.q.ki` comes out as NaN"), "{e}");
+    assert!(e.problem.contains("drive.switching_frequency"), "{e}");
+    assert_eq!(
+        (e.line, e.key.as_str()),
+        (line_of(&text, "bandwidth = "), "current_loop.bandwidth"),
+        "{e}"
+    );
+}

@@ -86,7 +86,9 @@ fn deciding(spec: &Spec, section: &str) -> (&'static str, Range<usize>) {
         ),
         "adc" => (
             "[adc], drive.switching_frequency, motor.*.phase_resistance, motor.*.inductance",
-            spec.adc.as_ref().map_or(d.switching_frequency.span.clone(), |a| a.clock.span.clone()),
+            spec.adc
+                .as_ref()
+                .map_or(d.switching_frequency.span.clone(), |a| a.clock.span.clone()),
         ),
         "per_unit" | "field_weakening" | "sensorless" => (
             "motor.*.peak_current, motor.*.nominal_current, motor.*.flux_linkage (or K_t, K_e), motor.*.inductance, motor.*.max_speed, drive.dc_link_voltage_min",
@@ -145,10 +147,7 @@ mod tests {
         };
         assert_eq!(first_non_finite(&Value::from(minijinja::value::Serde(&ok))), None);
         let nan = Outer {
-            d: Inner {
-                kp: f64::NAN,
-                ..ok.d
-            },
+            d: Inner { kp: f64::NAN, ..ok.d },
             ..ok
         };
         let (path, x) = first_non_finite(&Value::from(minijinja::value::Serde(&nan))).unwrap();

@@ -313,19 +313,95 @@ pub fn parse(file: &str, text: &str, kind: RecordingKind, sample_period_s: f64) 
     if let Some(h) = rec.header_key("sample_period") {
         let t = units::parse(Kind::Time, &h.value)
             .ok()
-            .filter(|t| *t > 0.0)
+            .filter(|t| sample_period_in_range(*t))
             .ok_or_else(|| {
                 src.error(
                     h.offset..h.offset,
                     "sample_period",
-                    format!("`{}` is not a positive time", h.value),
-                    Kind::Time.accepted(),
+                    format!("`{}` is not a sample period: {SAMPLE_PERIOD_REASON}", h.value),
+                    format!("a time in {SAMPLE_PERIOD_RANGE}, e.g. \"50 µs\""),
                 )
             })?;
         rec.sample_period_s = t;
     }
+    check_values(&rec)?;
     timebase(&mut rec)?;
+    if !sample_period_in_range(rec.sample_period_s) {
+        // T_s from the time_s spacing (no header), or the caller's fallback.
+        return Err(rec.error_at_cell(
+            1,
+            0,
+            format!(
+                "the sample period T_s = {} s (from {}) is outside {SAMPLE_PERIOD_RANGE}: {SAMPLE_PERIOD_REASON}",
+                rec.sample_period_s,
+                if rec.columns[0] == "time_s" {
+                    "the time_s spacing"
+                } else {
+                    "--sample-period or the spec"
+                }
+            ),
+            format!("rows one period apart with T_s in {SAMPLE_PERIOD_RANGE}, or a `# sample_period = 50 µs` header"),
+        ));
+    }
     Ok(rec)
+}
+
+/// Accepted sample periods T_s: one PWM period of a drive switching at 100 Hz to 1 MHz,
+/// around the spec's `drive.switching_frequency` range (the firmware samples once per period).
+pub const SAMPLE_PERIOD_S: (f64, f64) = (1e-6, 1e-2);
+const SAMPLE_PERIOD_RANGE: &str = "[1 µs, 10 ms]";
+const SAMPLE_PERIOD_REASON: &str = "the firmware samples once per PWM period, and drives switch at 100 Hz to 1 MHz";
+
+/// Whether `t` \[s\] is an accepted sample period.
+pub fn sample_period_in_range(t: f64) -> bool {
+    t.is_finite() && (SAMPLE_PERIOD_S.0..=SAMPLE_PERIOD_S.1).contains(&t)
+}
+
+/// The accepted magnitude of a column's values and why, by the column's unit suffix.
+fn column_range(name: &str) -> (f64, &'static str) {
+    if name == "sample" {
+        (
+            u32::MAX as f64,
+            "|sample| ≤ 4294967295: the firmware counts periods in a u32",
+        )
+    } else if name == "time_s" {
+        (
+            1e5,
+            "|time_s| ≤ 1e5 s: a commissioning run lasts seconds, and beyond a day f64 times lose the row spacing",
+        )
+    } else if name.ends_with("_rad_s") {
+        (1e6, "|ω| ≤ 1e6 rad/s: beyond any machine's electrical speed")
+    } else if name.ends_with("_rad") {
+        (
+            1e3,
+            "|θ| ≤ 1000 rad: angles are recorded wrapped to ±π (or a few turns)",
+        )
+    } else if name.ends_with("_v") {
+        (2000.0, "|u| ≤ 2000 V: the DC-link range of the motor spec")
+    } else if name.ends_with("_a") {
+        (1e5, "|i| ≤ 100 kA: the current range of the motor spec")
+    } else {
+        (f64::MAX, "")
+    }
+}
+
+/// Every value within its column's range ([`column_range`]): a number beyond it is a
+/// corrupted or mis-scaled capture, never input to an estimate.
+fn check_values(rec: &Recording) -> Result<(), Diagnostics> {
+    for (row, (t, values)) in rec.samples.iter().zip(&rec.values).enumerate() {
+        for (col, v) in std::iter::once(t).chain(values).enumerate() {
+            let (max, why) = column_range(&rec.columns[col]);
+            if v.abs() > max {
+                return Err(rec.error_at_cell(
+                    row,
+                    col,
+                    format!("{} = {v} is out of range", rec.columns[col]),
+                    why.to_string(),
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn check_columns(
@@ -533,6 +609,56 @@ mod tests {
         assert_eq!((e.line, e.column), (3, 5));
         assert_eq!(e.key, "current_a");
         assert!(e.problem.contains("not a finite number"), "{}", e.problem);
+    }
+
+    /// Issue 18: sample periods like 1e300 s or 0 s are located errors naming the range.
+    #[test]
+    fn sample_periods_outside_one_pwm_period_are_refused() {
+        for t in ["1e300 s", "0 s", "1e-300 s", "-1 µs", "20 ms"] {
+            let e = parse_step(&format!(
+                "# sample_period = {t}\nsample,voltage_v,current_a\n0,0,0\n1,4,1\n"
+            ))
+            .unwrap_err();
+            assert_eq!((e.line, e.column, e.key.as_str()), (1, 19, "sample_period"), "{t}: {e}");
+            assert!(e.accepted.contains("[1 µs, 10 ms]"), "{e}");
+        }
+        // From the time_s spacing without a header: 1000 s per row.
+        let e = parse_step("time_s,voltage_v,current_a\n0,0,0\n1000,4,1\n").unwrap_err();
+        assert_eq!((e.line, e.key.as_str()), (3, "time_s"), "{e}");
+        assert!(e.problem.contains("outside [1 µs, 10 ms]"), "{e}");
+        // The fallback (CLI or spec) is judged too.
+        let e = parse(
+            "rec.csv",
+            "sample,voltage_v,current_a\n0,0,0\n1,4,1\n",
+            RecordingKind::Step,
+            1e300,
+        )
+        .unwrap_err();
+        assert!(e.0[0].problem.contains("--sample-period or the spec"), "{}", e.0[0]);
+    }
+
+    /// Huge offsets and values beyond any drive are located at their cell with the range.
+    #[test]
+    fn values_beyond_their_column_range_are_located() {
+        let e = parse_step("sample,voltage_v,current_a\n1e300,0,0\n1e300,4,1\n").unwrap_err();
+        assert_eq!((e.line, e.column, e.key.as_str()), (2, 1, "sample"), "{e}");
+        assert!(e.accepted.contains("4294967295"), "{e}");
+        let e = parse_step("sample,voltage_v,current_a\n0,0,0\n1,4,6.1e201\n").unwrap_err();
+        assert_eq!((e.line, e.column, e.key.as_str()), (3, 5, "current_a"), "{e}");
+        assert!(e.accepted.contains("100 kA"), "{e}");
+        let e = parse(
+            "r.csv",
+            "sample,theta_e_rad,theta_r_rad\n0,0,0\n1,0.1,1e200\n",
+            RecordingKind::PolePairRatio,
+            50e-6,
+        )
+        .unwrap_err();
+        assert_eq!((e.0[0].line, e.0[0].key.as_str()), (3, "theta_r_rad"), "{}", e.0[0]);
+        // Empty and one-row recordings.
+        for text in ["sample,voltage_v,current_a\n", "sample,voltage_v,current_a\n0,0,0\n"] {
+            let e = parse_step(text).unwrap_err();
+            assert!(e.problem.contains("data rows") && e.line >= 1, "{e}");
+        }
     }
 
     #[test]

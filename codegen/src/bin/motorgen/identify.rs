@@ -182,13 +182,16 @@ fn recordings(files: &[PathBuf], kind: RecordingKind, ts: f64) -> Result<Vec<Rec
 fn sample_period(common: &Common, design: &Design) -> Result<f64, Failure> {
     match &common.sample_period {
         None => Ok(design.drive.sample_period_s),
-        Some(s) => units::parse(Kind::Time, s).ok().filter(|t| *t > 0.0).ok_or_else(|| {
-            Failure::from(plain_error(
-                "--sample-period",
-                format!("`{s}` is not a positive time"),
-                Kind::Time.accepted(),
-            ))
-        }),
+        Some(s) => units::parse(Kind::Time, s)
+            .ok()
+            .filter(|t| recording::sample_period_in_range(*t))
+            .ok_or_else(|| {
+                Failure::from(plain_error(
+                    "--sample-period",
+                    format!("`{s}` is not a sample period (one PWM period)"),
+                    "a time in [1 µs, 10 ms], e.g. \"50 µs\"",
+                ))
+            }),
     }
 }
 

@@ -572,7 +572,13 @@ fn attenuation_beyond_the_q15_floor_is_refused_after_a_bounded_walk() {
         "{runs} Parks–McClellan runs"
     );
     let msg = err_text(99.0);
-    assert!(msg.contains(&format!("accepted: stop_attenuation ≤ {:.1} dB", (best * 10.0).floor() / 10.0)), "{msg}");
+    assert!(
+        msg.contains(&format!(
+            "accepted: stop_attenuation ≤ {:.1} dB",
+            (best * 10.0).floor() / 10.0
+        )),
+        "{msg}"
+    );
     // The bound it names is designable: 3 dB below it, the minimum-order search succeeds.
     let d = design_fir(&FirRequest {
         length: FirLength::StopAttenuationDb(best - 3.0),
