@@ -13,6 +13,29 @@ pub const EXIT_IO: i32 = 74;
 /// SIGXFSZ (Linux: 25): the default action of exceeding RLIMIT_FSIZE (`ulimit -f`).
 pub const SIGXFSZ: i32 = 25;
 
+/// Issue 18's examples on the Fischer spec: (text replaced, replacement, key, range the
+/// refusal names). Each overflowed or underflowed the design before it had a range.
+pub const ISSUE_18_RANGE_EXAMPLES: &[(&str, &str, &str, &str)] = &[
+    (
+        "peak_current = \"61 A\"",
+        "peak_current = \"6.1e201 A\"",
+        "motor.datasheet.peak_current",
+        "[1 mA, 100 kA]",
+    ),
+    (
+        "dc_link_voltage = \"600 V\"",
+        "dc_link_voltage = \"1.7976931348623157e308 V\"",
+        "drive.dc_link_voltage",
+        "[1 V, 2000 V]",
+    ),
+    (
+        "bandwidth = \"100 rad/s\"",
+        "bandwidth = \"1e-308 rad/s\"",
+        "current_loop.bandwidth",
+        "[1 rad/s, 1e6 rad/s]",
+    ),
+];
+
 /// The repository root.
 pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
