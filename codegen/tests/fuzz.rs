@@ -1,6 +1,7 @@
-//! Bounded fuzzing of everything a user file reaches (issue 18): mutated motor specs through
-//! the design, the check and the three templates, and mutated recordings through the CSV
-//! parser and the identification of their routine, all in-process.
+//! Bounded fuzzing of everything a user file reaches (issue 18): mutated motor specs (and
+//! board files) through the design, the check and the three templates, and mutated
+//! recordings through the CSV parser and the identification of their routine, all
+//! in-process.
 //!
 //! Each case is derived from a seeded SplitMix64, so a failure prints the seed and the
 //! mutated text and reproduces exactly. Per case: no panic (`catch_unwind`), every `Ok`
@@ -9,9 +10,9 @@
 //! is accepted. Work per case is bounded by construction (the spec is at most a few kB, the
 //! recording a few thousand rows).
 //!
-//! CI runs a bounded slice (`SPEC_CASES`, `RECORDING_CASES` below); more locally with
-//! `MOTORGEN_FUZZ_CASES=100000 cargo test --release -p codegen --test fuzz -- --nocapture`
-//! (the count applies to each of the two targets; `MOTORGEN_FUZZ_SEED` shifts the seeds).
+//! CI runs a bounded slice (`SPEC_CASES`, `BOARD_CASES`, `RECORDING_CASES` below); more
+//! locally with `MOTORGEN_FUZZ_CASES=100000 cargo test --release -p codegen --test fuzz -- --nocapture`
+//! (the count applies to each of the three targets; `MOTORGEN_FUZZ_SEED` shifts the seeds).
 
 mod common;
 
@@ -30,6 +31,8 @@ use motor_control::commissioning::Axis;
 
 /// Spec cases in CI (debug build).
 const SPEC_CASES: usize = 800;
+/// Board cases in CI (debug build).
+const BOARD_CASES: usize = 40;
 /// Recording cases in CI (debug build).
 const RECORDING_CASES: usize = 3000;
 
@@ -275,11 +278,21 @@ fn replace_line(lines: &[&str], i: usize, new: &str) -> String {
 
 /// Every diagnostic names its file, a position and what would be accepted.
 fn located(e: &Diagnostics, file: &str) -> Result<(), String> {
+    located_in(e, &[file])
+}
+
+/// As [`located`], for an input of several files.
+fn located_in(e: &Diagnostics, files: &[&str]) -> Result<(), String> {
     if e.0.is_empty() {
         return Err("an error without any diagnostic".into());
     }
     for d in &e.0 {
-        if d.file != file || d.line == 0 || d.column == 0 || d.problem.is_empty() || d.accepted.is_empty() {
+        if !files.contains(&d.file.as_str())
+            || d.line == 0
+            || d.column == 0
+            || d.problem.is_empty()
+            || d.accepted.is_empty()
+        {
             return Err(format!("unlocated diagnostic: {d:?}"));
         }
     }
@@ -287,7 +300,7 @@ fn located(e: &Diagnostics, file: &str) -> Result<(), String> {
 }
 
 /// An `Ok` design is all-finite and renders; an `Err` is located. `Ok(true)`: accepted.
-fn judge_design(result: Result<Design, Diagnostics>, file: &str) -> Result<bool, String> {
+fn judge_design(result: Result<Design, Diagnostics>, files: &[&str]) -> Result<bool, String> {
     match result {
         Ok(d) => {
             if let Some((path, x)) = first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&d))) {
@@ -301,7 +314,7 @@ fn judge_design(result: Result<Design, Diagnostics>, file: &str) -> Result<bool,
             }
             Ok(true)
         }
-        Err(e) => located(&e, file).map(|()| false),
+        Err(e) => located_in(&e, files).map(|()| false),
     }
 }
 
@@ -370,7 +383,39 @@ fn mutated_specs_never_panic_and_every_design_is_finite() {
         }
         let file = "fuzz.toml";
         let verdict = catch_unwind(AssertUnwindSafe(|| {
-            judge_design(codegen::design_source(file, &text), file)
+            judge_design(codegen::design_source(file, &text), &[file])
+        }))
+        .unwrap_or_else(|p| Err(format!("panic: {}", panic_text(p))));
+        (text, verdict)
+    });
+}
+
+/// Mutated board files (1–3 mutations of a file in boards/) with each motor, through
+/// `design_with_board` (the board checks and the board's constants) and the templates.
+#[test]
+fn mutated_boards_never_panic_and_every_design_is_finite() {
+    let motors = seeds();
+    let mut boards = Vec::new();
+    for e in std::fs::read_dir(common::repo().join("boards")).unwrap() {
+        let path = e.unwrap().path();
+        if path.extension().is_some_and(|x| x == "toml") {
+            boards.push(std::fs::read_to_string(path).unwrap());
+        }
+    }
+    boards.sort();
+    std::panic::set_hook(Box::new(|_| {}));
+    run("boards", cases(BOARD_CASES), |seed| {
+        let mut rng = Rng::new(seed ^ 0xB0A4D);
+        let (_, motor) = rng.pick(&motors);
+        let mut text = rng.pick(&boards).clone();
+        for _ in 0..=rng.below(3) {
+            text = mutate(&mut rng, &text);
+        }
+        let verdict = catch_unwind(AssertUnwindSafe(|| {
+            judge_design(
+                codegen::design_with_board("m.toml", motor, "board.toml", &text),
+                &["m.toml", "board.toml"],
+            )
         }))
         .unwrap_or_else(|p| Err(format!("panic: {}", panic_text(p))));
         (text, verdict)
