@@ -345,6 +345,9 @@ fn run(name: &str, n: usize, mut one: impl FnMut(u64) -> (String, Result<bool, S
         if verdict == Ok(true) {
             accepted += 1;
         }
+        if n >= 10_000 && (k + 1) % (n as u64 / 10) == 0 {
+            eprintln!("{name}: {} cases, {:.0} s", k + 1, started.elapsed().as_secs_f64());
+        }
         if let Err(why) = verdict {
             failures.push(format!("seed {seed}: {why}\n--- input ---\n{input}\n---"));
             if failures.len() >= 5 {
