@@ -348,7 +348,12 @@ fn run(name: &str, n: usize, mut one: impl FnMut(u64) -> (String, Result<bool, S
         if n >= 10_000 && (k + 1) % (n as u64 / 10) == 0 {
             eprintln!("{name}: {} cases, {:.0} s", k + 1, started.elapsed().as_secs_f64());
         }
+        if n == 1 {
+            eprintln!("seed {seed} ({dt:.2} s): {verdict:?}\n--- input ---\n{input}\n---");
+        }
         if let Err(why) = verdict {
+            // Printed at once: a long run shows its findings while it goes on.
+            eprintln!("FAILURE seed {seed}: {why}\n--- input ---\n{input}\n---");
             failures.push(format!("seed {seed}: {why}\n--- input ---\n{input}\n---"));
             if failures.len() >= 5 {
                 break;
@@ -362,6 +367,9 @@ fn run(name: &str, n: usize, mut one: impl FnMut(u64) -> (String, Result<bool, S
         slowest.1,
         failures.len()
     );
+    // The cases silence the panic hook (a caught panic is a finding, not noise); the
+    // verdict must be heard.
+    let _ = std::panic::take_hook();
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
