@@ -656,3 +656,30 @@ fn mutated_recordings_never_panic_and_every_estimate_is_finite() {
         (text, verdict)
     });
 }
+
+/// Finding of the 10^5-case release run (seed 71809): `voltage_fraction = 1e-308` on the
+/// Chalmers spec was accepted and the field-weakening gain α_fw·L/V'_max (1e300-odd, finite
+/// in f64) was written as `pub const GAIN_AT_BASE_SPEED: f32 = inf;`. Now the fraction has
+/// a range and the finite gate judges numbers in f32 too.
+#[test]
+fn finding_voltage_fraction_overflowing_f32_is_refused_at_its_key() {
+    let text = std::fs::read_to_string(common::repo().join("motors/chalmers-hev50.toml")).unwrap();
+    let from = "voltage_fraction = 0.9 ";
+    assert!(text.contains(from));
+    let bad = text.replacen(from, "voltage_fraction = 1e-308 ", 1);
+    let e = codegen::design_source("c.toml", &bad).unwrap_err();
+    let d = &e.0[0];
+    assert_eq!(d.key, "field_weakening.voltage_fraction", "{e}");
+    assert_eq!(
+        d.line,
+        bad[..bad.find("voltage_fraction = 1e-308").unwrap()]
+            .matches('\n')
+            .count()
+            + 1
+    );
+    assert!(d.accepted.contains("from 0.5 to below 1"), "{e}");
+    // The bound itself designs.
+    let edge = text.replacen(from, "voltage_fraction = 0.5 ", 1);
+    let design = codegen::design_source("c.toml", &edge).unwrap();
+    assert!(judge_design(Ok(design), &["c.toml"]).unwrap());
+}

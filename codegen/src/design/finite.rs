@@ -1,5 +1,5 @@
 //! The last gate before anything is written or printed: every number of the [`Design`] is
-//! finite. `serde_json` writes NaN and ±∞ as `null` without a word, and a template prints
+//! finite, in f64 and in the firmware's f32. `serde_json` writes NaN and ±∞ as `null` without a word, and a template prints
 //! them as `NaN`/`inf` in generated code (issue 18), so the whole design is walked in its
 //! serialised form — the same form the JSON and the templates see — and the first
 //! non-finite number is an error naming its JSON path (e.g. `current_loop.d.kp`) and the
@@ -14,7 +14,13 @@ use super::Design;
 use crate::diagnostic::{Diagnostic, Source};
 use crate::spec::Spec;
 
-/// The first non-finite number in `value`, as (JSON path, value).
+/// Finite in f64 and in f32: the firmware's constants are f32, where |x| > f32::MAX is ∞
+/// (a field-weakening gain of 1e300 was written as `f32 = inf`, issue 18).
+pub fn representable(x: f64) -> bool {
+    x.is_finite() && x.abs() <= f32::MAX as f64
+}
+
+/// The first number in `value` that is not [`representable`], as (JSON path, value).
 pub fn first_non_finite(value: &Value) -> Option<(String, f64)> {
     let mut path = String::new();
     walk(value, &mut path)
@@ -24,7 +30,7 @@ fn walk(value: &Value, path: &mut String) -> Option<(String, f64)> {
     match value.kind() {
         ValueKind::Number => {
             let x = f64::try_from(value.clone()).ok()?;
-            (!x.is_finite()).then(|| (path.clone(), x))
+            (!representable(x)).then(|| (path.clone(), x))
         }
         ValueKind::Seq | ValueKind::Iterable => {
             for (i, item) in value.try_iter().ok()?.enumerate() {
@@ -111,7 +117,7 @@ pub fn check(design: &Design, spec: &Spec, src: Source<'_>) -> Result<(), Box<Di
     Err(Box::new(src.error(
         span,
         keys.split(", ").next().unwrap_or(""),
-        format!("the design's `{path}` comes out as {x}: these inputs overflow or underflow f64 in its formula (decided by {keys})"),
+        format!("the design's `{path}` comes out as {x:e}, not a finite number in f64 and in the firmware's f32 (|x| ≤ 3.4e38): these inputs overflow or underflow its formula (decided by {keys})"),
         "values in their physically sensible ranges (`motorgen new` writes a commented example); the design never writes a non-finite number",
     )))
 }
@@ -164,6 +170,19 @@ mod tests {
         assert_eq!(
             first_non_finite(&Value::from(minijinja::value::Serde(&inf))),
             Some(("d.gains[1]".to_string(), f64::NEG_INFINITY))
+        );
+        // Finite in f64 but ∞ as the firmware's f32 (3.4028235e38 is f32::MAX).
+        let big = Outer {
+            name: "z".into(),
+            d: Inner {
+                kp: 3.5e38,
+                gains: vec![3.4e38],
+                optional: None,
+            },
+        };
+        assert_eq!(
+            first_non_finite(&Value::from(minijinja::value::Serde(&big))),
+            Some(("d.kp".to_string(), 3.5e38))
         );
     }
 }

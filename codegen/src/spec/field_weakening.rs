@@ -9,6 +9,10 @@ use super::raw::{RawSpec, Val};
 use super::{Param, Provenance, Resolver_};
 use crate::units::Kind;
 
+/// Smallest accepted V'_max/V_max: below half the inverter's voltage the field-weakening
+/// region starts at half the speed the inverter allows, and the gain α_fw·L/V'_max (2.57)
+/// grows without bound as the fraction goes to zero.
+pub const MIN_VOLTAGE_FRACTION: f64 = 0.5;
 /// V'_max/V_max when `field_weakening.voltage_fraction` is not given: thesis B Fig. 2.15
 /// ("V'_max is set to 0.9 pu", V_max = 1 pu).
 pub const DEFAULT_VOLTAGE_FRACTION: f64 = 0.9;
@@ -58,9 +62,9 @@ impl Resolver_<'_> {
             Some(v) => self.number(
                 "field_weakening.voltage_fraction",
                 v,
-                0.0,
+                MIN_VOLTAGE_FRACTION - 1e-12,
                 1.0,
-                "a fraction V'_max/V_max above 0 and below 1, e.g. 0.9 (thesis B Fig. 2.15); V'_max must stay below the inverter's V_max (2.55)",
+                "a fraction V'_max/V_max from 0.5 to below 1, e.g. 0.9 (thesis B Fig. 2.15); V'_max must stay below the inverter's V_max (2.55), and below half of it field weakening would start at half the speed the inverter allows (at 1e-308 the field-weakening gain α_fw·L/V' overflowed the firmware's f32, issue 18)",
             ),
             None => Some(Param {
                 value: DEFAULT_VOLTAGE_FRACTION,
