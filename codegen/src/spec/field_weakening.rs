@@ -64,7 +64,7 @@ impl Resolver_<'_> {
                 v,
                 MIN_VOLTAGE_FRACTION - 1e-12,
                 1.0,
-                "a fraction V'_max/V_max from 0.5 to below 1, e.g. 0.9 (thesis B Fig. 2.15); V'_max must stay below the inverter's V_max (2.55), and below half of it field weakening would start at half the speed the inverter allows (at 1e-308 the field-weakening gain α_fw·L/V' overflowed the firmware's f32, issue 18)",
+                "a fraction V'_max/V_max from 0.5 to below 1, e.g. 0.9 (thesis B Fig. 2.15); V'_max must stay below the inverter's V_max (2.55), and below half of it the field-weakening gain α_fw·L/V'_max (2.57) grows without bound",
             ),
             None => Some(Param {
                 value: DEFAULT_VOLTAGE_FRACTION,
