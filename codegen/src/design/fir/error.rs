@@ -93,7 +93,7 @@ pub enum FirError {
         best_db: Option<f64>,
     },
     /// The minimum-order walk stopped: the quantised attenuation stopped improving
-    /// ([`super::search::STALL_ORDERS`] orders without progress), the Q1.15 floor.
+    /// (`STALL_ORDERS` = 6 orders without progress), the Q1.15 floor.
     AttenuationFloor {
         /// Requested attenuation \[dB\].
         requested_db: f64,
