@@ -21,7 +21,11 @@ use common::repo;
 /// SRAM's 32 KiB alias at 0x2001_8000 form 128 KiB of contiguous RAM ending at
 /// 0x2000_0000 + 0x2_0000 = 0x2002_0000 (80 + 16 + 32 = 128 KiB = 0x2_0000).
 const FLASH_START: u32 = 0x0800_0000;
+const RAM_START: u32 = 0x2000_0000;
 const RAM_END: u32 = 0x2002_0000;
+/// The image's initial stack pointer: the top of the 32 KiB main stack that
+/// firmware/app/memory.x places at the bottom of RAM (0x2000_0000 + 0x8000).
+const STACK_TOP: u32 = RAM_START + 32 * 1024;
 
 /// Runs `motorgen firmware <args>` from the repository root.
 fn firmware(args: &[&str]) -> Output {
@@ -79,7 +83,7 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
 
     // Cortex-M vector table: initial SP, then the reset handler's address with the
     // Thumb bit set, inside the image.
-    assert_eq!(word(&bin, 0), RAM_END, "initial stack pointer = end of the G474's RAM");
+    assert_eq!(word(&bin, 0), STACK_TOP, "initial stack pointer = top of the stack below the statics");
     let reset = word(&bin, 4);
     assert_eq!(reset & 1, 1, "reset vector {reset:#010x} is not a Thumb address");
     let flash_end = FLASH_START + u32::try_from(flash).unwrap();
@@ -87,6 +91,84 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
         (FLASH_START..flash_end).contains(&(reset & !1)),
         "reset vector {reset:#010x} outside the image {FLASH_START:#010x}..{flash_end:#010x}"
     );
+}
+
+/// Stack overflow protection and the fault record, read from the fischer-ti085 ELF:
+/// * the main stack is `[0x2000_0000, _stack_start)`: nothing lies below it (RM0440
+///   memory map: reserved below SRAM1), every RAM section (.data, .bss, .uninit) lies
+///   above it, so an overflow faults instead of overwriting statics;
+/// * the HardFault vector points at the entry in app/src/board/fault.rs, which moves
+///   MSP to `_stack_start` before anything could push onto the overflowed stack;
+/// * the fault record and the live control state are in `.uninit` (not zeroed at boot)
+///   under their documented symbols, 14 and 7 words.
+#[test]
+fn stack_below_the_statics_and_the_fault_record_in_uninit() {
+    use object::{Object, ObjectSection, ObjectSymbol, SectionFlags, elf};
+
+    let out = firmware(&["fischer-ti085"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let bytes = std::fs::read(repo().join("target/firmware/fischer-ti085.elf")).expect("the .elf is written");
+    let file = object::File::parse(&*bytes).expect("an ELF");
+    let symbol = |name: &str| {
+        file.symbols()
+            .find(|s| s.name() == Ok(name))
+            .map(|s| (s.address() as u32, s.size() as u32))
+            .unwrap_or_else(|| panic!("no symbol {name}"))
+    };
+    let (stack_top, _) = symbol("_stack_start");
+    let (stack_bottom, _) = symbol("_stack_end");
+    assert_eq!(stack_bottom, RAM_START, "the stack grows down to the start of RAM");
+    assert_eq!(stack_top, STACK_TOP);
+    let mut ram_sections = 0;
+    for s in file.sections() {
+        let SectionFlags::Elf { sh_flags } = s.flags() else { unreachable!() };
+        if sh_flags & u64::from(elf::SHF_ALLOC | elf::SHF_WRITE) == u64::from(elf::SHF_ALLOC | elf::SHF_WRITE)
+            && s.size() > 0
+        {
+            ram_sections += 1;
+            let name = s.name().unwrap_or("?");
+            assert!(
+                s.address() >= u64::from(stack_top) && s.address() + s.size() <= u64::from(RAM_END),
+                "{name} at {:#010x} (+{}) is not above the stack (top {stack_top:#010x})",
+                s.address(),
+                s.size()
+            );
+        }
+    }
+    assert!(ram_sections >= 2, "found .bss and .uninit");
+
+    // The record: 6 + 7 + 1 words (magic, cause, flags, PC, CFSR, HFSR; state; CRC).
+    let (uninit_start, _) = symbol("__suninit");
+    let (uninit_end, _) = symbol("__euninit");
+    for (name, words) in [("MOTOR_FAULT_RECORD", 14), ("MOTOR_CONTROL_STATE", 7)] {
+        let (at, size) = symbol(name);
+        assert_eq!(size, 4 * words, "{name} size");
+        assert!(
+            at >= uninit_start && at + size <= uninit_end,
+            "{name} at {at:#010x} is not in .uninit [{uninit_start:#010x}, {uninit_end:#010x})"
+        );
+    }
+
+    // HardFault: the vector (word 3, PM0214 §2.3.4 vector table) is the entry's address
+    // with the Thumb bit; its first instruction is `mrs r0, MSP` (Thumb-2 F3EF 8008) and
+    // `msr MSP, r1` (F381 8808) follows within its first 24 bytes with no push (16-bit
+    // B4xx/B5xx, 32-bit E92D) before it.
+    let (hard_fault, _) = symbol("HardFault");
+    let text = file.section_by_name(".text").expect(".text");
+    let vectors = file.section_by_name(".vector_table").expect(".vector_table");
+    let table = vectors.data().unwrap();
+    assert_eq!(word(table, 12), hard_fault | 1, "HardFault vector");
+    let at = (u64::from(hard_fault) - text.address()) as usize;
+    let code = &text.data().unwrap()[at..at + 24];
+    let halfwords: Vec<u16> = code.chunks(2).map(|c| u16::from_le_bytes([c[0], c[1]])).collect();
+    assert_eq!(&halfwords[..2], &[0xF3EF, 0x8008], "HardFault starts with mrs r0, MSP");
+    let msr = halfwords
+        .windows(2)
+        .position(|w| w == [0xF381, 0x8808])
+        .expect("msr MSP, r1 in the HardFault entry");
+    for &h in &halfwords[..msr] {
+        assert!(h >> 9 != 0b1011_010 && h != 0xE92D, "a push ({h:#06x}) before MSP is reset");
+    }
 }
 
 /// `motorgen firmware --all [--board <board>]`: every motor's image is written into `dir`
@@ -110,7 +192,7 @@ fn every_motor_builds(board: Option<&str>) -> String {
     for stem in common::motor_stems() {
         let bin = std::fs::read(dir.join(format!("{stem}.bin"))).expect("the .bin is written");
         assert!(bin.len() < 64 * 1024, "{stem}: {} bytes", bin.len());
-        assert_eq!(word(&bin, 0), RAM_END, "{stem}: initial stack pointer");
+        assert_eq!(word(&bin, 0), STACK_TOP, "{stem}: initial stack pointer");
         assert!(
             stdout.contains(&format!("{stem}: flash {} bytes", bin.len())),
             "{stem}: no flash line for {} bytes in\n{stdout}",

@@ -48,6 +48,18 @@ pub const FDCAN1_RAM: usize = 0x4000_A400;
 pub const FDCAN_RXF0_OFFSET: usize = 0xB0;
 /// Size of one RX FIFO element \[bytes\]: 18 words (header + 64 data bytes).
 pub const FDCAN_RX_ELEMENT_BYTES: usize = 72;
+/// Offset of the Tx buffers in the message RAM \[bytes\]: after the 28 standard and 8
+/// extended filter elements, RX FIFO 0 and 1 (3 × 18 words each) and the 3 Tx event
+/// FIFO elements (2 words each): 0xB0 + 2·216 + 24 = 0x278 (RM0440 §44.3.3, Figure 589).
+pub const FDCAN_TXBUF_OFFSET: usize = 0x278;
+/// Size of one Tx buffer element \[bytes\]: 18 words, as the Rx elements.
+pub const FDCAN_TX_ELEMENT_BYTES: usize = 72;
+/// Standard identifier of the fault-report frame sent once after a boot that found a
+/// fault record (`fault_frame`); a choice of this firmware, checked at compile time to
+/// differ from the board's setpoint identifier.
+pub const FAULT_REPORT_ID: u16 = 0x0E0;
+/// Current unit of the fault report's i_q \[A per LSB\] (±3276.7 A in an `i16`).
+pub const FAULT_FRAME_AMPS_PER_LSB: f32 = 0.1;
 
 /// TIM1 break-input digital filter BKF: f_DTS, N = 8 samples (RM0440 §28.6.20,
 /// code 0b0011 = f_CK_INT, N = 8): ignores glitches shorter than 47 ns.

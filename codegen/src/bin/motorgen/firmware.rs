@@ -12,8 +12,8 @@
 //! for another board), writes `<stem>.bin` (the
 //! ELF's loadable segments placed by load address, gaps filled with the erased-flash
 //! byte 0xFF) and prints flash and static RAM use; for one motor it first prints the
-//! constants summary of the design the image is built from. An image over 64 KiB of flash is an
-//! error and is not written.
+//! constants summary of the design the image is built from. An image over the 64 KiB flash
+//! budget (the G474RE itself has 512 KiB) is an error and is not written.
 //!
 //! The repository root is the nearest ancestor of the motors folder that holds
 //! `firmware/Cargo.toml`, else the nearest such ancestor of the current directory,
@@ -35,7 +35,8 @@ use crate::output::{errln, out};
 const TARGET: &str = "thumbv7em-none-eabihf";
 /// The firmware package (a binary of the same name).
 const PACKAGE: &str = "motor-firmware";
-/// Flash the image must fit in \[bytes\].
+/// The project's flash budget for one image \[bytes\] — a budget, not the chip's limit:
+/// the STM32G474RE has 512 KiB of flash (DS12288 Table 2).
 pub const FLASH_LIMIT: u64 = 64 * 1024;
 /// Erased-flash byte, for gaps between segments in the `.bin`.
 const ERASED: u8 = 0xFF;
@@ -62,8 +63,8 @@ pub struct Usage {
     pub ram: u64,
     /// RAM bytes per allocated writable section.
     pub ram_sections: Vec<(String, u64)>,
-    /// Stack space: `_stack_start − _stack_end` if the ELF defines both (cortex-m-rt
-    /// gives the stack the RAM above the static data).
+    /// Stack space: `_stack_start − _stack_end` if the ELF defines both (the image's
+    /// memory.x places the stack at the bottom of RAM, below the static data).
     pub stack: Option<u64>,
 }
 
@@ -170,7 +171,7 @@ pub fn report(stem: &str, usage: &Usage) -> String {
     };
     let _ = writeln!(
         out,
-        "{stem}: flash {} bytes ({}, {:.1} % of 64 KiB) = {}",
+        "{stem}: flash {} bytes ({}, {:.1} % of the 64 KiB budget) = {}",
         usage.flash,
         kib(usage.flash),
         usage.flash as f64 / FLASH_LIMIT as f64 * 100.0,
@@ -189,7 +190,7 @@ pub fn report(stem: &str, usage: &Usage) -> String {
     );
     match usage.stack {
         Some(s) => {
-            let _ = writeln!(out, "; stack: the remaining {s} bytes ({}) of RAM", kib(s));
+            let _ = writeln!(out, "; stack: {s} bytes ({}) below the statics", kib(s));
         }
         None => out.push('\n'),
     }

@@ -26,6 +26,8 @@ const NBTP: u32 = match nominal_bit_timing(
 
 /// Number of RX FIFO 0 elements.
 const RX_FIFO_ELEMENTS: u8 = 3;
+/// Number of Tx buffers (RM0440 §44.3.3).
+const TX_BUFFERS: u8 = 3;
 
 /// FDCAN1, owned.
 pub struct Can {
@@ -77,5 +79,26 @@ impl Can {
         // SAFETY: F0AI takes the get index just read.
         self.regs.rxf0a().write(|w| unsafe { w.f0ai().bits(index) });
         Some(frame)
+    }
+
+    /// Queues one frame (the first four words of a Tx buffer element,
+    /// `crate::fault_frame::tx_element`) in the Tx FIFO (TXBC.TFQM = 0 after reset) and
+    /// requests its transmission; `false` if the FIFO is full. The FDCAN retransmits
+    /// until the frame is acknowledged (CCCR.DAR = 0).
+    pub fn send(&mut self, element: [u32; 4]) -> bool {
+        let status = self.regs.txfqs().read();
+        let index = status.tfqpi().bits();
+        if status.tfqf().bit_is_set() || index >= TX_BUFFERS {
+            return false;
+        }
+        let base = hw::FDCAN1_RAM + hw::FDCAN_TXBUF_OFFSET + usize::from(index) * hw::FDCAN_TX_ELEMENT_BYTES;
+        for (k, w) in element.into_iter().enumerate() {
+            // SAFETY: `base` is Tx buffer `index` (< 3) of the FDCAN1 message RAM, free
+            // (TXFQS put index of a FIFO that is not full); word-aligned.
+            unsafe { core::ptr::write_volatile((base + 4 * k) as *mut u32, w) };
+        }
+        // SAFETY: AR takes a mask of the buffers to send; bit `index` < 3.
+        self.regs.txbar().write(|w| unsafe { w.ar().bits(1 << index) });
+        true
     }
 }

@@ -11,6 +11,9 @@
 //! nothing tripped, the setpoint is alive or still ramping down, and the break flag —
 //! read again now, not at the start of the interrupt (defect 6) — is clear
 //! (`motor_config::bringup::finish_period`). A tripped drive stays off until reset.
+//! Every period's state (currents, angle, speed, DC link, outputs on, tripped) is kept
+//! for the fault record ([`super::fault::keep_state`]); the first trip seals the record
+//! with its cause (trip, lost conversion, break) at the end of its period.
 //! i_d = 0 (the torque → i_q conversion (2.34) assumes it).
 
 use core::cell::Cell;
@@ -23,10 +26,11 @@ use stm32g4::stm32g474 as pac;
 use stm32g4::stm32g474::interrupt;
 
 use super::cordic::Cordic;
-use super::{adc, pins, pwm};
+use super::{adc, fault, pins, pwm};
 use crate::adc_frame::{self, Excitation};
 use crate::bringup;
 use crate::config::{CONTROLLER, SETPOINT, TRIPS};
+use crate::fault_record::{ControlState, FaultCause};
 use crate::motor::board;
 
 /// Control periods run (wrapping); the main loop refreshes the watchdog only when
@@ -61,6 +65,8 @@ pub struct Control {
     tripped: bool,
     /// Electrical speed of the last step \[rad/s\], for the over-speed trip.
     omega_e: f32,
+    /// Why this period tripped, recorded at its end with its state.
+    trip_cause: Option<FaultCause>,
 }
 
 /// Passes the [`Control`] from `run` to the interrupt once.
@@ -78,11 +84,16 @@ impl Control {
             setpoint: SetpointState::new(),
             tripped: false,
             omega_e: 0.0,
+            trip_cause: None,
         }
     }
 
-    /// Latches a trip and switches the gates off at once.
-    fn trip(&mut self) {
+    /// Latches a trip and switches the gates off at once; the first trip's cause goes
+    /// into the fault record.
+    fn trip(&mut self, cause: FaultCause) {
+        if !self.tripped && self.trip_cause.is_none() {
+            self.trip_cause = Some(cause);
+        }
         self.tripped = true;
         pwm::outputs_off(&self.tim1);
     }
@@ -90,11 +101,14 @@ impl Control {
     /// One control period.
     pub fn step(&mut self) {
         let Some(raw) = adc::read(&self.adc1, &self.adc2) else {
-            // A lost conversion: no valid currents this period.
-            return self.trip();
+            // A lost conversion: no valid currents this period (the record keeps the
+            // last period's state).
+            self.trip(FaultCause::LostConversion);
+            return self.record_trip();
         };
+        let was_tripped = self.tripped;
         if TRIPS.tripped(&raw, usize::from(board::CURRENT_PHASES), self.omega_e) {
-            self.trip();
+            self.trip(FaultCause::Trip);
         }
         let excitation = if pins::excitation_high() {
             Excitation::Positive
@@ -117,8 +131,30 @@ impl Control {
         let out = CONTROLLER.process(&mut self.state, &mut self.cordic, &sample, demand);
         self.omega_e = out.omega_e;
         pwm::set_compare(&self.tim1, out.compare);
-        bringup::finish_period(&mut pwm::Break(&self.tim1), &mut self.tripped, run);
-        TICKS.fetch_add(1, Ordering::Relaxed);
+        let on = bringup::finish_period(&mut pwm::Break(&self.tim1), &mut self.tripped, run);
+        if self.tripped && !was_tripped && self.trip_cause.is_none() {
+            self.trip_cause = Some(FaultCause::Break);
+        }
+        let periods = TICKS.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
+        fault::keep_state(&ControlState {
+            i_d: out.i_dq.d,
+            i_q: out.i_dq.q,
+            theta_e: out.theta_e,
+            omega_e: out.omega_e,
+            u_dc: out.u_dc,
+            periods,
+            running: on,
+            tripped: self.tripped,
+        });
+        self.record_trip();
+    }
+
+    /// Seals the fault record once, for the first trip (the drive stays off until
+    /// reset, and the record waits for it).
+    fn record_trip(&mut self) {
+        if let Some(cause) = self.trip_cause.take() {
+            fault::record(cause);
+        }
     }
 }
 

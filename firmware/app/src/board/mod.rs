@@ -14,7 +14,7 @@
 //! | [`can`] | FDCAN1 setpoint reception |
 //! | [`watchdog`] | IWDG |
 //! | [`control`] | the control interrupt |
-//! | [`fault`] | HardFault, unhandled interrupts, panics |
+//! | [`fault`] | HardFault (also on stack overflow), unhandled interrupts, panics; the fault record |
 #![allow(unsafe_code)]
 
 pub mod adc;
@@ -46,6 +46,8 @@ use fault::halt;
 /// outputs off.
 ///
 /// Order (each step's reason in its module):
+/// 0. the fault record of the previous run, read and validated before anything can
+///    fault again ([`fault::take_at_boot`]); sent on CAN once FDCAN1 is up;
 /// 1. clocks; the boot source (defect 2): with `boot0.handling = "option_bytes"` the
 ///    image runs only if FLASH_OPTR.nSWBOOT0 = 0 and nBOOT0 = 1, so PB8's level at the
 ///    next reset cannot start the system bootloader (DS12288 §3.7);
@@ -59,6 +61,7 @@ use fault::halt;
 /// 4. CORDIC and FMAC self-tests, ADCs (defect 1), TIM3, FDCAN, start.
 pub fn run() -> ! {
     let Some(dp) = pac::Peripherals::take() else { halt() };
+    let previous_fault = fault::take_at_boot(&dp.RCC);
     if !clocks::init(&dp.RCC, &dp.PWR, &dp.FLASH) {
         halt()
     }
@@ -84,6 +87,9 @@ pub fn run() -> ! {
     let Some(mut can) = can::Can::new(dp.FDCAN1) else {
         halt()
     };
+    if let Some(record) = previous_fault {
+        fault::report(&mut can, record);
+    }
     pwm::start(&dp.TIM1);
     let control = Control::new(dp.TIM1, dp.ADC1, dp.ADC2, cordic);
     cortex_m::interrupt::free(|cs| HANDOFF.borrow(cs).set(Some(control)));

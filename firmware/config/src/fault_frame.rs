@@ -1,0 +1,133 @@
+//! The fault-report CAN frame (pure), sent once after a boot that found a fault record
+//! ([`crate::fault_record`]): standard identifier [`crate::hw::FAULT_REPORT_ID`], eight
+//! data bytes:
+//!
+//! | byte | content |
+//! |---|---|
+//! | 0 | cause code ([`FaultCause`] as `u8`: 1 HardFault, 2 stack overflow, 3 break, 4 trip, 5 lost conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog) |
+//! | 1 | flags: bit 0 PC valid, bit 1 state valid, bit 2 outputs were on, bit 3 tripped |
+//! | 2–5 | stacked PC, little-endian (0 when not valid) |
+//! | 6–7 | i_q of the last period, little-endian `i16` in units of [`crate::hw::FAULT_FRAME_AMPS_PER_LSB`], saturating; `i16::MIN` when not a number; 0 when the state is not valid |
+//!
+//! The full record (currents, angle, speed, DC link, CFSR/HFSR) is read with a probe
+//! (firmware/README.md, "Fault record").
+#![forbid(unsafe_code)]
+
+use crate::fault_record::{FaultCause, FaultRecord};
+use crate::hw;
+use crate::motor::board;
+
+// The report must not be taken for a setpoint by the vehicle unit, nor the reverse.
+const _: () = assert!(
+    hw::FAULT_REPORT_ID != board::SETPOINT_ID,
+    "the board's setpoint identifier collides with the fault report's (hw::FAULT_REPORT_ID)"
+);
+
+/// The eight data bytes of the report of `r`.
+pub fn encode(r: &FaultRecord) -> [u8; 8] {
+    let state = r.state;
+    let flags = u8::from(r.pc.is_some())
+        | u8::from(state.is_some()) << 1
+        | u8::from(state.is_some_and(|s| s.running)) << 2
+        | u8::from(state.is_some_and(|s| s.tripped)) << 3;
+    let [p0, p1, p2, p3] = r.pc.unwrap_or(0).to_le_bytes();
+    let iq = state.map_or(0, |s| {
+        if s.i_q.is_nan() {
+            i16::MIN
+        } else {
+            // `as` saturates at the i16 range (and rounds towards zero).
+            (s.i_q / hw::FAULT_FRAME_AMPS_PER_LSB) as i16
+        }
+    });
+    let [q0, q1] = iq.to_le_bytes();
+    [r.cause as u8, flags, p0, p1, p2, p3, q0, q1]
+}
+
+/// The first four words of an FDCAN Tx buffer element for a classic data frame with a
+/// standard identifier and eight bytes (RM0440 §44.3.3, "Tx buffer element"): T0 holds
+/// the identifier in bits 28:18 (XTD = RTR = ESI = 0), T1 the DLC in bits 19:16
+/// (FDF = BRS = 0: classic CAN; EFC = 0: no Tx event), T2–T3 the data bytes
+/// little-endian.
+pub fn tx_element(standard_id: u16, data: &[u8; 8]) -> [u32; 4] {
+    let [a, b, c, d, e, f, g, h] = *data;
+    [
+        (u32::from(standard_id) & 0x7FF) << 18,
+        8 << 16,
+        u32::from_le_bytes([a, b, c, d]),
+        u32::from_le_bytes([e, f, g, h]),
+    ]
+}
+
+/// The cause byte of a report, decoded (for a receiver written in Rust).
+pub fn cause_of(data: &[u8; 8]) -> Option<FaultCause> {
+    FaultCause::from_code(u32::from(data[0]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fault_record::ControlState;
+
+    fn state(i_q: f32) -> ControlState {
+        ControlState {
+            i_d: 0.0,
+            i_q,
+            theta_e: 0,
+            omega_e: 0.0,
+            u_dc: 600.0,
+            periods: 1,
+            running: true,
+            tripped: true,
+        }
+    }
+
+    /// A trip at i_q = 212.25 A with PC 0x0800_1234: i_q/0.1 A = 2122.5 → 2122 =
+    /// 0x084A; flags = PC | state | on | tripped = 0x0F.
+    #[test]
+    fn trip_report() {
+        assert_eq!(hw::FAULT_FRAME_AMPS_PER_LSB, 0.1);
+        let r = FaultRecord {
+            cause: FaultCause::Trip,
+            pc: Some(0x0800_1234),
+            cfsr: 0,
+            hfsr: 0,
+            state: Some(state(212.25)),
+            reported: false,
+        };
+        let d = encode(&r);
+        assert_eq!(d, [4, 0x0F, 0x34, 0x12, 0x00, 0x08, 0x4A, 0x08]);
+        assert_eq!(cause_of(&d), Some(FaultCause::Trip));
+    }
+
+    /// No PC, no state: only the cause; −5000 A saturates at −32768 (0x8000), as does a
+    /// NaN (documented as "not a number").
+    #[test]
+    fn bare_and_saturated() {
+        let mut r = FaultRecord {
+            cause: FaultCause::Watchdog,
+            pc: None,
+            cfsr: 0,
+            hfsr: 0,
+            state: None,
+            reported: false,
+        };
+        assert_eq!(encode(&r), [9, 0, 0, 0, 0, 0, 0, 0]);
+        r.state = Some(state(5000.0));
+        assert_eq!(&encode(&r)[6..], &0x7FFFu16.to_le_bytes());
+        r.state = Some(state(f32::NAN));
+        assert_eq!(&encode(&r)[6..], &[0x00, 0x80]);
+    }
+
+    /// ID 0x0E0 → T0 = 0x0E0 << 18 = 0x0380_0000; DLC 8 → T1 = 0x0008_0000; the
+    /// element decodes back through the receive path's `RxFrame::from_words` (same
+    /// layout of the first words for Rx and Tx elements, RM0440 §44.3.3).
+    #[test]
+    fn tx_element_layout() {
+        let data = [1, 2, 3, 4, 5, 6, 7, 8];
+        let w = tx_element(0x0E0, &data);
+        assert_eq!(w, [0x0380_0000, 0x0008_0000, 0x0403_0201, 0x0807_0605]);
+        let back = crate::can_frame::RxFrame::from_words(w);
+        assert_eq!(back.standard_id, Some(0x0E0));
+        assert_eq!(back.bytes(), &data);
+    }
+}
