@@ -83,7 +83,11 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
 
     // Cortex-M vector table: initial SP, then the reset handler's address with the
     // Thumb bit set, inside the image.
-    assert_eq!(word(&bin, 0), STACK_TOP, "initial stack pointer = top of the stack below the statics");
+    assert_eq!(
+        word(&bin, 0),
+        STACK_TOP,
+        "initial stack pointer = top of the stack below the statics"
+    );
     let reset = word(&bin, 4);
     assert_eq!(reset & 1, 1, "reset vector {reset:#010x} is not a Thumb address");
     let flash_end = FLASH_START + u32::try_from(flash).unwrap();
@@ -121,7 +125,9 @@ fn stack_below_the_statics_and_the_fault_record_in_uninit() {
     assert_eq!(stack_top, STACK_TOP);
     let mut ram_sections = 0;
     for s in file.sections() {
-        let SectionFlags::Elf { sh_flags } = s.flags() else { unreachable!() };
+        let SectionFlags::Elf { sh_flags } = s.flags() else {
+            unreachable!()
+        };
         if sh_flags & u64::from(elf::SHF_ALLOC | elf::SHF_WRITE) == u64::from(elf::SHF_ALLOC | elf::SHF_WRITE)
             && s.size() > 0
         {
@@ -167,7 +173,10 @@ fn stack_below_the_statics_and_the_fault_record_in_uninit() {
         .position(|w| w == [0xF381, 0x8808])
         .expect("msr MSP, r1 in the HardFault entry");
     for &h in &halfwords[..msr] {
-        assert!(h >> 9 != 0b1011_010 && h != 0xE92D, "a push ({h:#06x}) before MSP is reset");
+        assert!(
+            h >> 9 != 0b1011_010 && h != 0xE92D,
+            "a push ({h:#06x}) before MSP is reset"
+        );
     }
 }
 

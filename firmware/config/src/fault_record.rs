@@ -111,9 +111,8 @@ const STATE_WRITTEN: u32 = 1 << 31;
 impl ControlState {
     /// The words the control interrupt writes.
     pub fn to_words(&self) -> [u32; STATE_WORDS] {
-        let flags = STATE_WRITTEN
-            | if self.running { STATE_RUNNING } else { 0 }
-            | if self.tripped { STATE_TRIPPED } else { 0 };
+        let flags =
+            STATE_WRITTEN | if self.running { STATE_RUNNING } else { 0 } | if self.tripped { STATE_TRIPPED } else { 0 };
         [
             self.i_d.to_bits(),
             self.i_q.to_bits(),
@@ -173,7 +172,14 @@ impl FaultRecord {
         let flags = if self.pc.is_some() { HAS_PC } else { 0 }
             | if self.state.is_some() { HAS_STATE } else { 0 }
             | if self.reported { REPORTED } else { 0 };
-        let head = [MAGIC, self.cause as u32, flags, self.pc.unwrap_or(0), self.cfsr, self.hfsr];
+        let head = [
+            MAGIC,
+            self.cause as u32,
+            flags,
+            self.pc.unwrap_or(0),
+            self.cfsr,
+            self.hfsr,
+        ];
         let state = self.state.map_or([0; STATE_WORDS], |s| s.to_words());
         for (slot, v) in w.iter_mut().zip(head.into_iter().chain(state)) {
             *slot = v;
@@ -256,7 +262,10 @@ pub fn classify_hard_fault(sp: u32, stack: (u32, u32), cfsr: u32) -> (FaultCause
     } else {
         FaultCause::HardFault
     };
-    (cause, (frame_inside && !overflow).then(|| sp.wrapping_add(FRAME_PC_OFFSET)))
+    (
+        cause,
+        (frame_inside && !overflow).then(|| sp.wrapping_add(FRAME_PC_OFFSET)),
+    )
 }
 
 /// CRC-32 (IEEE 802.3: reflected, polynomial 0x04C11DB7 → 0xEDB88320, initial value and
@@ -376,7 +385,10 @@ mod tests {
         assert_eq!(reseal(2, 1 << 5), None);
         // HAS_STATE with state words the interrupt never wrote.
         assert_eq!(reseal(6 + STATE_WORDS - 1, 0), None);
-        assert!(reseal(3, 0x0800_0000).is_some(), "the check itself accepts a resealed record");
+        assert!(
+            reseal(3, 0x0800_0000).is_some(),
+            "the check itself accepts a resealed record"
+        );
     }
 
     /// Power-up RAM: all zeros, all ones, and pseudo-random patterns (xorshift32,
@@ -437,7 +449,13 @@ mod tests {
             classify_hard_fault(0x1FFF_FFE0, stack, 0),
             (FaultCause::StackOverflow, None)
         );
-        assert_eq!(classify_hard_fault(0x2000_7FF0, stack, 0), (FaultCause::HardFault, None));
-        assert_eq!(classify_hard_fault(0xFFFF_FFF0, stack, 0), (FaultCause::HardFault, None));
+        assert_eq!(
+            classify_hard_fault(0x2000_7FF0, stack, 0),
+            (FaultCause::HardFault, None)
+        );
+        assert_eq!(
+            classify_hard_fault(0xFFFF_FFF0, stack, 0),
+            (FaultCause::HardFault, None)
+        );
     }
 }

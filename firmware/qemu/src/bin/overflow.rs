@@ -27,6 +27,7 @@ mod target {
     /// Recurses without end: each level keeps 256 bytes alive across the call, so the
     /// optimiser can neither drop the frame nor turn the recursion into a loop.
     #[inline(never)]
+    #[allow(unconditional_recursion)] // the point: it only ends in the HardFault
     fn deep(level: u32) -> u32 {
         let mut frame = [level; 64];
         core::hint::black_box(&mut frame);
