@@ -171,7 +171,7 @@ fn stack_below_the_statics_and_the_fault_record_in_uninit() {
         .expect("msr MSP, r1 in the HardFault entry");
     for &h in &halfwords[..msr] {
         assert!(
-            h >> 9 != 0b1011_010 && h != 0xE92D,
+            h >> 9 != 0b101_1010 && h != 0xE92D,
             "a push ({h:#06x}) before MSP is reset"
         );
     }
