@@ -12,6 +12,8 @@
 //! | [`cordic`] | CORDIC as the core's `Trig` |
 //! | [`fmac`] | FMAC start-up self-test of the generated FIR against the bit-exact model |
 //! | [`can`] | FDCAN1 setpoint reception |
+//! | [`can_tx`] | FDCAN1 transmission: status and capture frames |
+//! | [`commissioning`] | the commissioning mode between main loop and interrupt |
 //! | [`watchdog`] | IWDG |
 //! | [`control`] | the control interrupt |
 //! | [`fault`] | HardFault, unhandled interrupts, panics |
@@ -19,7 +21,9 @@
 
 pub mod adc;
 pub mod can;
+pub mod can_tx;
 pub mod clocks;
+pub mod commissioning;
 pub mod control;
 pub mod cordic;
 pub mod fault;
@@ -92,14 +96,21 @@ pub fn run() -> ! {
     unsafe { cortex_m::peripheral::NVIC::unmask(pac::Interrupt::ADC1_2) };
     watchdog::start(&dp.IWDG);
 
+    let mut tx = can_tx::CanTx::new();
     let mut last = TICKS.load(Ordering::Relaxed);
+    let mut last_status = last;
     loop {
-        if let Some(frame) = can.poll()
-            && let Some(torque) = can_frame::decode_torque(frame.standard_id, frame.bytes())
-        {
-            publish_setpoint(can_frame::torque_to_iq(torque, config::IQ_PER_NM));
+        if let Some(frame) = can.poll() {
+            match can_frame::decode_torque(frame.standard_id, frame.bytes()) {
+                Some(torque) => {
+                    commissioning::torque_received(torque);
+                    publish_setpoint(can_frame::torque_to_iq(torque, config::IQ_PER_NM));
+                }
+                None => commissioning::frame_received(frame.standard_id, frame.bytes()),
+            }
         }
         let now = TICKS.load(Ordering::Relaxed);
+        commissioning::transmit(&mut tx, now, &mut last_status);
         if now != last {
             watchdog::refresh(&dp.IWDG);
             last = now;
