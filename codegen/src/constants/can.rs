@@ -170,7 +170,13 @@ pub fn commissioning_group(d: &Design) -> Option<Group> {
             format!("τ = {}, {ts_in}", phys(tau, "s")),
         ),
         u32c("ALIGN_RAMP_SAMPLES", periods(0.05), "⌈50 ms/T_s⌉: voltage ramp to the alignment level", "thesis A §6.3", ts_in.clone()),
-        u32c("ALIGN_SETTLE_SAMPLES", periods(0.5), "⌈500 ms/T_s⌉: the rotor comes to rest on the α axis", "thesis A §6.3", ts_in.clone()),
+        u32c(
+            "ALIGN_SETTLE_SAMPLES",
+            periods((30.0 * tau).max(0.5)),
+            "⌈max(30·τ, 500 ms)/T_s⌉: the rotor comes to rest on the α axis (the rotor's motion and the currents form a mode as slow as τ = max(L_d, L_q)/R)",
+            "thesis A §6.3",
+            format!("τ = {}, {ts_in}", phys(tau, "s")),
+        ),
         u32c("ALIGN_AVERAGE_SAMPLES", periods(0.1), "⌈100 ms/T_s⌉: θ_r averaged", "thesis A (6.9)", ts_in.clone()),
         c(
             "ROTATION_STEP",
