@@ -27,7 +27,10 @@ fn design(stem: &str) -> codegen::Design {
 /// times factor plus offset.
 fn decode(sig: &Signal, data: &[u8]) -> f64 {
     assert_eq!(sig.byte_order, ByteOrder::LittleEndian, "{}", sig.name);
-    let word = data.iter().enumerate().fold(0u64, |w, (k, &b)| w | u64::from(b) << (8 * k));
+    let word = data
+        .iter()
+        .enumerate()
+        .fold(0u64, |w, (k, &b)| w | u64::from(b) << (8 * k));
     let raw = (word >> sig.start_bit) & ((1u64 << sig.size) - 1);
     let signed = sig.value_type == ValueType::Signed && (raw >> (sig.size - 1)) & 1 == 1;
     let v = if signed {
@@ -46,8 +49,15 @@ fn check(sigs: &[Signal], seen: &mut BTreeSet<String>, name: &str, data: &[u8], 
         .find(|s| s.name == name)
         .unwrap_or_else(|| panic!("signal {name} missing"));
     let got = decode(sig, data);
-    let tol = if sig.factor == 1.0 { 0.0 } else { 0.5 * sig.factor * (1.0 + 1e-6) };
-    assert!((got - want).abs() <= tol, "{name}: DBC decodes {got}, encoded {want} (±{tol})");
+    let tol = if sig.factor == 1.0 {
+        0.0
+    } else {
+        0.5 * sig.factor * (1.0 + 1e-6)
+    };
+    assert!(
+        (got - want).abs() <= tol,
+        "{name}: DBC decodes {got}, encoded {want} (±{tol})"
+    );
     seen.insert(name.to_string());
 }
 
@@ -68,7 +78,13 @@ fn all_names(sigs: &[Signal]) -> BTreeSet<String> {
 
 #[test]
 fn generated_dbc_matches_the_firmware_encoders() {
-    let stems = ["fischer-ti085", "unimotor-142umd300", "chalmers-hev50", "maxon-ec45-flat-70w", "emrax-228-hv"];
+    let stems = [
+        "fischer-ti085",
+        "unimotor-142umd300",
+        "chalmers-hev50",
+        "maxon-ec45-flat-70w",
+        "emrax-228-hv",
+    ];
     for stem in stems {
         let d = design(stem);
         let text = render(&d, Output::Dbc).unwrap();
@@ -83,7 +99,13 @@ fn generated_dbc_matches_the_firmware_encoders() {
         // `can_frame::decode_torque`): 0x0BB8 = 3000 LSB.
         let sigs = message(&dbc, "SETPOINT", board.setpoint_id, 2);
         let mut seen = BTreeSet::new();
-        check(sigs, &mut seen, "TORQUE", &[0xB8, 0x0B], 3000.0 * board.torque_resolution_nm);
+        check(
+            sigs,
+            &mut seen,
+            "TORQUE",
+            &[0xB8, 0x0B],
+            3000.0 * board.torque_resolution_nm,
+        );
         assert_eq!(seen, all_names(sigs), "{stem} SETPOINT");
 
         let sigs = message(&dbc, "STATUS", l.status_id, p::STATUS_LEN);

@@ -48,7 +48,11 @@ fn motor(stem: &str) -> Motor {
     let text = std::fs::read_to_string(repo().join(&rel)).unwrap();
     let board_text = std::fs::read_to_string(repo().join(BOARD)).unwrap();
     let design = codegen::design_with_board(&rel, &text, BOARD, &board_text).unwrap();
-    let setup_spec = codegen::spec::parse(Source { file: &rel, text: &text }).unwrap();
+    let setup_spec = codegen::spec::parse(Source {
+        file: &rel,
+        text: &text,
+    })
+    .unwrap();
     Motor {
         stem: stem.to_string(),
         design,
@@ -248,14 +252,26 @@ fn every_seed_motor_identifies_over_can() {
             ("ψ_M", got("flux_linkage_wb"), psi, 0.01),
         ];
         for (name, value, truth, tol) in checks {
-            eprintln!("{stem}: {name} = {value:.6e} (plant {truth:.6e}, {:+.3} %)", 100.0 * (value / truth - 1.0));
-            assert!((value / truth - 1.0).abs() < tol, "{stem}: {name} = {value}, plant {truth}");
+            eprintln!(
+                "{stem}: {name} = {value:.6e} (plant {truth:.6e}, {:+.3} %)",
+                100.0 * (value / truth - 1.0)
+            );
+            assert!(
+                (value / truth - 1.0).abs() < tol,
+                "{stem}: {name} = {value}, plant {truth}"
+            );
             assert_eq!(mj["provenance"][key(name)]["source"], "identified", "{stem} {name}");
         }
         // θ_off modulo 2π·n_r/n_p (6.9).
         let text = std::fs::read_to_string(&spec).unwrap();
         let line = text.lines().find(|l| l.starts_with("resolver_offset = ")).unwrap();
-        let value: f64 = line.split('"').nth(1).unwrap().trim_end_matches(" rad").parse().unwrap();
+        let value: f64 = line
+            .split('"')
+            .nth(1)
+            .unwrap()
+            .trim_end_matches(" rad")
+            .parse()
+            .unwrap();
         let period = TAU * f64::from(d.angle_observer.resolver_pole_pairs) / np;
         let diff = (value - OFFSET).rem_euclid(period);
         let err = diff.min(period - diff);
@@ -320,14 +336,27 @@ fn corrupted_logs_are_located_errors() {
     let spec_s = spec.display().to_string();
     let board = repo().join(BOARD).display().to_string();
     for (name, text, line, words) in [
-        ("dropped", dropped.join("\n") + "\n", k + 1, "sequence numbers 500 are missing"),
+        (
+            "dropped",
+            dropped.join("\n") + "\n",
+            k + 1,
+            "sequence numbers 500 are missing",
+        ),
         ("flipped", flipped.join("\n") + "\n", end + 1, "checksum mismatch"),
         ("truncated", truncated.join("\n") + "\n", data[700] + 1, "truncated"),
     ] {
         let f = write(&dir, &format!("{name}.log"), &text);
         let f_s = f.display().to_string();
         let out = motorgen(&[
-            "identify", "step", &spec_s, "--axis", "q", "--board", &board, "--candump", &f_s,
+            "identify",
+            "step",
+            &spec_s,
+            "--axis",
+            "q",
+            "--board",
+            &board,
+            "--candump",
+            &f_s,
         ]);
         let err = String::from_utf8_lossy(&out.stderr);
         assert!(!out.status.success(), "{name}: accepted");
@@ -338,7 +367,13 @@ fn corrupted_logs_are_located_errors() {
         // `capture` refuses it too and writes nothing.
         let out_dir = dir.join(format!("{name}-csv"));
         let o = motorgen(&[
-            "capture", &spec_s, "--board", &board, "--candump", &f_s, "--out",
+            "capture",
+            &spec_s,
+            "--board",
+            &board,
+            "--candump",
+            &f_s,
+            "--out",
             &out_dir.display().to_string(),
         ]);
         assert!(!o.status.success(), "{name}: capture accepted");
@@ -348,20 +383,38 @@ fn corrupted_logs_are_located_errors() {
     let f = write(&dir, "good.log", &good);
     let out_dir = dir.join("csv");
     let o = motorgen(&[
-        "capture", &spec_s, "--board", &board, "--candump", &f.display().to_string(), "--out",
+        "capture",
+        &spec_s,
+        "--board",
+        &board,
+        "--candump",
+        &f.display().to_string(),
+        "--out",
         &out_dir.display().to_string(),
     ]);
     assert!(o.status.success(), "{}", text_of(&o));
     let csv = out_dir.join("good-1-step.csv");
     let text = std::fs::read_to_string(&csv).unwrap();
-    assert!(text.starts_with("# motorgen recording: step\n# sample_period = 50 µs\n# axis = q\n"), "{text}");
+    assert!(
+        text.starts_with("# motorgen recording: step\n# sample_period = 50 µs\n# axis = q\n"),
+        "{text}"
+    );
     // A wrong routine: a step log given to `identify flux`, located at the header frame.
     let out = motorgen(&[
-        "identify", "flux", &spec_s, "--board", &board, "--candump", &f.display().to_string(),
+        "identify",
+        "flux",
+        &spec_s,
+        "--board",
+        &board,
+        "--candump",
+        &f.display().to_string(),
     ]);
     let err = String::from_utf8_lossy(&out.stderr);
     let header = lines.iter().position(|x| is(x, l.header_id)).unwrap() + 1;
     assert!(!out.status.success());
-    assert!(err.contains(&format!(":{header}:")) && err.contains("`step` capture"), "{err}");
+    assert!(
+        err.contains(&format!(":{header}:")) && err.contains("`step` capture"),
+        "{err}"
+    );
     assert_eq!(std::fs::read_to_string(&spec).unwrap(), original);
 }

@@ -34,16 +34,14 @@ pub fn group(d: &Design) -> Option<Group> {
         (5, "CAPTURE_END_ID", "capture end with the CRC-32 (drive → bus)"),
     ] {
         let id = base + k;
-        v.push(
-            c(
-                name,
-                intv(i64::from(id), "u16", "uint16_t"),
-                format!("{id:#05x}"),
-                &format!("setpoint_id + {k}: standard identifier of the {what}"),
-                proto,
-                format!("can.setpoint_id = {base:#05x} ({file})"),
-            ),
-        );
+        v.push(c(
+            name,
+            intv(i64::from(id), "u16", "uint16_t"),
+            format!("{id:#05x}"),
+            &format!("setpoint_id + {k}: standard identifier of the {what}"),
+            proto,
+            format!("can.setpoint_id = {base:#05x} ({file})"),
+        ));
     }
     for (name, len, what) in [
         ("SETPOINT_LEN", SETPOINT_LEN, "setpoint: bytes 0–1 torque (i16)"),
@@ -81,16 +79,14 @@ pub fn group(d: &Design) -> Option<Group> {
         ("SPEED_PER_LSB", &s.speed, "rad/s", "electrical speed"),
     ] {
         let x = sc.full_scale / 32768.0;
-        v.push(
-            c(
-                name,
-                f32v(x),
-                phys(x, unit),
-                &format!("A/2^15: a 16-bit signal is the {what} in Q1.15 of its full scale"),
-                "thesis A (4.16), Table 4.1",
-                format!("A = {} (scaling)", phys(sc.full_scale, unit)),
-            ),
-        );
+        v.push(c(
+            name,
+            f32v(x),
+            phys(x, unit),
+            &format!("A/2^15: a 16-bit signal is the {what} in Q1.15 of its full scale"),
+            "thesis A (4.16), Table 4.1",
+            format!("A = {} (scaling)", phys(sc.full_scale, unit)),
+        ));
     }
     v.push(c(
         "ANGLE_PER_LSB",
@@ -103,16 +99,14 @@ pub fn group(d: &Design) -> Option<Group> {
     let units = (d.drive.sample_period_s * p::SAMPLE_PERIOD_UNITS_PER_S)
         .round()
         .clamp(1.0, f64::from(u16::MAX));
-    v.push(
-        c(
-            "SAMPLE_PERIOD_UNITS",
-            intv(units as i64, "u16", "uint16_t"),
-            format!("{} (T_s = {})", units, phys(d.drive.sample_period_s, "s")),
-            "T_s/100 ns, rounded: the capture header's sample period",
-            "thesis A §6.2",
-            "drive.switching_frequency (spec)".into(),
-        ),
-    );
+    v.push(c(
+        "SAMPLE_PERIOD_UNITS",
+        intv(units as i64, "u16", "uint16_t"),
+        format!("{} (T_s = {})", units, phys(d.drive.sample_period_s, "s")),
+        "T_s/100 ns, rounded: the capture header's sample period",
+        "thesis A §6.2",
+        "drive.switching_frequency (spec)".into(),
+    ));
     v.push(
         c(
             "STATUS_PERIOD_S",
@@ -146,7 +140,14 @@ pub fn commissioning_group(d: &Design) -> Option<Group> {
     let tau = m.d_inductance_h.max(m.q_inductance_h) / m.phase_resistance_ohm;
     let ts_in = format!("T_s = {} (drive.switching_frequency)", phys(ts, "s"));
     let u32c = |name: &str, x: f64, formula: &str, eq: &str, inputs: String| {
-        c(name, intv(x as i64, "u32", "uint32_t"), format!("{x} periods ({})", phys(x * ts, "s")), formula, eq, inputs)
+        c(
+            name,
+            intv(x as i64, "u32", "uint32_t"),
+            format!("{x} periods ({})", phys(x * ts, "s")),
+            formula,
+            eq,
+            inputs,
+        )
     };
     let np = d.angle_observer.motor_pole_pairs;
     let nr = d.angle_observer.resolver_pole_pairs;
@@ -161,7 +162,13 @@ pub fn commissioning_group(d: &Design) -> Option<Group> {
             "DS12288 §3.5",
             "the firmware's RAM budget".into(),
         ),
-        u32c("STEP_PRE_SAMPLES", 40.0, "periods at 0 V before the step (baseline)", "thesis A §6.2", "—".into()),
+        u32c(
+            "STEP_PRE_SAMPLES",
+            40.0,
+            "periods at 0 V before the step (baseline)",
+            "thesis A §6.2",
+            "—".into(),
+        ),
         u32c(
             "STEP_SAMPLES",
             periods(12.0 * tau).max(3000.0),
@@ -169,7 +176,13 @@ pub fn commissioning_group(d: &Design) -> Option<Group> {
             "thesis A (6.4), (6.7)",
             format!("τ = {}, {ts_in}", phys(tau, "s")),
         ),
-        u32c("ALIGN_RAMP_SAMPLES", periods(0.05), "⌈50 ms/T_s⌉: voltage ramp to the alignment level", "thesis A §6.3", ts_in.clone()),
+        u32c(
+            "ALIGN_RAMP_SAMPLES",
+            periods(0.05),
+            "⌈50 ms/T_s⌉: voltage ramp to the alignment level",
+            "thesis A §6.3",
+            ts_in.clone(),
+        ),
         u32c(
             "ALIGN_SETTLE_SAMPLES",
             periods((30.0 * tau).max(0.5)),
@@ -177,7 +190,13 @@ pub fn commissioning_group(d: &Design) -> Option<Group> {
             "thesis A §6.3",
             format!("τ = {}, {ts_in}", phys(tau, "s")),
         ),
-        u32c("ALIGN_AVERAGE_SAMPLES", periods(0.1), "⌈100 ms/T_s⌉: θ_r averaged", "thesis A (6.9)", ts_in.clone()),
+        u32c(
+            "ALIGN_AVERAGE_SAMPLES",
+            periods(0.1),
+            "⌈100 ms/T_s⌉: θ_r averaged",
+            "thesis A (6.9)",
+            ts_in.clone(),
+        ),
         c(
             "ROTATION_STEP",
             intv(rotation_step as i64, "i32", "int32_t"),
@@ -194,9 +213,27 @@ pub fn commissioning_group(d: &Design) -> Option<Group> {
             "thesis A (6.2)",
             format!("n_p = {np}, n_r = {nr}"),
         ),
-        u32c("ROTATION_SETTLE_SAMPLES", periods(0.5), "⌈500 ms/T_s⌉ held at the start and the end angle", "thesis A §6.4", ts_in.clone()),
-        u32c("FLUX_SETTLE_SAMPLES", periods(0.2), "⌈200 ms/T_s⌉: the current loop settles at i = 0", "thesis A §6.5", ts_in.clone()),
-        u32c("FLUX_AVERAGE_SAMPLES", periods(0.1), "⌈100 ms/T_s⌉ averaged (and captured)", "thesis A (6.10)", ts_in),
+        u32c(
+            "ROTATION_SETTLE_SAMPLES",
+            periods(0.5),
+            "⌈500 ms/T_s⌉ held at the start and the end angle",
+            "thesis A §6.4",
+            ts_in.clone(),
+        ),
+        u32c(
+            "FLUX_SETTLE_SAMPLES",
+            periods(0.2),
+            "⌈200 ms/T_s⌉: the current loop settles at i = 0",
+            "thesis A §6.5",
+            ts_in.clone(),
+        ),
+        u32c(
+            "FLUX_AVERAGE_SAMPLES",
+            periods(0.1),
+            "⌈100 ms/T_s⌉ averaged (and captured)",
+            "thesis A (6.10)",
+            ts_in,
+        ),
         c(
             "FLUX_MIN_SPEED",
             f32v(0.05 * m.max_electrical_speed_rad_s),

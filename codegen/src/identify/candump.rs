@@ -131,7 +131,11 @@ fn parse_line(line: &str) -> Result<Option<(u32, bool, Vec<u8>)>, String> {
     let extended = match id.len() {
         3 => false,
         8 => true,
-        _ => return Err(format!("identifier `{id}` is neither 3 (standard) nor 8 (extended) hex digits")),
+        _ => {
+            return Err(format!(
+                "identifier `{id}` is neither 3 (standard) nor 8 (extended) hex digits"
+            ));
+        }
     };
     let id = u32::from_str_radix(id, 16).map_err(|_| format!("identifier `{id}` is not hexadecimal"))?;
     if data.len() % 2 != 0 || data.len() > 16 {
@@ -193,7 +197,8 @@ pub fn captures(file: &str, text: &str, frames: &[LoggedFrame], layout: &Layout)
     let err = |at: usize, key: &str, problem: String, accepted: &str| -> Diagnostics {
         src.error(at..at, key, problem, accepted).into()
     };
-    let sequence_accepted = "a header frame, then data frames with sequence numbers 0, 1, … count − 1 in order, then the end frame";
+    let sequence_accepted =
+        "a header frame, then data frames with sequence numbers 0, 1, … count − 1 in order, then the end frame";
     let mut out = Vec::new();
     // The capture being received and the CRC over its bytes.
     let mut open: Option<(Capture, Crc32)> = None;
@@ -212,10 +217,7 @@ pub fn captures(file: &str, text: &str, frames: &[LoggedFrame], layout: &Layout)
                         "a capture header with {} bytes or an unknown routine code",
                         f.data.len()
                     ),
-                    &format!(
-                        "{} with routine 1–4 in bits 0–3 of byte 0",
-                        name(p::HEADER_LEN)
-                    ),
+                    &format!("{} with routine 1–4 in bits 0–3 of byte 0", name(p::HEADER_LEN)),
                 )
             })?;
             if let Some((c, _)) = &open {
@@ -298,10 +300,7 @@ pub fn captures(file: &str, text: &str, frames: &[LoggedFrame], layout: &Layout)
                 return Err(err(
                     f.offset,
                     "SEQUENCE",
-                    format!(
-                        "data frame {seq} is beyond the header's count of {}",
-                        c.header.count
-                    ),
+                    format!("data frame {seq} is beyond the header's count of {}", c.header.count),
                     sequence_accepted,
                 ));
             }
@@ -452,7 +451,11 @@ impl Capture {
                     src.error(
                         at..at,
                         d.key,
-                        format!("{} (in the capture at line {})", d.problem, line_of(log, self.header_offset)),
+                        format!(
+                            "{} (in the capture at line {})",
+                            d.problem,
+                            line_of(log, self.header_offset)
+                        ),
                         d.accepted,
                     )
                 })
@@ -473,7 +476,13 @@ pub fn encode_capture(layout: &Layout, header: &Header, rows: &[(f32, f32)], end
         crc.update(f.bytes());
         out.push(f);
     }
-    out.push(p::encode_end(layout, &End { crc: crc.value(), ..*end }));
+    out.push(p::encode_end(
+        layout,
+        &End {
+            crc: crc.value(),
+            ..*end
+        },
+    ));
     out
 }
 
@@ -540,7 +549,10 @@ mod tests {
         assert!((rec.sample_period_s - 50e-6).abs() < 1e-15);
         assert_eq!(rec.samples, [0.0, 1.0, 2.0]);
         for (row, want) in rec.values.iter().zip([[600.0, 60.0], [601.0, 60.1], [602.0, 60.2]]) {
-            assert!((row[0] - want[0]).abs() <= 0.5 && (row[1] - want[1]).abs() <= 0.005, "{row:?}");
+            assert!(
+                (row[0] - want[0]).abs() <= 0.5 && (row[1] - want[1]).abs() <= 0.005,
+                "{row:?}"
+            );
         }
     }
 

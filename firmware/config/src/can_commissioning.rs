@@ -84,7 +84,13 @@ mod tests {
     /// The drive's frames follow the setpoint identifier (status +1 … capture end +5).
     #[test]
     fn identifiers_follow_the_setpoint() {
-        let ids = [LAYOUT.status_id, LAYOUT.command_id, LAYOUT.header_id, LAYOUT.data_id, LAYOUT.end_id];
+        let ids = [
+            LAYOUT.status_id,
+            LAYOUT.command_id,
+            LAYOUT.header_id,
+            LAYOUT.data_id,
+            LAYOUT.end_id,
+        ];
         for (k, id) in (1u16..).zip(ids) {
             assert_eq!(id, board::SETPOINT_ID + k);
         }

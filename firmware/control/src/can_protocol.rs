@@ -480,7 +480,10 @@ mod tests {
         };
         let f = encode_end(&l, &e);
         assert_eq!(f.bytes(), &[0x26, 0x39, 0xF4, 0xCB, 0x2C, 0x03, 0xFC, 0x03]);
-        assert_eq!(encode_status(&l, State::Idle, Reason::TorqueNotZero, 1, 0).bytes(), &[0, 2, 1, 0]);
+        assert_eq!(
+            encode_status(&l, State::Idle, Reason::TorqueNotZero, 1, 0).bytes(),
+            &[0, 2, 1, 0]
+        );
     }
 
     /// Saturation and wrap: currents beyond ±327.67 A saturate, NaN is 0; an angle of

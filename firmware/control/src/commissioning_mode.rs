@@ -224,10 +224,12 @@ impl CommissioningMode {
         if guards.any() {
             return Reason::FaultActive;
         }
-        if !(libm::fabsf(guards.torque_setpoint) <= cfg.zero_torque) {
+        // NaN counts as not zero / not at standstill.
+        let within = |x: f32, limit: f32| libm::fabsf(x) <= limit;
+        if !within(guards.torque_setpoint, cfg.zero_torque) {
             return Reason::TorqueNotZero;
         }
-        if routine != Routine::Flux && !(libm::fabsf(omega_e) <= cfg.standstill_speed) {
+        if routine != Routine::Flux && !within(omega_e, cfg.standstill_speed) {
             return Reason::NotAtStandstill;
         }
         let decimation = match u8::try_from(c.decimation) {
@@ -376,7 +378,8 @@ impl CommissioningMode {
                     0
                 };
                 if n >= from
-                    && n.saturating_sub(from).is_multiple_of(u32::from(self.header.decimation.max(1)))
+                    && n.saturating_sub(from)
+                        .is_multiple_of(u32::from(self.header.decimation.max(1)))
                     && let Some(slot) = buffer.get_mut(self.len)
                     && self.len < usize::from(u16::MAX)
                 {
@@ -533,7 +536,10 @@ mod tests {
         assert_eq!(m.command(&c, &bad, &g, 0.0, 8), Reason::BadCommand);
         assert_eq!(m.state(), (State::Idle, Reason::BadCommand));
         assert_eq!(m.status(&c, 0).bytes(), &[0, 4, 0, 0]);
-        assert_eq!(m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf), Control::Normal);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Normal
+        );
         // Flux is accepted at speed.
         let flux = Command {
             routine: Some(Routine::Flux),
@@ -556,7 +562,10 @@ mod tests {
         let mut volts = vec![];
         for k in 0..7 {
             let meas = Measured {
-                i_dq: Dq { d: 0.0, q: 0.5 * k as f32 },
+                i_dq: Dq {
+                    d: 0.0,
+                    q: 0.5 * k as f32,
+                },
                 ..Measured::default()
             };
             match m.step(&c, &g, &meas, &mut SoftTrig, &mut buf) {
@@ -601,17 +610,26 @@ mod tests {
             setpoint_timeout: true,
             ..g
         };
-        assert_eq!(m.step(&c, &t, &Measured::default(), &mut SoftTrig, &mut buf), Control::Off);
+        assert_eq!(
+            m.step(&c, &t, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Off
+        );
         assert_eq!(m.state(), (State::Fault, Reason::Aborted));
         assert_eq!(m.next_frame(&c, &buf), None);
-        assert_eq!(m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf), Control::Off);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Off
+        );
         let abort = Command {
             routine: None,
             ..step_cmd()
         };
         assert_eq!(m.command(&c, &abort, &t, 0.0, 8), Reason::FaultActive);
         assert_eq!(m.command(&c, &abort, &g, 0.0, 8), Reason::None);
-        assert_eq!(m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf), Control::Normal);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Normal
+        );
     }
 
     /// A trip: the header says tripped, the end frame carries the sample and current.
@@ -627,7 +645,10 @@ mod tests {
             &c,
             &g,
             &Measured {
-                i_dq: Dq { d: 0.0, q: 6.0 * k as f32 },
+                i_dq: Dq {
+                    d: 0.0,
+                    q: 6.0 * k as f32,
+                },
                 ..Measured::default()
             },
             &mut SoftTrig,

@@ -140,7 +140,10 @@ pub fn layout(spec: &Path, board: &Path) -> Result<Layout, Failure> {
 /// Every capture in `logs`, checked and turned into its CSV text: (log file, log text,
 /// capture, CSV). The reading of frames from a live socket shares everything after the
 /// frames ([`captures_from_frames`]).
-pub fn read_logs(logs: &[PathBuf], layout: &Layout) -> Result<Vec<(String, std::rc::Rc<String>, candump::Capture, String)>, Failure> {
+pub fn read_logs(
+    logs: &[PathBuf],
+    layout: &Layout,
+) -> Result<Vec<(String, std::rc::Rc<String>, candump::Capture, String)>, Failure> {
     let mut out = Vec::new();
     let mut errors = Vec::new();
     for f in logs {
@@ -150,7 +153,12 @@ pub fn read_logs(logs: &[PathBuf], layout: &Layout) -> Result<Vec<(String, std::
             Err(e) => {
                 return Err(Failure::new(
                     Exit::Io,
-                    plain_error(&name, format!("cannot read the log: {e}"), "a readable `candump -l` log").to_string(),
+                    plain_error(
+                        &name,
+                        format!("cannot read the log: {e}"),
+                        "a readable `candump -l` log",
+                    )
+                    .to_string(),
                 ));
             }
         };
@@ -202,7 +210,12 @@ fn can_recordings(
         return Ok(Vec::new());
     }
     let Some(board) = &common.board else {
-        return Err(plain_error("--candump", "no --board given".into(), "--board BOARD_FILE with --candump").into());
+        return Err(plain_error(
+            "--candump",
+            "no --board given".into(),
+            "--board BOARD_FILE with --candump",
+        )
+        .into());
     };
     let layout = layout(spec, board)?;
     let mut out = Vec::new();
@@ -223,7 +236,11 @@ fn can_recordings(
                             line: 1,
                             column: 1,
                             key: "ROUTINE".into(),
-                            problem: format!("this is a `{}` capture; this identification reads {}", kind.name(), names.join(" and ")),
+                            problem: format!(
+                                "this is a `{}` capture; this identification reads {}",
+                                kind.name(),
+                                names.join(" and ")
+                            ),
                             accepted: format!("captures of the routine {}", names.join(" or ")),
                             excerpt: String::new(),
                         }
@@ -258,8 +275,10 @@ fn all_recordings(
     kind: RecordingKind,
     ts: f64,
 ) -> Result<Vec<(Recording, RecordingOrigin)>, Failure> {
-    let mut out: Vec<(Recording, RecordingOrigin)> =
-        recordings(csv, kind, ts)?.into_iter().map(|r| (r, RecordingOrigin::csv())).collect();
+    let mut out: Vec<(Recording, RecordingOrigin)> = recordings(csv, kind, ts)?
+        .into_iter()
+        .map(|r| (r, RecordingOrigin::csv()))
+        .collect();
     out.extend(can_recordings(common, spec, &[kind])?);
     Ok(out)
 }
@@ -510,7 +529,9 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
     let design = &loaded.design;
     let ts = sample_period(common, design)?;
     let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) =
-        all_recordings(csv, common, spec, RecordingKind::Step, ts)?.into_iter().unzip();
+        all_recordings(csv, common, spec, RecordingKind::Step, ts)?
+            .into_iter()
+            .unzip();
     let (axis, name) = match axis {
         AxisArg::D => (Axis::D, "d"),
         AxisArg::Q => (Axis::Q, "q"),
@@ -611,7 +632,9 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
     let design = &loaded.design;
     let ts = sample_period(common, design)?;
     let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) =
-        all_recordings(csv, common, spec, RecordingKind::Flux, ts)?.into_iter().unzip();
+        all_recordings(csv, common, spec, RecordingKind::Flux, ts)?
+            .into_iter()
+            .unzip();
     let setup = flux::FluxSetup {
         resistance_ohm: design.motor.phase_resistance_ohm,
         d_inductance_h: design.motor.d_inductance_h,
@@ -682,8 +705,9 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         spec,
         &[RecordingKind::PolePairRatio, RecordingKind::ResolverOffset],
     )?;
-    let (can_ratio, can_offset): (Vec<_>, Vec<_>) =
-        can.into_iter().partition(|(r, _)| r.kind == RecordingKind::PolePairRatio);
+    let (can_ratio, can_offset): (Vec<_>, Vec<_>) = can
+        .into_iter()
+        .partition(|(r, _)| r.kind == RecordingKind::PolePairRatio);
     let mut ratio_recs: Vec<(Recording, RecordingOrigin)> = recordings(ratio, RecordingKind::PolePairRatio, ts)?
         .into_iter()
         .map(|r| (r, RecordingOrigin::csv()))

@@ -1,5 +1,5 @@
 //! FDCAN1 transmission through its TX FIFO: the status frame and the commissioning
-//! capture ([`crate::can_commissioning`]). Reception stays in [`super::can`]; this
+//! capture (`motor_config::can_commissioning`). Reception stays in [`super::can`]; this
 //! module touches only the TX side (TXFQS, TXBAR and the TX buffer elements of the
 //! message RAM), which [`super::can::Can`] never uses.
 //!
@@ -9,8 +9,8 @@
 
 use stm32g4::stm32g474 as pac;
 
-use crate::can_commissioning::tx_element;
 use crate::hw;
+use motor_config::can_commissioning::tx_element;
 use motor_control::can_protocol::Frame;
 
 /// Offset of the TX buffers in the FDCAN1 message RAM \[bytes\] (RM0440 §44.3.3).

@@ -15,7 +15,7 @@ use motor_control::commissioning_mode::{Control, Guards, Measured, Sample};
 use motor_control::{Demand, Trig};
 
 use super::can_tx::CanTx;
-use crate::can_commissioning::{CAPACITY, LAYOUT, MODE, Mode, STATUS_PERIODS};
+use motor_config::can_commissioning::{CAPACITY, LAYOUT, MODE, Mode, STATUS_PERIODS};
 
 /// The supervisor.
 static SUPERVISOR: Mutex<RefCell<Mode>> = Mutex::new(RefCell::new(Mode::new()));
@@ -92,7 +92,10 @@ pub fn control_step<T: Trig>(
     FAULT.store(guards.fault, Ordering::Relaxed);
     TIMED_OUT.store(guards.setpoint_timeout, Ordering::Relaxed);
     let control = interrupt::free(|cs| {
-        match (SUPERVISOR.borrow(cs).try_borrow_mut(), BUFFER.borrow(cs).try_borrow_mut()) {
+        match (
+            SUPERVISOR.borrow(cs).try_borrow_mut(),
+            BUFFER.borrow(cs).try_borrow_mut(),
+        ) {
             (Ok(mut m), Ok(mut buffer)) => m.step(&MODE, guards, measured, trig, &mut buffer[..]),
             // Never happens (every borrow is inside a critical section); outputs off.
             _ => Control::Off,

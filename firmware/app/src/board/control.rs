@@ -130,7 +130,8 @@ impl Control {
             break_active: false,
             setpoint_timeout: self.setpoint.timed_out(&SETPOINT),
         };
-        let (demand, run) = commissioning::control_step(&mut self.cordic, &self.measured, &guards, self.omega_e, normal, run);
+        let (demand, run) =
+            commissioning::control_step(&mut self.cordic, &self.measured, &guards, self.omega_e, normal, run);
         let out = CONTROLLER.process(&mut self.state, &mut self.cordic, &sample, demand);
         self.measured = Measured {
             i_dq: out.i_dq,
