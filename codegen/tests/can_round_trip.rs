@@ -93,7 +93,7 @@ fn run(m: &Motor, bench: &mut Bench, cmd: Command, omega_e: f32) -> String {
     let mut n = 0u64;
     loop {
         let t = 1.7e9 + n as f64 * ts;
-        if n % (0.01 / ts).round() as u64 == 0 {
+        if n.is_multiple_of((0.01 / ts).round() as u64) {
             log.push_str(&candump_line(t, "can0", &setpoint));
             log.push('\n');
         }
