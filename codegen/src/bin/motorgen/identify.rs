@@ -118,6 +118,9 @@ impl RecordingOrigin {
     }
 }
 
+/// A checked capture from a log: (log file, log text, capture, its CSV recording).
+pub type LoggedCapture = (String, std::rc::Rc<String>, candump::Capture, String);
+
 /// The CAN interface of the spec on `--board`.
 pub fn layout(spec: &Path, board: &Path) -> Result<Layout, Failure> {
     let text = crate::read_spec(spec)?;
@@ -140,10 +143,7 @@ pub fn layout(spec: &Path, board: &Path) -> Result<Layout, Failure> {
 /// Every capture in `logs`, checked and turned into its CSV text: (log file, log text,
 /// capture, CSV). The reading of frames from a live socket shares everything after the
 /// frames ([`captures_from_frames`]).
-pub fn read_logs(
-    logs: &[PathBuf],
-    layout: &Layout,
-) -> Result<Vec<(String, std::rc::Rc<String>, candump::Capture, String)>, Failure> {
+pub fn read_logs(logs: &[PathBuf], layout: &Layout) -> Result<Vec<LoggedCapture>, Failure> {
     let mut out = Vec::new();
     let mut errors = Vec::new();
     for f in logs {
@@ -187,7 +187,7 @@ pub fn captures_from_frames(
     text: String,
     frames: &[candump::LoggedFrame],
     layout: &Layout,
-) -> Result<Vec<(String, std::rc::Rc<String>, candump::Capture, String)>, Diagnostics> {
+) -> Result<Vec<LoggedCapture>, Diagnostics> {
     let caps = candump::captures(name, &text, frames, layout)?;
     let text = std::rc::Rc::new(text);
     Ok(caps
