@@ -6,6 +6,7 @@
 //! with unit, its formula, the source equation and the provenance of its inputs.
 
 mod board;
+pub mod can;
 mod field_weakening;
 mod sensorless;
 
@@ -711,6 +712,8 @@ pub fn constants(d: &Design) -> Vec<Group> {
     ]
     .into_iter()
     .chain(board::group(d))
+    .chain(can::group(d))
+    .chain(can::commissioning_group(d))
     .collect()
 }
 

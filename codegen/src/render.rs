@@ -22,6 +22,9 @@ pub enum Output {
     C,
     /// Markdown summary.
     Markdown,
+    /// DBC description of the CAN interface (only for a design on a board, whose
+    /// `can` constants group it renders; not in [`Output::ALL`]).
+    Dbc,
 }
 
 impl Output {
@@ -34,6 +37,7 @@ impl Output {
             Output::Rust => "motor.rs.j2",
             Output::C => "motor.h.j2",
             Output::Markdown => "motor.md.j2",
+            Output::Dbc => "motor.dbc.j2",
         }
     }
 
@@ -43,6 +47,7 @@ impl Output {
             Output::Rust => format!("{}.rs", stem.replace('-', "_")),
             Output::C => format!("{}.h", stem.replace('-', "_")),
             Output::Markdown => format!("{stem}.md"),
+            Output::Dbc => format!("{stem}.dbc"),
         }
     }
 
@@ -52,6 +57,7 @@ impl Output {
             Output::Rust => include_str!("../../templates/motor.rs.j2"),
             Output::C => include_str!("../../templates/motor.h.j2"),
             Output::Markdown => include_str!("../../templates/motor.md.j2"),
+            Output::Dbc => include_str!("../../templates/motor.dbc.j2"),
         }
     }
 }
@@ -165,6 +171,19 @@ pub fn c_prefix(spec_file: &str) -> String {
     }
 }
 
+/// `s` as the text of a DBC string literal: printable ASCII only (DBC files are read
+/// as single-byte text), `"` and `\\` replaced by `'` and `/`, anything else by `?`.
+pub fn dbc_string(s: &str) -> String {
+    s.chars()
+        .map(|c| match c {
+            '"' => '\'',
+            '\\' => '/',
+            ' '..='~' => c,
+            _ => '?',
+        })
+        .collect()
+}
+
 /// Renders `source` (named `name` for messages) for the design `d`.
 pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, RenderError> {
     let mut env = Environment::new();
@@ -180,6 +199,7 @@ pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, Rende
         Value::from_safe_string(rust_const(&k, indent))
     });
     env.add_filter("md_code", |s: String| Value::from_safe_string(markdown_code(&s)));
+    env.add_filter("dbc_string", |s: String| Value::from_safe_string(dbc_string(&s)));
     let target = Target::of_template(name);
     env.set_formatter(move |out, _state, value| {
         let text = value.to_string();
@@ -193,6 +213,7 @@ pub fn render_with(d: &Design, name: &str, source: &str) -> Result<String, Rende
         spec_file => d.spec_file.clone(),
         name => d.name.clone(),
         c_prefix => c_prefix(&d.spec_file),
+        can => Value::from(Serde(crate::constants::can::dbc_values(&groups))),
         groups => Value::from(Serde(&groups)),
         design => Value::from(Serde(d)),
     })

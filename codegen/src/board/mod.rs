@@ -521,8 +521,9 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
         "can.setpoint_id",
         &c.setpoint_id,
         0,
-        0x7FF,
-        "a standard (11-bit) identifier 0 … 0x7FF, e.g. 0x100",
+        // The drive's own frames take the identifiers after it (constants group `can`).
+        0x7FF - i64::from(crate::constants::can::FRAMES_AFTER_SETPOINT),
+        "a standard (11-bit) identifier 0 … 0x7FA (the drive's status, command and capture frames take the 5 after it), e.g. 0x100",
     );
     let period = q(cx, &mut spans, "can.setpoint_period", &c.setpoint_period, Kind::Time);
     let timeout = q(cx, &mut spans, "can.setpoint_timeout", &c.setpoint_timeout, Kind::Time);

@@ -8,11 +8,14 @@
 //! * [`flux`]: ψ_M from u_q ≈ ω_e·ψ_M at zero current (6.10).
 //! * [`resolver`]: resolver offset θ_off = θ_r after alignment (6.9) and the pole-pair
 //!   ratio n_p/n_r with the direction check (§6.4).
+//! * [`candump`]: captures sent over CAN (`candump -l` logs or a live socket),
+//!   reassembled, checked and turned into recordings.
 //! * [`writeback`]: the new values into the spec text with `toml_edit` (comments and
 //!   layout kept).
 //!
 //! Nothing here does file I/O; `motorgen identify` reads the files and writes the spec.
 
+pub mod candump;
 pub mod flux;
 pub mod recording;
 pub mod resolver;

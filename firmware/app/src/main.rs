@@ -8,7 +8,9 @@
 #[cfg(target_os = "none")]
 mod board;
 #[cfg(target_os = "none")]
-use motor_config::{adc_frame, bringup, can_frame, config, fault_frame, fault_record, hw, motor, registers};
+use motor_config::{
+    adc_frame, bringup, can_commissioning, can_frame, config, fault_frame, fault_record, hw, motor, registers,
+};
 
 #[cfg(target_os = "none")]
 mod target {

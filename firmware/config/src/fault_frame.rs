@@ -15,13 +15,18 @@
 
 use crate::fault_record::{FaultCause, FaultRecord};
 use crate::hw;
-use crate::motor::board;
+use crate::motor::{board, can};
 
-// The report must not be taken for a setpoint by the vehicle unit, nor the reverse.
-const _: () = assert!(
-    hw::FAULT_REPORT_ID != board::SETPOINT_ID,
-    "the board's setpoint identifier collides with the fault report's (hw::FAULT_REPORT_ID)"
-);
+// The report must not be taken for a setpoint or another drive frame by the vehicle
+// unit, nor the reverse: its identifier lies outside the board's setpoint identifier and
+// the generated `can` group's status … capture-end identifiers.
+const _: () = {
+    let id = hw::FAULT_REPORT_ID;
+    assert!(
+        id != board::SETPOINT_ID && (id < can::STATUS_ID || id > can::CAPTURE_END_ID),
+        "the fault report's identifier (hw::FAULT_REPORT_ID) collides with a drive frame's"
+    );
+};
 
 /// The eight data bytes of the report of `r`.
 pub fn encode(r: &FaultRecord) -> [u8; 8] {
@@ -41,21 +46,6 @@ pub fn encode(r: &FaultRecord) -> [u8; 8] {
     });
     let [q0, q1] = iq.to_le_bytes();
     [r.cause as u8, flags, p0, p1, p2, p3, q0, q1]
-}
-
-/// The first four words of an FDCAN Tx buffer element for a classic data frame with a
-/// standard identifier and eight bytes (RM0440 §44.3.3, "Tx buffer element"): T0 holds
-/// the identifier in bits 28:18 (XTD = RTR = ESI = 0), T1 the DLC in bits 19:16
-/// (FDF = BRS = 0: classic CAN; EFC = 0: no Tx event), T2–T3 the data bytes
-/// little-endian.
-pub fn tx_element(standard_id: u16, data: &[u8; 8]) -> [u32; 4] {
-    let [a, b, c, d, e, f, g, h] = *data;
-    [
-        (u32::from(standard_id) & 0x7FF) << 18,
-        8 << 16,
-        u32::from_le_bytes([a, b, c, d]),
-        u32::from_le_bytes([e, f, g, h]),
-    ]
 }
 
 /// The cause byte of a report, decoded (for a receiver written in Rust).
@@ -124,7 +114,11 @@ mod tests {
     #[test]
     fn tx_element_layout() {
         let data = [1, 2, 3, 4, 5, 6, 7, 8];
-        let w = tx_element(0x0E0, &data);
+        let w = crate::can_commissioning::tx_element(&motor_control::can_protocol::Frame {
+            id: 0x0E0,
+            len: 8,
+            data,
+        });
         assert_eq!(w, [0x0380_0000, 0x0008_0000, 0x0403_0201, 0x0807_0605]);
         let back = crate::can_frame::RxFrame::from_words(w);
         assert_eq!(back.standard_id, Some(0x0E0));

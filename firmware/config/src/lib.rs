@@ -8,8 +8,10 @@
 //! [`bringup`] (ADC enable, break arming, output enable — sequences whose order matters),
 //! [`timing`] (register encodings from times and frequencies),
 //! [`adc_frame`] (ADC codes → the core's sample, resolver demodulation),
-//! [`can_frame`] (the setpoint frame), [`fault_record`] (the fault record kept across a
-//! reset: encoding, CRC, validation at boot), [`fault_frame`] (its CAN report). The board layer (`motor-firmware`, `../app`) owns
+//! [`can_frame`] (the setpoint frame), [`can_commissioning`] (the commissioning mode's
+//! configuration), [`fault_record`] (the fault record kept across a reset: encoding,
+//! CRC, validation at boot), [`fault_frame`] (its CAN report). The board layer
+//! (`motor-firmware`, `../app`) owns
 //! the peripherals; it is a separate crate so that other bare-metal binaries (the QEMU
 //! benchmarks) link this logic without the STM32G4 vector table, the G474 `memory.x`
 //! or a second set of exception and panic handlers.
@@ -23,6 +25,7 @@ pub mod motor {
 
 pub mod adc_frame;
 pub mod bringup;
+pub mod can_commissioning;
 pub mod can_frame;
 pub mod config;
 pub mod fault_frame;

@@ -336,6 +336,14 @@ pub struct PolePairRatioState {
     end_hold: u32,
 }
 
+impl PolePairRatioState {
+    /// The electrical angle the rotating field has reached (π-scaled Q1.31, wrapped).
+    pub fn generated_angle(&self) -> i32 {
+        // The generated angle modulo one turn (truncation is the wrap).
+        self.generated as i32
+    }
+}
+
 /// Measured pole-pair ratio.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PolePairRatioResult {

@@ -23,6 +23,8 @@
 //! | [`modulation`] | THPWM (3.7), (3.8), duties and compare values |
 //! | [`fir`] | FMAC-bit-exact FIR for the identification filter (§6.2) |
 //! | [`commissioning`] | chapter-6 routines as state machines |
+//! | [`commissioning_mode`] | CAN-commanded commissioning: guards, capture, streaming |
+//! | [`can_protocol`] | status, command and capture frames as bytes, CRC-32 |
 //! | [`setpoint`] | received setpoint with timeout and ramp to zero |
 //! | [`step`] | the complete control step and its [`step::ControllerConfig`] |
 //!
@@ -52,7 +54,9 @@
 pub mod adc;
 pub mod angle;
 pub mod ato;
+pub mod can_protocol;
 pub mod commissioning;
+pub mod commissioning_mode;
 pub mod estimator;
 pub mod fast_trig;
 pub mod feedforward;

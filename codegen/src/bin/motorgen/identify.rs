@@ -11,6 +11,7 @@
 use std::path::{Path, PathBuf};
 
 use clap::{Args, Subcommand, ValueEnum};
+use codegen::identify::candump;
 use codegen::identify::recording::{self, Recording, RecordingKind};
 use codegen::identify::resolver::{self, RatioEstimate};
 use codegen::identify::step::{StepEstimate, StepSetup, identify_step};
@@ -18,6 +19,7 @@ use codegen::identify::writeback::{self, Entry, Origin};
 use codegen::identify::{Spread, flux};
 use codegen::units::{self, Kind};
 use codegen::{Design, Diagnostic, Diagnostics, Source};
+use motor_control::can_protocol::Layout;
 use motor_control::commissioning::Axis;
 
 use crate::atomic::LockedSpec;
@@ -36,7 +38,7 @@ pub enum What {
         #[arg(long, value_enum)]
         axis: AxisArg,
         /// One or more `step` recordings (CSV, see `codegen::identify::recording`).
-        #[arg(long, required = true, num_args = 1..)]
+        #[arg(long, required_unless_present = "candump", num_args = 1..)]
         csv: Vec<PathBuf>,
         #[command(flatten)]
         common: Common,
@@ -47,7 +49,7 @@ pub enum What {
         /// The motor spec to update.
         spec: PathBuf,
         /// One or more `flux` recordings.
-        #[arg(long, required = true, num_args = 1..)]
+        #[arg(long, required_unless_present = "candump", num_args = 1..)]
         csv: Vec<PathBuf>,
         #[command(flatten)]
         common: Common,
@@ -82,6 +84,203 @@ pub struct Common {
     /// (default: 1/switching_frequency of the spec).
     #[arg(long)]
     sample_period: Option<String>,
+    /// Logs of the CAN bus (`candump -l` format) holding the drive's captures: each
+    /// capture is checked and identified as its CSV recording would be.
+    #[arg(long, num_args = 1.., value_name = "LOG", requires = "board")]
+    pub candump: Vec<PathBuf>,
+    /// The board file whose CAN identifiers the drive uses (needed with --candump).
+    #[arg(long, value_name = "BOARD_FILE")]
+    pub board: Option<PathBuf>,
+}
+
+/// Where a recording came from: a CSV file, or a capture in a CAN log (whose problems
+/// are located at the log's frames).
+pub struct RecordingOrigin {
+    capture: Option<(candump::Capture, String, String)>,
+    /// The log's text, for relocating.
+    log: std::rc::Rc<String>,
+}
+
+impl RecordingOrigin {
+    fn csv() -> Self {
+        RecordingOrigin {
+            capture: None,
+            log: std::rc::Rc::new(String::new()),
+        }
+    }
+
+    /// `e` located in the log for a capture, unchanged for a CSV file.
+    fn locate(&self, e: Diagnostics) -> Diagnostics {
+        match &self.capture {
+            Some((c, csv, file)) => c.relocate(e, csv, file, &self.log),
+            None => e,
+        }
+    }
+}
+
+/// A checked capture from a log: (log file, log text, capture, its CSV recording).
+pub type LoggedCapture = (String, std::rc::Rc<String>, candump::Capture, String);
+
+/// The CAN interface of the spec on `--board`.
+pub fn layout(spec: &Path, board: &Path) -> Result<Layout, Failure> {
+    let text = crate::read_spec(spec)?;
+    let board_text = crate::read_spec(board)?;
+    let d = codegen::design_with_board(
+        &spec.display().to_string(),
+        &text,
+        &board.display().to_string(),
+        &board_text,
+    )?;
+    candump::layout(&d).ok_or_else(|| {
+        Failure::from(plain_error(
+            &board.display().to_string(),
+            "the design has no CAN interface".into(),
+            "a board file with a [can] section",
+        ))
+    })
+}
+
+/// Every capture in `logs`, checked and turned into its CSV text: (log file, log text,
+/// capture, CSV). The reading of frames from a live socket shares everything after the
+/// frames ([`captures_from_frames`]).
+pub fn read_logs(logs: &[PathBuf], layout: &Layout) -> Result<Vec<LoggedCapture>, Failure> {
+    let mut out = Vec::new();
+    let mut errors = Vec::new();
+    for f in logs {
+        let name = f.display().to_string();
+        let text = match std::fs::read_to_string(f) {
+            Ok(t) => t,
+            Err(e) => {
+                return Err(Failure::new(
+                    Exit::Io,
+                    plain_error(
+                        &name,
+                        format!("cannot read the log: {e}"),
+                        "a readable `candump -l` log",
+                    )
+                    .to_string(),
+                ));
+            }
+        };
+        let frames = match candump::parse_log(&name, &text) {
+            Ok(fr) => fr,
+            Err(e) => {
+                errors.extend(e.0);
+                continue;
+            }
+        };
+        match captures_from_frames(&name, text, &frames, layout) {
+            Ok(v) => out.extend(v),
+            Err(e) => errors.extend(e.0),
+        }
+    }
+    if errors.is_empty() {
+        Ok(out)
+    } else {
+        Err(Diagnostics(errors).into())
+    }
+}
+
+/// The checked captures of `frames` (from a log `name` with text `text`) and their CSV.
+pub fn captures_from_frames(
+    name: &str,
+    text: String,
+    frames: &[candump::LoggedFrame],
+    layout: &Layout,
+) -> Result<Vec<LoggedCapture>, Diagnostics> {
+    let caps = candump::captures(name, &text, frames, layout)?;
+    let text = std::rc::Rc::new(text);
+    Ok(caps
+        .into_iter()
+        .map(|c| {
+            let csv = c.to_csv(layout);
+            (name.to_string(), text.clone(), c, csv)
+        })
+        .collect())
+}
+
+/// The recordings of `--candump` whose kind is one of `kinds`; a capture of another
+/// routine is a located error at its header frame.
+fn can_recordings(
+    common: &Common,
+    spec: &Path,
+    kinds: &[RecordingKind],
+) -> Result<Vec<(Recording, RecordingOrigin)>, Failure> {
+    if common.candump.is_empty() {
+        return Ok(Vec::new());
+    }
+    let Some(board) = &common.board else {
+        return Err(plain_error(
+            "--candump",
+            "no --board given".into(),
+            "--board BOARD_FILE with --candump",
+        )
+        .into());
+    };
+    let layout = layout(spec, board)?;
+    let mut out = Vec::new();
+    let mut errors = Vec::new();
+    for (k, (file, log, cap, csv)) in read_logs(&common.candump, &layout)?.into_iter().enumerate() {
+        let kind = candump::kind_of(cap.header.routine);
+        let origin = RecordingOrigin {
+            capture: Some((cap, csv.clone(), file.clone())),
+            log,
+        };
+        if !kinds.contains(&kind) {
+            let names: Vec<&str> = kinds.iter().map(|k| k.name()).collect();
+            errors.extend(
+                origin
+                    .locate(
+                        codegen::Diagnostic {
+                            file: file.clone(),
+                            line: 1,
+                            column: 1,
+                            key: "ROUTINE".into(),
+                            problem: format!(
+                                "this is a `{}` capture; this identification reads {}",
+                                kind.name(),
+                                names.join(" and ")
+                            ),
+                            accepted: format!("captures of the routine {}", names.join(" or ")),
+                            excerpt: String::new(),
+                        }
+                        .into(),
+                    )
+                    .0,
+            );
+            continue;
+        }
+        let name = format!("{file} (capture {})", k + 1);
+        match recording::parse(&name, &csv, kind, cap_ts(&origin)) {
+            Ok(r) => out.push((r, origin)),
+            Err(e) => errors.extend(origin.locate(e).0),
+        }
+    }
+    if errors.is_empty() {
+        Ok(out)
+    } else {
+        Err(Diagnostics(errors).into())
+    }
+}
+
+fn cap_ts(o: &RecordingOrigin) -> f64 {
+    o.capture.as_ref().map_or(0.0, |(c, _, _)| c.sample_period_s())
+}
+
+/// The recordings of `--csv` files and `--candump` logs together.
+fn all_recordings(
+    csv: &[PathBuf],
+    common: &Common,
+    spec: &Path,
+    kind: RecordingKind,
+    ts: f64,
+) -> Result<Vec<(Recording, RecordingOrigin)>, Failure> {
+    let mut out: Vec<(Recording, RecordingOrigin)> = recordings(csv, kind, ts)?
+        .into_iter()
+        .map(|r| (r, RecordingOrigin::csv()))
+        .collect();
+    out.extend(can_recordings(common, spec, &[kind])?);
+    Ok(out)
 }
 
 /// `--axis`.
@@ -203,9 +402,10 @@ fn today() -> String {
     writeback::date_from_unix_days((secs / 86_400) as i64)
 }
 
-fn names(files: &[PathBuf]) -> Vec<String> {
+fn names(files: &[PathBuf], logs: &[PathBuf]) -> Vec<String> {
     files
         .iter()
+        .chain(logs)
         .map(|f| {
             f.file_name()
                 .map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned())
@@ -328,7 +528,10 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
     let loaded = load(spec, common)?;
     let design = &loaded.design;
     let ts = sample_period(common, design)?;
-    let recs = recordings(csv, RecordingKind::Step, ts)?;
+    let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) =
+        all_recordings(csv, common, spec, RecordingKind::Step, ts)?
+            .into_iter()
+            .unzip();
     let (axis, name) = match axis {
         AxisArg::D => (Axis::D, "d"),
         AxisArg::Q => (Axis::Q, "q"),
@@ -342,10 +545,10 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
     };
     let mut estimates: Vec<StepEstimate> = Vec::new();
     let mut errors = Vec::new();
-    for r in &recs {
+    for (r, o) in recs.iter().zip(&origins) {
         match identify_step(r, &setup) {
             Ok(e) => estimates.push(e),
-            Err(e) => errors.extend(e.0),
+            Err(e) => errors.extend(o.locate(e).0),
         }
     }
     if !errors.is_empty() {
@@ -402,7 +605,7 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         design.angle_observer.lead_samples
     );
     let label = format!("step {name}");
-    let files = names(csv);
+    let files = names(csv, &common.candump);
     let entries = [
         Entry {
             key: "phase_resistance",
@@ -428,7 +631,10 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
     let loaded = load(spec, common)?;
     let design = &loaded.design;
     let ts = sample_period(common, design)?;
-    let recs = recordings(csv, RecordingKind::Flux, ts)?;
+    let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) =
+        all_recordings(csv, common, spec, RecordingKind::Flux, ts)?
+            .into_iter()
+            .unzip();
     let setup = flux::FluxSetup {
         resistance_ohm: design.motor.phase_resistance_ohm,
         d_inductance_h: design.motor.d_inductance_h,
@@ -438,8 +644,8 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
     };
     let mut values = Vec::new();
     let mut errors = Vec::new();
-    for r in &recs {
-        match flux::identify_flux(r, &setup) {
+    for (r, o) in recs.iter().zip(&origins) {
+        match flux::identify_flux(r, &setup).map_err(|e| o.locate(e)) {
             Ok(e) => {
                 outln!(
                     "  {:<20} ω_e = {:>9.1} rad/s  ψ_M = {:.5} Wb (current correction {:+.2e} Wb)",
@@ -460,7 +666,7 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
         return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
     outln!("  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
-    let files = names(csv);
+    let files = names(csv, &common.candump);
     let entries = [Entry {
         key: "flux_linkage",
         value: writeback::webers(s.mean),
@@ -477,7 +683,7 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
 
 fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Common) -> Result<(), Failure> {
     let file = spec.display().to_string();
-    if offset.is_empty() && ratio.is_empty() {
+    if offset.is_empty() && ratio.is_empty() && common.candump.is_empty() {
         return Err(plain_error(
             "motorgen identify resolver",
             "no recordings given".into(),
@@ -494,10 +700,22 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
     );
     let mut errors = Vec::new();
     // Ratio and direction first: an offset is meaningless with the wrong ratio.
-    let ratio_recs = recordings(ratio, RecordingKind::PolePairRatio, ts)?;
+    let can = can_recordings(
+        common,
+        spec,
+        &[RecordingKind::PolePairRatio, RecordingKind::ResolverOffset],
+    )?;
+    let (can_ratio, can_offset): (Vec<_>, Vec<_>) = can
+        .into_iter()
+        .partition(|(r, _)| r.kind == RecordingKind::PolePairRatio);
+    let mut ratio_recs: Vec<(Recording, RecordingOrigin)> = recordings(ratio, RecordingKind::PolePairRatio, ts)?
+        .into_iter()
+        .map(|r| (r, RecordingOrigin::csv()))
+        .collect();
+    ratio_recs.extend(can_ratio);
     let mut ratios: Vec<RatioEstimate> = Vec::new();
-    for r in &ratio_recs {
-        match resolver::identify_ratio(r) {
+    for (r, o) in &ratio_recs {
+        match resolver::identify_ratio(r).map_err(|e| o.locate(e)) {
             Ok(e) => {
                 outln!(
                     "  {:<20} n_p/n_r = {:.4}, directions {}",
@@ -516,7 +734,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
     let expected = f64::from(np) / f64::from(nr);
     let src = Source { file: &file, text };
     let at = writeback::value_span(text, &["motor", "pole_pairs"]).unwrap_or(0..0);
-    for (r, e) in ratio_recs.iter().zip(&ratios) {
+    for ((r, _), e) in ratio_recs.iter().zip(&ratios) {
         if !e.directions_agree {
             errors.push(src.error(
                 at.clone(),
@@ -549,13 +767,17 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
     if !ratios.is_empty() {
         outln!("  pole-pair ratio agrees with the spec ({np}/{nr}); directions agree");
     }
-    if offset.is_empty() {
+    if offset.is_empty() && can_offset.is_empty() {
         return Ok(());
     }
-    let recs = recordings(offset, RecordingKind::ResolverOffset, ts)?;
+    let mut recs: Vec<(Recording, RecordingOrigin)> = recordings(offset, RecordingKind::ResolverOffset, ts)?
+        .into_iter()
+        .map(|r| (r, RecordingOrigin::csv()))
+        .collect();
+    recs.extend(can_offset);
     let mut offsets = Vec::new();
-    for r in &recs {
-        match resolver::identify_offset(r, np, nr) {
+    for (r, o) in &recs {
+        match resolver::identify_offset(r, np, nr).map_err(|e| o.locate(e)) {
             Ok(e) => {
                 outln!(
                     "  {:<20} θ_off = {:.5} rad (θ_r within ±{:.5} rad over {} rows)",
@@ -579,7 +801,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         "  mean: θ_off = {mean:.5} rad (mod 2π·n_r/n_p), runs within ±{:.3}° electrical",
         (dev * f64::from(np) / f64::from(nr)).to_degrees()
     );
-    let files = names(offset);
+    let files = names(offset, &common.candump);
     let entries = [Entry {
         key: "resolver_offset",
         value: writeback::radians(mean),

@@ -42,8 +42,9 @@ enum Command {
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
-    /// Write the Rust module, C header and Markdown summary of one motor into a directory
-    /// (files are only rewritten when their bytes change).
+    /// Write the Rust module, C header and Markdown summary of one motor into a directory,
+    /// and with --board the DBC file of its CAN interface (files are only rewritten when
+    /// their bytes change).
     Generate {
         /// The motor spec.
         #[arg(value_name = "SPEC")]
@@ -51,10 +52,12 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
-        /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2).
+        /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2,
+        /// motor.dbc.j2).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
-        /// A board file: adds its `board` constants (as `design --board`).
+        /// A board file: adds its `board` and `can` constants (as `design --board`) and
+        /// writes STEM.dbc.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
@@ -119,6 +122,23 @@ enum Command {
         #[command(subcommand)]
         what: identify::What,
     },
+    /// Write the captures in CAN logs (`candump -l` format) as the CSV recordings
+    /// `identify --csv` reads, for inspection: DIR/LOGSTEM-N-ROUTINE.csv (all or nothing;
+    /// a corrupted capture is a located error and nothing is written).
+    Capture {
+        /// The motor spec (its scalings decode the signals).
+        #[arg(value_name = "SPEC")]
+        spec: PathBuf,
+        /// The board file whose CAN identifiers the drive uses.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: PathBuf,
+        /// One or more logs.
+        #[arg(long, required = true, num_args = 1.., value_name = "LOG")]
+        candump: Vec<PathBuf>,
+        /// Output directory (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
     /// List the motors in a directory (default: motors/).
     List {
         /// Directory of motor specs.
@@ -155,6 +175,8 @@ impl Format {
 /// Renders `out` with the template from `dir` if given, else the built-in one.
 fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String, Failure> {
     let bad_template = |e: codegen::render::RenderError| Failure::new(Exit::BadInput, e.to_string());
+    // A template directory made before the DBC output existed: the built-in DBC.
+    let dir = dir.filter(|dir| out != Output::Dbc || dir.join(out.template()).exists());
     match dir {
         Some(dir) => {
             let path = dir.join(out.template());
@@ -279,7 +301,9 @@ fn run(command: Command) -> Result<(), Failure> {
                 .unwrap_or_else(|| "motor".into());
             // Render everything first: nothing is written unless every output renders.
             let mut files = Vec::new();
-            for o in Output::ALL {
+            // The DBC of the CAN interface needs the board's identifiers.
+            let dbc = d.board.is_some().then_some(Output::Dbc);
+            for o in Output::ALL.into_iter().chain(dbc) {
                 let text = render(&d, o, templates.as_deref())?;
                 files.push((out.join(o.file_name(&stem)), text.into_bytes()));
             }
@@ -381,6 +405,28 @@ fn run(command: Command) -> Result<(), Failure> {
         Command::Verify { spec } => verify::run(&spec),
         Command::Report { spec, out } => report::run(&spec, &out),
         Command::Identify { what } => identify::run(what),
+        Command::Capture {
+            spec,
+            board,
+            candump,
+            out,
+        } => {
+            atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+            let layout = identify::layout(&spec, &board)?;
+            let mut files = Vec::new();
+            for (k, (file, _, cap, csv)) in identify::read_logs(&candump, &layout)?.into_iter().enumerate() {
+                let stem = Path::new(&file)
+                    .file_stem()
+                    .map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
+                let kind = codegen::identify::candump::kind_of(cap.header.routine).name();
+                files.push((out.join(format!("{stem}-{}-{kind}.csv", k + 1)), csv.into_bytes()));
+            }
+            let written = atomic::write_set(&out, &files)?;
+            for ((path, _), w) in files.iter().zip(written) {
+                outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
+            }
+            Ok(())
+        }
         Command::List { dir } => {
             let dir = motors_dir(dir);
             let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)

@@ -9,9 +9,11 @@
 use stm32g4::stm32g474 as pac;
 
 use super::clocks::{POLL_LIMIT, wait_for};
+use crate::can_commissioning::tx_element;
 use crate::can_frame::{RxFrame, nominal_bit_timing};
 use crate::hw;
 use crate::motor::board;
+use motor_control::can_protocol::Frame;
 
 /// FDCAN_NBTP of the bus (a build error if the clock does not divide).
 const NBTP: u32 = match nominal_bit_timing(
@@ -81,18 +83,24 @@ impl Can {
         Some(frame)
     }
 
-    /// Queues one frame (the first four words of a Tx buffer element,
-    /// `crate::fault_frame::tx_element`) in the Tx FIFO (TXBC.TFQM = 0 after reset) and
-    /// requests its transmission; `false` if the FIFO is full. The FDCAN retransmits
-    /// until the frame is acknowledged (CCCR.DAR = 0).
-    pub fn send(&mut self, element: [u32; 4]) -> bool {
+    /// The Tx FIFO can take a frame (TXFQS.TFQF clear, RM0440 §44.4.29).
+    pub fn has_room(&self) -> bool {
+        self.regs.txfqs().read().tfqf().bit_is_clear()
+    }
+
+    /// Queues one classic frame in the Tx FIFO (TXBC.TFQM = 0 after reset) as the first
+    /// four words of a Tx buffer element (`motor_config::can_commissioning::tx_element`)
+    /// and requests its transmission; `false` if the FIFO is full (nothing written). The
+    /// FDCAN retransmits until the frame is acknowledged (CCCR.DAR = 0). The only
+    /// transmit path of the image: status, capture and fault-report frames.
+    pub fn send(&mut self, frame: &Frame) -> bool {
         let status = self.regs.txfqs().read();
         let index = status.tfqpi().bits();
         if status.tfqf().bit_is_set() || index >= TX_BUFFERS {
             return false;
         }
         let base = hw::FDCAN1_RAM + hw::FDCAN_TXBUF_OFFSET + usize::from(index) * hw::FDCAN_TX_ELEMENT_BYTES;
-        for (k, w) in element.into_iter().enumerate() {
+        for (k, w) in tx_element(frame).into_iter().enumerate() {
             // SAFETY: `base` is Tx buffer `index` (< 3) of the FDCAN1 message RAM, free
             // (TXFQS put index of a FIFO that is not full); word-aligned.
             unsafe { core::ptr::write_volatile((base + 4 * k) as *mut u32, w) };

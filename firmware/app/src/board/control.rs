@@ -20,13 +20,14 @@ use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::interrupt::Mutex;
+use motor_control::commissioning_mode::{Guards, Measured};
 use motor_control::setpoint::SetpointState;
 use motor_control::{ControllerState, Demand};
 use stm32g4::stm32g474 as pac;
 use stm32g4::stm32g474::interrupt;
 
 use super::cordic::Cordic;
-use super::{adc, fault, pins, pwm};
+use super::{adc, commissioning, fault, pins, pwm};
 use crate::adc_frame::{self, Excitation};
 use crate::bringup;
 use crate::config::{CONTROLLER, SETPOINT, TRIPS};
@@ -67,6 +68,8 @@ pub struct Control {
     omega_e: f32,
     /// Why this period tripped, recorded at its end with its state.
     trip_cause: Option<FaultCause>,
+    /// What the last step measured, for a commissioning routine.
+    measured: Measured,
 }
 
 /// Passes the [`Control`] from `run` to the interrupt once.
@@ -85,6 +88,12 @@ impl Control {
             tripped: false,
             omega_e: 0.0,
             trip_cause: None,
+            measured: Measured {
+                i_dq: motor_control::transforms::Dq { d: 0.0, q: 0.0 },
+                theta_r: 0,
+                omega_e: 0.0,
+                u_q: 0.0,
+            },
         }
     }
 
@@ -119,7 +128,7 @@ impl Control {
         let iq = SETPOINT.process(&mut self.setpoint, take_setpoint());
         let alive = !(self.setpoint.timed_out(&SETPOINT) && iq == 0.0);
         let run = alive && !self.tripped;
-        let demand = if run {
+        let normal = if run {
             Demand::Current {
                 id: 0.0,
                 iq,
@@ -128,7 +137,22 @@ impl Control {
         } else {
             Demand::Off
         };
+        // A commissioning routine replaces the torque demand (or switches off).
+        let guards = Guards {
+            torque_setpoint: iq,
+            fault: self.tripped,
+            break_active: false,
+            setpoint_timeout: self.setpoint.timed_out(&SETPOINT),
+        };
+        let (demand, run) =
+            commissioning::control_step(&mut self.cordic, &self.measured, &guards, self.omega_e, normal, run);
         let out = CONTROLLER.process(&mut self.state, &mut self.cordic, &sample, demand);
+        self.measured = Measured {
+            i_dq: out.i_dq,
+            theta_r: out.theta_r,
+            omega_e: out.omega_e,
+            u_q: out.u_dq.q,
+        };
         self.omega_e = out.omega_e;
         pwm::set_compare(&self.tim1, out.compare);
         let on = bringup::finish_period(&mut pwm::Break(&self.tim1), &mut self.tripped, run);

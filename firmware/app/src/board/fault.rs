@@ -13,11 +13,12 @@ use stm32g4::stm32g474 as pac;
 
 use super::can::Can;
 use super::{pins, watchdog};
-use crate::fault_frame::{encode, tx_element};
+use crate::fault_frame::encode;
 use crate::fault_record::{
     ControlState, FaultCause, FaultRecord, RECORD_WORDS, STATE_WORDS, at_boot, classify_hard_fault,
 };
 use crate::hw;
+use motor_control::can_protocol::Frame;
 
 /// Routes faults the software can no longer handle to TIM1's break input and stops TIM1
 /// under a debugger halt (defect 6): SYSCFG_CFGR2.CLL (Cortex-M4 LOCKUP), SPL (SRAM
@@ -202,8 +203,12 @@ pub fn report(can: &mut Can, record: FaultRecord) {
     if record.reported {
         return;
     }
-    let frame = tx_element(hw::FAULT_REPORT_ID, &encode(&record));
-    if can.send(frame) {
+    let frame = Frame {
+        id: hw::FAULT_REPORT_ID,
+        len: 8,
+        data: encode(&record),
+    };
+    if can.send(&frame) {
         let sent = FaultRecord {
             reported: true,
             ..record

@@ -11,7 +11,8 @@
 //! | [`adc`] | ADC1/ADC2 injected conversions |
 //! | [`cordic`] | CORDIC as the core's `Trig` |
 //! | [`fmac`] | FMAC start-up self-test of the generated FIR against the bit-exact model |
-//! | [`can`] | FDCAN1 setpoint reception |
+//! | [`can`] | FDCAN1: setpoint reception; status, capture and fault-report transmission |
+//! | [`commissioning`] | the commissioning mode between main loop and interrupt |
 //! | [`watchdog`] | IWDG |
 //! | [`control`] | the control interrupt |
 //! | [`fault`] | HardFault (also on stack overflow), unhandled interrupts, panics; the fault record |
@@ -20,6 +21,7 @@
 pub mod adc;
 pub mod can;
 pub mod clocks;
+pub mod commissioning;
 pub mod control;
 pub mod cordic;
 pub mod fault;
@@ -99,13 +101,19 @@ pub fn run() -> ! {
     watchdog::start(&dp.IWDG);
 
     let mut last = TICKS.load(Ordering::Relaxed);
+    let mut last_status = last;
     loop {
-        if let Some(frame) = can.poll()
-            && let Some(torque) = can_frame::decode_torque(frame.standard_id, frame.bytes())
-        {
-            publish_setpoint(can_frame::torque_to_iq(torque, config::IQ_PER_NM));
+        if let Some(frame) = can.poll() {
+            match can_frame::decode_torque(frame.standard_id, frame.bytes()) {
+                Some(torque) => {
+                    commissioning::torque_received(torque);
+                    publish_setpoint(can_frame::torque_to_iq(torque, config::IQ_PER_NM));
+                }
+                None => commissioning::frame_received(frame.standard_id, frame.bytes()),
+            }
         }
         let now = TICKS.load(Ordering::Relaxed);
+        commissioning::transmit(&mut can, now, &mut last_status);
         if now != last {
             watchdog::refresh(&dp.IWDG);
             last = now;

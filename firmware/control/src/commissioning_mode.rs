@@ -1,0 +1,672 @@
+//! The commissioning mode (pure): which chapter-6 routine runs, when a CAN command may
+//! start one, what it captures and how the capture leaves the board as frames.
+//!
+//! * A command ([`crate::can_protocol::Command`]) starts a routine only with a zero
+//!   torque setpoint, no fault and — except the ψ_M run — at standstill
+//!   (|ω_e| ≤ [`ModeConfig::standstill_speed`]); otherwise it is refused and the status
+//!   frame gives the [`Reason`]. The ψ_M run (§6.5) needs the rotor turned by the
+//!   dynamometer, so it is the one routine accepted at speed (and refused below the
+//!   routine's minimum speed at the end, as [`FluxLinkage`] does).
+//! * Every period [`CommissioningMode::step`] answers what the current-control step gets:
+//!   the normal torque path ([`Control::Normal`]), the routine's demand, or
+//!   [`Control::Off`]. A fault, a break or a setpoint timeout while a routine runs
+//!   aborts it to outputs off (latched until an abort command clears it).
+//! * The routine's view each period is captured (two channels, every `decimation`-th
+//!   period) as [`crate::can_protocol::Routine::channels`] names; when it finishes the
+//!   capture is sent raw (unfiltered): header, one data frame per sample, end frame
+//!   with the CRC-32 ([`CommissioningMode::next_frame`], one frame per call).
+//!
+//! Raw capture instead of the FMAC: the host filters with the bit-exact FMAC model
+//! (`motor_control::fir::FmacFir`, the same taps), so the result is the same number
+//! for number, and the log keeps the unfiltered current for inspection; the FMAC stays
+//! free for the control interrupt and the capture needs no second buffer.
+
+use crate::can_protocol::{self as p, Command, End, Frame, Header, Layout, Reason, Routine, State};
+use crate::commissioning::{
+    Axis, CommissioningError, FluxLinkage, FluxLinkageState, PolePairRatio, PolePairRatioState, Progress,
+    ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState,
+};
+use crate::step::Demand;
+use crate::transforms::Dq;
+use crate::trig::Trig;
+
+/// Fixed parameters of the routines (the command gives voltage, trip and decimation).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ModeConfig {
+    /// Frame identifiers and scalings.
+    pub layout: Layout,
+    /// T_s in units of 100 ns (the generated `SAMPLE_PERIOD_UNITS`).
+    pub sample_period_units: u16,
+    /// Largest |ω_e| counted as standstill \[rad/s\].
+    pub standstill_speed: f32,
+    /// Largest |torque setpoint| counted as zero \[N·m\].
+    pub zero_torque: f32,
+    /// Blocked-rotor step: periods at 0 V before the step, periods at the step.
+    pub step_samples: (u32, u32),
+    /// Resolver offset: ramp, settle and averaging periods (§6.3).
+    pub align_samples: (u32, u32, u32),
+    /// Pole-pair ratio: angle step per period (π-scaled), whole turns, settle periods.
+    pub rotation: (i32, u32, u32),
+    /// ψ_M run (§6.5).
+    pub flux: FluxLinkage,
+}
+
+/// Safety inputs, every period.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Guards {
+    /// The torque setpoint now \[N·m\].
+    pub torque_setpoint: f32,
+    /// A latched drive fault (over-current, over-voltage, over-speed).
+    pub fault: bool,
+    /// The break input is active (the timer has disabled the outputs).
+    pub break_active: bool,
+    /// No setpoint frame within the board's timeout.
+    pub setpoint_timeout: bool,
+}
+
+impl Guards {
+    fn any(&self) -> bool {
+        self.fault || self.break_active || self.setpoint_timeout
+    }
+}
+
+/// What the routine sees each period (from the previous control step).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Measured {
+    /// Measured currents \[A\].
+    pub i_dq: Dq,
+    /// Observed resolver angle (π-scaled Q1.31).
+    pub theta_r: i32,
+    /// Electrical speed \[rad/s\].
+    pub omega_e: f32,
+    /// Applied q voltage \[V\].
+    pub u_q: f32,
+}
+
+/// What the current-control step gets this period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Control {
+    /// Torque control from the setpoint (no commissioning).
+    Normal,
+    /// The routine's demand.
+    Demand(Demand),
+    /// Outputs off.
+    Off,
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Running {
+    Step(VoltageStep, VoltageStepState<0>),
+    Align(ResolverOffset, ResolverOffsetState),
+    Rotate(PolePairRatio, PolePairRatioState),
+    Flux(FluxLinkageState),
+}
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Mode {
+    Idle,
+    Running {
+        routine: Routine,
+        run: Running,
+        n: u32,
+    },
+    /// Sending: `next` 0 is the header, 1…count the data frames, count + 1 the end.
+    Streaming {
+        next: u32,
+    },
+    Fault,
+}
+
+/// The commissioning supervisor. The capture buffer is the caller's (a separate,
+/// zero-initialised static on the board, so it costs RAM but no flash), passed to the
+/// calls that use it; its length is the capture capacity.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CommissioningMode {
+    mode: Mode,
+    reason: Reason,
+    header: Header,
+    end: End,
+    crc: p::Crc32,
+    len: usize,
+}
+
+impl Default for CommissioningMode {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// One captured sample: channels A and B (SI units).
+pub type Sample = (f32, f32);
+
+impl CommissioningMode {
+    /// Idle, empty capture.
+    pub const fn new() -> Self {
+        Self {
+            mode: Mode::Idle,
+            reason: Reason::None,
+            header: Header {
+                routine: Routine::Step,
+                axis_q: false,
+                tripped: false,
+                decimation: 1,
+                sample_period_units: 0,
+                count: 0,
+                current_trip: 0.0,
+            },
+            end: End {
+                crc: 0,
+                trip_sample: 0,
+                trip_current: 0.0,
+            },
+            crc: p::Crc32::new(),
+            len: 0,
+        }
+    }
+
+    /// The state and reason for the status frame.
+    pub fn state(&self) -> (State, Reason) {
+        let s = match self.mode {
+            Mode::Idle => State::Idle,
+            Mode::Running { .. } => State::Commissioning,
+            Mode::Streaming { .. } => State::Streaming,
+            Mode::Fault => State::Fault,
+        };
+        (s, self.reason)
+    }
+
+    /// The status frame (`faults`: the image's fault flags).
+    pub fn status(&self, cfg: &ModeConfig, faults: u8) -> Frame {
+        let (s, r) = self.state();
+        let routine = match self.mode {
+            Mode::Running { routine, .. } => routine.code(),
+            Mode::Streaming { .. } => self.header.routine.code(),
+            _ => 0,
+        };
+        p::encode_status(&cfg.layout, s, r, routine, faults)
+    }
+
+    /// The samples captured so far in `buffer`.
+    pub fn captured<'a>(&self, buffer: &'a [Sample]) -> &'a [Sample] {
+        buffer.get(..self.len).unwrap_or(&[])
+    }
+
+    /// A received command; returns the reason it was refused ([`Reason::None`]:
+    /// accepted). `capacity` is the capture buffer's length.
+    pub fn command(&mut self, cfg: &ModeConfig, c: &Command, guards: &Guards, omega_e: f32, capacity: usize) -> Reason {
+        let reason = self.accept(cfg, c, guards, omega_e, capacity);
+        self.reason = reason;
+        reason
+    }
+
+    fn accept(&mut self, cfg: &ModeConfig, c: &Command, guards: &Guards, omega_e: f32, capacity: usize) -> Reason {
+        let Some(routine) = c.routine else {
+            // Abort: outputs off, capture dropped; clears a latched abort once safe.
+            return match self.mode {
+                Mode::Fault if guards.any() => Reason::FaultActive,
+                Mode::Running { .. } | Mode::Streaming { .. } => {
+                    self.mode = Mode::Idle;
+                    Reason::Aborted
+                }
+                _ => {
+                    self.mode = Mode::Idle;
+                    Reason::None
+                }
+            };
+        };
+        if !matches!(self.mode, Mode::Idle) {
+            return if matches!(self.mode, Mode::Fault) {
+                Reason::FaultActive
+            } else {
+                Reason::Busy
+            };
+        }
+        if guards.any() {
+            return Reason::FaultActive;
+        }
+        // NaN counts as not zero / not at standstill.
+        let within = |x: f32, limit: f32| libm::fabsf(x) <= limit;
+        if !within(guards.torque_setpoint, cfg.zero_torque) {
+            return Reason::TorqueNotZero;
+        }
+        if routine != Routine::Flux && !within(omega_e, cfg.standstill_speed) {
+            return Reason::NotAtStandstill;
+        }
+        let decimation = match u8::try_from(c.decimation) {
+            Ok(d) if d >= 1 => d,
+            _ => return Reason::BadCommand,
+        };
+        let needs_voltage = routine != Routine::Flux;
+        if needs_voltage && !(c.voltage > 0.0 && c.voltage.is_finite()) {
+            return Reason::BadCommand;
+        }
+        if routine == Routine::Step && !(c.current_trip > 0.0 && c.current_trip.is_finite()) {
+            return Reason::BadCommand;
+        }
+        // The capture must fit: a routine whose samples overflow the buffer would be
+        // identified from a cut record.
+        let periods = capture_periods(cfg, routine);
+        let samples = periods.div_ceil(u64::from(decimation));
+        if samples > capacity as u64 || samples > u64::from(u16::MAX) {
+            return Reason::BadCommand;
+        }
+        let run = match routine {
+            Routine::Step => Running::Step(
+                VoltageStep {
+                    axis: if c.axis_q { Axis::Q } else { Axis::D },
+                    voltage: c.voltage,
+                    current_trip: c.current_trip,
+                    pre_samples: cfg.step_samples.0,
+                    step_samples: cfg.step_samples.1,
+                    // The routine's own buffer is empty; this module captures.
+                    decimation: 1,
+                },
+                VoltageStepState::new(),
+            ),
+            Routine::ResolverOffset => Running::Align(
+                ResolverOffset {
+                    voltage: c.voltage,
+                    ramp_samples: cfg.align_samples.0,
+                    settle_samples: cfg.align_samples.1,
+                    average_samples: cfg.align_samples.2,
+                },
+                ResolverOffsetState::default(),
+            ),
+            Routine::PolePairRatio => Running::Rotate(
+                PolePairRatio {
+                    voltage: c.voltage,
+                    step: cfg.rotation.0,
+                    turns: cfg.rotation.1,
+                    settle_samples: cfg.rotation.2,
+                },
+                PolePairRatioState::default(),
+            ),
+            Routine::Flux => Running::Flux(FluxLinkageState::default()),
+        };
+        self.header = Header {
+            routine,
+            axis_q: routine == Routine::Step && c.axis_q,
+            tripped: false,
+            decimation,
+            sample_period_units: cfg.sample_period_units,
+            count: 0,
+            current_trip: if routine == Routine::Step { c.current_trip } else { 0.0 },
+        };
+        self.end = End {
+            crc: 0,
+            trip_sample: 0,
+            trip_current: 0.0,
+        };
+        self.len = 0;
+        self.mode = Mode::Running { routine, run, n: 0 };
+        Reason::None
+    }
+
+    /// One control period: what the current-control step gets; the routine's channels
+    /// go to `buffer`.
+    pub fn step<T: Trig>(
+        &mut self,
+        cfg: &ModeConfig,
+        guards: &Guards,
+        m: &Measured,
+        trig: &mut T,
+        buffer: &mut [Sample],
+    ) -> Control {
+        let Mode::Running { routine, mut run, n } = self.mode else {
+            return match self.mode {
+                Mode::Idle => Control::Normal,
+                _ => Control::Off,
+            };
+        };
+        if guards.any() {
+            self.mode = Mode::Fault;
+            self.reason = Reason::Aborted;
+            return Control::Off;
+        }
+        // The demand and the two captured channels of this period, or the outcome.
+        let (progress, channels) = match &mut run {
+            Running::Step(r, st) => {
+                let pr = r.process(st, m.i_dq);
+                let ch = match pr {
+                    Progress::Running(Demand::VoltageDq(v)) => match r.axis {
+                        Axis::D => (v.d, m.i_dq.d),
+                        Axis::Q => (v.q, m.i_dq.q),
+                    },
+                    _ => (0.0, 0.0),
+                };
+                let outcome = match pr {
+                    Progress::Running(d) => Progress::Running(d),
+                    Progress::Finished(Ok(_)) => Progress::Finished(None),
+                    Progress::Finished(Err(e)) => Progress::Finished(Some(e)),
+                };
+                (outcome, ch)
+            }
+            Running::Align(r, st) => {
+                let pr = r.process(st, m.theta_r);
+                let u = match pr {
+                    Progress::Running(Demand::VoltageAlphaBeta(v)) => v.alpha,
+                    _ => 0.0,
+                };
+                (finish_ok(pr), (u, angle_rad(m.theta_r)))
+            }
+            Running::Rotate(r, st) => {
+                let pr = r.process(st, trig, m.theta_r);
+                let generated = angle_rad(st.generated_angle());
+                let outcome = match pr {
+                    Progress::Running(d) => Progress::Running(d),
+                    Progress::Finished(Ok(_)) => Progress::Finished(None),
+                    Progress::Finished(Err(e)) => Progress::Finished(Some(e)),
+                };
+                (outcome, (generated, angle_rad(m.theta_r)))
+            }
+            Running::Flux(st) => {
+                let pr = cfg.flux.process(st, m.u_q, m.omega_e);
+                let outcome = match pr {
+                    Progress::Running(d) => Progress::Running(d),
+                    Progress::Finished(Ok(_)) => Progress::Finished(None),
+                    Progress::Finished(Err(e)) => Progress::Finished(Some(e)),
+                };
+                (outcome, (m.omega_e, m.u_q))
+            }
+        };
+        match progress {
+            Progress::Running(demand) => {
+                // ψ_M: only the averaged periods (the settling ones hold transients).
+                let from = if routine == Routine::Flux {
+                    cfg.flux.settle_samples
+                } else {
+                    0
+                };
+                if n >= from
+                    && n.saturating_sub(from)
+                        .is_multiple_of(u32::from(self.header.decimation.max(1)))
+                    && let Some(slot) = buffer.get_mut(self.len)
+                    && self.len < usize::from(u16::MAX)
+                {
+                    *slot = channels;
+                    self.len = self.len.saturating_add(1);
+                }
+                self.mode = Mode::Running {
+                    routine,
+                    run,
+                    n: n.saturating_add(1),
+                };
+                Control::Demand(demand)
+            }
+            Progress::Finished(error) => {
+                if let Some(CommissioningError::Tripped { sample, current }) = error {
+                    self.header.tripped = true;
+                    self.end.trip_sample = u16::try_from(sample).unwrap_or(u16::MAX);
+                    self.end.trip_current = current;
+                    self.reason = Reason::Tripped;
+                }
+                self.header.count = u16::try_from(self.len).unwrap_or(u16::MAX);
+                self.crc = p::Crc32::new();
+                self.mode = Mode::Streaming { next: 0 };
+                Control::Off
+            }
+        }
+    }
+
+    /// The next capture frame (of `buffer`) to send while streaming (then idle again),
+    /// `None` otherwise.
+    pub fn next_frame(&mut self, cfg: &ModeConfig, buffer: &[Sample]) -> Option<Frame> {
+        let Mode::Streaming { next } = self.mode else {
+            return None;
+        };
+        let count = u32::from(self.header.count);
+        let frame = if next == 0 {
+            p::encode_header(&cfg.layout, &self.header)
+        } else if next <= count {
+            let k = next.saturating_sub(1);
+            let (a, b) = buffer.get(k as usize).copied().unwrap_or((0.0, 0.0));
+            p::encode_data(&cfg.layout, self.header.routine, k as u16, a, b)
+        } else {
+            self.mode = Mode::Idle;
+            return Some(p::encode_end(
+                &cfg.layout,
+                &End {
+                    crc: self.crc.value(),
+                    ..self.end
+                },
+            ));
+        };
+        self.crc.update(frame.bytes());
+        self.mode = Mode::Streaming {
+            next: next.saturating_add(1),
+        };
+        Some(frame)
+    }
+}
+
+/// Periods a routine captures (an upper bound for the rotation, whose last step may be
+/// shorter).
+fn capture_periods(cfg: &ModeConfig, routine: Routine) -> u64 {
+    let sum = |a: u32, b: u32, c: u32| u64::from(a).saturating_add(u64::from(b)).saturating_add(u64::from(c));
+    match routine {
+        Routine::Step => sum(cfg.step_samples.0, cfg.step_samples.1, 0),
+        Routine::ResolverOffset => sum(cfg.align_samples.0, cfg.align_samples.1, cfg.align_samples.2),
+        Routine::PolePairRatio => {
+            let (step, turns, settle) = cfg.rotation;
+            let per_turn = (1u64 << 32)
+                .checked_div(u64::from(step.unsigned_abs()))
+                .unwrap_or(u64::MAX)
+                .saturating_add(1);
+            per_turn
+                .saturating_mul(u64::from(turns))
+                .saturating_add(sum(settle, settle, 2))
+        }
+        Routine::Flux => sum(cfg.flux.average_samples, 1, 0),
+    }
+}
+
+fn finish_ok<R>(pr: Progress<R>) -> Progress<Option<CommissioningError>> {
+    match pr {
+        Progress::Running(d) => Progress::Running(d),
+        Progress::Finished(_) => Progress::Finished(None),
+    }
+}
+
+/// A π-scaled Q1.31 angle in radians, in \[−π, π).
+fn angle_rad(theta: i32) -> f32 {
+    theta as f32 * (core::f32::consts::PI / 2_147_483_648.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::trig::SoftTrig;
+
+    fn cfg() -> ModeConfig {
+        ModeConfig {
+            layout: Layout {
+                status_id: 0x101,
+                command_id: 0x102,
+                header_id: 0x103,
+                data_id: 0x104,
+                end_id: 0x105,
+                current_per_lsb: 0.01,
+                voltage_per_lsb: 0.01,
+                speed_per_lsb: 1.0,
+            },
+            sample_period_units: 500,
+            standstill_speed: 1.0,
+            zero_torque: 0.005,
+            step_samples: (2, 4),
+            align_samples: (2, 2, 2),
+            rotation: (1 << 30, 1, 1),
+            flux: FluxLinkage {
+                settle_samples: 1,
+                average_samples: 2,
+                min_speed: 10.0,
+            },
+        }
+    }
+
+    fn step_cmd() -> Command {
+        Command {
+            routine: Some(Routine::Step),
+            axis_q: true,
+            voltage: 4.0,
+            current_trip: 10.0,
+            decimation: 1,
+        }
+    }
+
+    /// Refusals, each with its reason; nothing starts.
+    #[test]
+    fn refuses_unless_at_standstill_with_zero_torque() {
+        let c = cfg();
+        let mut m = CommissioningMode::new();
+        let mut buf = [(0.0f32, 0.0f32); 8];
+        let g = Guards::default();
+        let turning = m.command(&c, &step_cmd(), &g, 50.0, 8);
+        assert_eq!(turning, Reason::NotAtStandstill);
+        let torque = Guards {
+            torque_setpoint: 1.0,
+            ..g
+        };
+        assert_eq!(m.command(&c, &step_cmd(), &torque, 0.0, 8), Reason::TorqueNotZero);
+        let fault = Guards { fault: true, ..g };
+        assert_eq!(m.command(&c, &step_cmd(), &fault, 0.0, 8), Reason::FaultActive);
+        let bad = Command {
+            decimation: 0,
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &bad, &g, 0.0, 8), Reason::BadCommand);
+        assert_eq!(m.state(), (State::Idle, Reason::BadCommand));
+        assert_eq!(m.status(&c, 0).bytes(), &[0, 4, 0, 0]);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Normal
+        );
+        // Flux is accepted at speed.
+        let flux = Command {
+            routine: Some(Routine::Flux),
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &flux, &g, 500.0, 8), Reason::None);
+        assert_eq!(m.command(&c, &step_cmd(), &g, 0.0, 8), Reason::Busy);
+    }
+
+    /// A step of 2 + 4 periods: 6 demands (0, 0, 4, 4, 4, 4 V on q), then outputs off
+    /// and the capture streamed as header, 6 data frames and the end frame, whose CRC
+    /// is that of the header and data bytes.
+    #[test]
+    fn step_runs_captures_and_streams() {
+        let c = cfg();
+        let mut m = CommissioningMode::new();
+        let mut buf = [(0.0f32, 0.0f32); 8];
+        let g = Guards::default();
+        assert_eq!(m.command(&c, &step_cmd(), &g, 0.0, 8), Reason::None);
+        let mut volts = vec![];
+        for k in 0..7 {
+            let meas = Measured {
+                i_dq: Dq {
+                    d: 0.0,
+                    q: 0.5 * k as f32,
+                },
+                ..Measured::default()
+            };
+            match m.step(&c, &g, &meas, &mut SoftTrig, &mut buf) {
+                Control::Demand(Demand::VoltageDq(v)) => volts.push(v.q),
+                Control::Off => break,
+                other => panic!("{other:?}"),
+            }
+        }
+        assert_eq!(volts, [0.0, 0.0, 4.0, 4.0, 4.0, 4.0]);
+        assert_eq!(m.state().0, State::Streaming);
+        let mut frames = vec![];
+        while let Some(f) = m.next_frame(&c, &buf) {
+            frames.push(f);
+        }
+        assert_eq!(frames.len(), 8);
+        assert_eq!(m.state().0, State::Idle);
+        let h = p::decode_header(&c.layout, frames[0].bytes()).unwrap();
+        assert_eq!((h.count, h.axis_q, h.tripped), (6, true, false));
+        // Data frame 3: 4 V = 400 LSB, 1.5 A = 150 LSB.
+        assert_eq!(p::decode_data(frames[4].bytes()), Some((1, 3, 400, 150)));
+        let mut crc = p::Crc32::new();
+        for f in &frames[..7] {
+            crc.update(f.bytes());
+        }
+        assert_eq!(p::decode_end(&c.layout, frames[7].bytes()).unwrap().crc, crc.value());
+    }
+
+    /// A setpoint timeout while running: outputs off at once, latched, no capture sent;
+    /// an abort command clears it once the guards are clear.
+    #[test]
+    fn timeout_aborts_to_outputs_off() {
+        let c = cfg();
+        let mut m = CommissioningMode::new();
+        let mut buf = [(0.0f32, 0.0f32); 8];
+        let g = Guards::default();
+        m.command(&c, &step_cmd(), &g, 0.0, 8);
+        assert!(matches!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Demand(_)
+        ));
+        let t = Guards {
+            setpoint_timeout: true,
+            ..g
+        };
+        assert_eq!(
+            m.step(&c, &t, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Off
+        );
+        assert_eq!(m.state(), (State::Fault, Reason::Aborted));
+        assert_eq!(m.next_frame(&c, &buf), None);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Off
+        );
+        let abort = Command {
+            routine: None,
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &abort, &t, 0.0, 8), Reason::FaultActive);
+        assert_eq!(m.command(&c, &abort, &g, 0.0, 8), Reason::None);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Normal
+        );
+    }
+
+    /// A trip: the header says tripped, the end frame carries the sample and current.
+    #[test]
+    fn trip_is_reported_in_the_capture() {
+        let c = cfg();
+        let mut m = CommissioningMode::new();
+        let mut buf = [(0.0f32, 0.0f32); 8];
+        let g = Guards::default();
+        m.command(&c, &step_cmd(), &g, 0.0, 8);
+        let mut k = 0;
+        while let Control::Demand(_) = m.step(
+            &c,
+            &g,
+            &Measured {
+                i_dq: Dq {
+                    d: 0.0,
+                    q: 6.0 * k as f32,
+                },
+                ..Measured::default()
+            },
+            &mut SoftTrig,
+            &mut buf,
+        ) {
+            k += 1;
+        }
+        // 0, 6 A pass; 12 A > 10 A trips at period 2.
+        assert_eq!(k, 2);
+        assert_eq!(m.state(), (State::Streaming, Reason::Tripped));
+        let h = m.next_frame(&c, &buf).unwrap();
+        assert!(p::decode_header(&c.layout, h.bytes()).unwrap().tripped);
+        let mut last = h;
+        while let Some(f) = m.next_frame(&c, &buf) {
+            last = f;
+        }
+        let e = p::decode_end(&c.layout, last.bytes()).unwrap();
+        assert_eq!(e.trip_sample, 2);
+        assert!((e.trip_current - 12.0).abs() < 0.01);
+    }
+}
