@@ -68,8 +68,11 @@ pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// Every motor stem in `motors/`, sorted.
+/// Every motor stem in `motors/`, sorted; `EMULATOR_MOTORS=a,b` restricts the scenarios
+/// to those motors while iterating (CI sets nothing: every motor).
 pub fn motors() -> Vec<String> {
+    let only: Option<Vec<String>> =
+        std::env::var("EMULATOR_MOTORS").ok().map(|v| v.split(',').map(|s| s.trim().to_string()).collect());
     let mut out: Vec<String> = std::fs::read_dir(repo().join("motors"))
         .map(|d| {
             d.filter_map(|e| e.ok().map(|e| e.path()))
@@ -79,6 +82,7 @@ pub fn motors() -> Vec<String> {
         })
         .unwrap_or_default();
     out.sort();
+    out.retain(|m| only.as_ref().is_none_or(|o| o.contains(m)));
     out
 }
 

@@ -102,6 +102,8 @@ pub struct Machine {
     pub handled: Vec<Handled>,
     /// Exceptions the test asked for, raised at the next instruction boundary.
     injected: Vec<u32>,
+    /// The last fault the emulator raised (Unicorn's error, the PC).
+    pub last_fault: Option<String>,
 }
 
 fn uc_err(e: unicorn_engine::unicorn_const::uc_error) -> Stop {
@@ -170,6 +172,7 @@ impl Machine {
             active: Vec::new(),
             handled: Vec::new(),
             injected: Vec::new(),
+            last_fault: None,
         };
         let sp = m.vector(0)?;
         let reset = m.vector(1)?;
@@ -265,6 +268,7 @@ impl Machine {
         let (at, ins) = (soc.now, soc.instructions);
         if n >= 16 {
             soc.scs.set_pending(n - 16, false);
+            soc.irq_active = true;
         }
         self.active.push((n, ins, at));
         Ok(())
@@ -289,6 +293,9 @@ impl Machine {
         self.reg_w(APSR_NZCVQ, xpsr & 0xF800_0000)?;
         self.reg_w(SP, sp + FRAME_BYTES + ((xpsr >> 9) & 1) * 4)?;
         if let Some((n, ins, at)) = self.active.pop() {
+            if n >= 16 {
+                self.uc.get_data_mut().irq_active = false;
+            }
             let exit = self.uc.get_data().instructions;
             self.handled.push(Handled {
                 exception: n,
@@ -341,10 +348,18 @@ impl Machine {
                     if self.uc.get_data().violation.is_some() {
                         continue;
                     }
+                    // The M33 model in secure state raises its exception-exit exception for
+                    // a branch to EXC_RETURN even in thread mode (QEMU's FNC_RETURN /
+                    // EXC_RETURN check): that is the handler's return.
+                    let pc = self.reg(RegisterARM::PC)?;
+                    if !self.active.is_empty() && pc >= 0xFEFF_FFFE {
+                        self.exit()?;
+                        continue;
+                    }
                     // A bus error, undefined instruction or other fault: escalated to
                     // HardFault, as the image enables no configurable fault handler
                     // (ARMv7-M B1.5.14).
-                    let _ = e;
+                    self.last_fault = Some(format!("{e:?} at PC {:#010x}", self.uc.get_data().pc));
                     self.fault()?;
                 }
             }
@@ -385,6 +400,37 @@ impl Machine {
             self.enter(16 + irq)?;
         }
         Ok(())
+    }
+
+    /// A one-line account of the state, for failure messages.
+    pub fn summary(&self) -> String {
+        let s = self.soc();
+        format!(
+            "t = {:.1} µs, PC {:#010x}, {} instructions; TIM1 {} updates {} triggers, MOE {}, SR {:#x}; ADC sequences {}/{}, \
+             missed triggers {}/{}, ADC1 CR {:#x} JSQR {:#x}, TIM1 CR2 {:#x}; NVIC enabled {:#x} pending {:#x}; handlers {:?}; active {:?}; FDCAN accepted {} rejected {}; IWDG refreshes {}; last fault {:?}",
+            s.time_s() * 1e6,
+            s.pc,
+            s.instructions,
+            s.tim1.updates,
+            s.tim1.triggers,
+            s.tim1.moe(),
+            s.tim1.sr(),
+            s.adc[0].sequences,
+            s.adc[1].sequences,
+            s.adc[0].missed_triggers,
+            s.adc[1].missed_triggers,
+            s.adc[0].reg(0x08),
+            s.adc[0].reg(0x4C),
+            s.tim1.reg(0x04),
+            s.scs.enabled[0],
+            s.scs.pending[0],
+            self.handled.iter().map(|h| h.exception).take(8).collect::<Vec<_>>(),
+            self.active,
+            s.fdcan.accepted,
+            s.fdcan.rejected,
+            s.iwdg.refreshes,
+            self.last_fault,
+        )
     }
 
     /// Instructions of each completed handler of exception `n`.

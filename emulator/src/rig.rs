@@ -71,9 +71,9 @@ impl Rig {
     pub fn boot(&mut self, limit_s: f64) -> Result<f64, String> {
         let reached = self
             .run(limit_s, |_| Some(0.0), |m| first_enabled_period(m).is_some())
-            .map_err(|e| e.to_string())?;
+            .map_err(|e| format!("{e}; {}", self.machine.summary()))?;
         if !reached {
-            return Err(format!("no enabled PWM period within {limit_s} s"));
+            return Err(format!("no enabled PWM period within {limit_s} s; {}", self.machine.summary()));
         }
         first_enabled_period(&self.machine).ok_or_else(|| "no enabled period".into())
     }

@@ -123,9 +123,12 @@ pub struct Soc {
     /// Injected faults.
     pub patches: Patches,
     aden_writes: [u32; 2],
-    tim1_cursor: u64,
+    /// TIM1 events before these times (update, trigger) have been delivered.
+    tim1_cursor: [u64; 2],
     /// The watchdog reset the chip at this time \[s\].
     pub watchdog_reset: Option<f64>,
+    /// The control interrupt's handler is running (set by the core).
+    pub irq_active: bool,
 }
 
 /// Which block an address belongs to.
@@ -214,8 +217,9 @@ impl Soc {
             notes: Vec::new(),
             patches,
             aden_writes: [0; 2],
-            tim1_cursor: 0,
+            tim1_cursor: [0; 2],
             watchdog_reset: None,
+            irq_active: false,
         };
         soc.update_clock();
         soc
@@ -349,7 +353,15 @@ impl Soc {
             Block::Scs => self.scs.read(off)?,
         };
         let _ = gate;
+        self.reschedule();
         Ok(v)
+    }
+
+    /// An access may have scheduled an earlier event (a counter started, a conversion
+    /// begun): the running slice ends there.
+    fn reschedule(&mut self) {
+        let next = self.next_event();
+        self.deadline = self.deadline.min(next.max(self.now));
     }
 
     /// A bus write.
@@ -369,7 +381,7 @@ impl Soc {
                 let moe = self.tim1.moe();
                 if off == 0x00 && value & 1 != 0 {
                     self.tim1.tick = (UNITS_PER_S / self.clocks.tim_apb2_hz()).round() as u64;
-                    self.tim1_cursor = t;
+                    self.tim1_cursor = [t; 2];
                 }
                 if off == 0x44 && self.patches.bdtr_lock_second_write {
                     self.patches.bdtr_lock_second_write = false;
@@ -417,6 +429,7 @@ impl Soc {
             },
             Block::Scs => self.scs.write(off, value)?,
         }
+        self.reschedule();
         Ok(())
     }
 
@@ -430,7 +443,9 @@ impl Soc {
                 "no peripheral model at this address (RM0440 §2.2.2 memory map)",
             ));
         };
-        if size != 4 || off % 4 != 0 {
+        // IWDG registers also take half-word accesses (RM0440 §41.4).
+        let half_ok = block == Block::Iwdg && size == 2;
+        if (size != 4 && !half_ok) || off % 4 != 0 {
             return Err(Broken::new(
                 format!("{}+{off:#05x}", block_name(block)),
                 format!("{size}-byte access: only aligned word accesses are modelled"),
@@ -453,10 +468,10 @@ impl Soc {
     /// watchdog), in bus units.
     pub fn next_event(&mut self) -> u64 {
         let mut next = u64::MAX;
-        match self.tim1.next_event(self.tim1_cursor) {
-            Ok(Some((t, _))) => next = next.min(t),
-            Ok(None) => {}
-            Err(b) => self.fail(b),
+        for (k, e) in [TimerEvent::Update, TimerEvent::Trigger].into_iter().enumerate() {
+            if let Some(t) = self.tim1.next(e, self.tim1_cursor[k]) {
+                next = next.min(t);
+            }
         }
         for a in &self.adc {
             if let Some(t) = a.next_event() {
@@ -473,14 +488,12 @@ impl Soc {
     pub fn service(&mut self) {
         loop {
             let now = self.now;
-            let tim = match self.tim1.next_event(self.tim1_cursor) {
-                Ok(Some((t, e))) if t <= now => Some((t, e)),
-                Ok(_) => None,
-                Err(b) => {
-                    self.fail(b);
-                    None
-                }
-            };
+            let tim = [TimerEvent::Update, TimerEvent::Trigger]
+                .into_iter()
+                .enumerate()
+                .filter_map(|(k, e)| self.tim1.next(e, self.tim1_cursor[k]).map(|t| (t, k, e)))
+                .filter(|&(t, _, _)| t <= now)
+                .min_by_key(|&(t, k, _)| (t, k));
             let adc_due = self
                 .adc
                 .iter()
@@ -489,8 +502,8 @@ impl Soc {
                 .filter(|&t| t <= now)
                 .min();
             match (tim, adc_due) {
-                (Some((t, e)), a) if a.is_none_or(|a| t <= a) => {
-                    self.tim1_cursor = t + 1;
+                (Some((t, k, e)), a) if a.is_none_or(|a| t <= a) => {
+                    self.tim1_cursor[k] = t + 1;
                     self.timer_event(t, e);
                 }
                 (_, Some(a)) => self.convert(a),
@@ -503,8 +516,10 @@ impl Soc {
         {
             self.watchdog_reset = Some(t);
         }
+        // A level-sensitive interrupt pends while its line is asserted and it is not
+        // active; still asserted at the handler's return, it pends again (ARMv7-M B3.4.1).
         let line = self.adc.iter().any(Adc::irq);
-        if line {
+        if line && !self.irq_active {
             self.scs.set_pending(IRQ_ADC1_2, true);
         }
     }
@@ -534,7 +549,8 @@ impl Soc {
 
     /// Completes the conversions due at `t` units.
     fn convert(&mut self, t: u64) {
-        let ts = t as f64 / UNITS_PER_S;
+        // Half a unit later: the rank's end time was rounded up to `t` units.
+        let ts = (t as f64 + 0.5) / UNITS_PER_S;
         let vref = self.wiring.vref;
         for k in 0..2 {
             let inputs = self.wiring.adc_inputs[k].clone();

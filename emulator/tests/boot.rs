@@ -28,10 +28,10 @@ fn every_motor_boots_to_its_first_enabled_pwm_period() {
         // Zero torque every setpoint period from reset: frames before the CAN join are lost.
         let reached = rig
             .run(BOOT_LIMIT_S, |_| Some(0.0), |m| enabled(m))
-            .unwrap_or_else(|e| panic!("{motor}: {e}"));
+            .unwrap_or_else(|e| panic!("{motor}: {e}; {}", rig.machine.summary()));
         let m = &rig.machine;
         let soc = m.soc();
-        assert!(reached, "{motor}: no enabled PWM period within {BOOT_LIMIT_S} s");
+        assert!(reached, "{motor}: no enabled PWM period within {BOOT_LIMIT_S} s; {}", rig.machine.summary());
         let first_isr = m
             .handled
             .iter()

@@ -14,6 +14,8 @@ const JADSTART: u32 = 1 << 3;
 const ADVREGEN: u32 = 1 << 28;
 const DEEPPWD: u32 = 1 << 29;
 const ADCAL: u32 = 1 << 31;
+/// The set-only bits of ADC_CR.
+const RS_BITS: u32 = ADCAL | 0x3F;
 /// ADC_ISR bits (RM0440 §21.7.1).
 const ADRDY: u32 = 1;
 const JEOC: u32 = 1 << 5;
@@ -101,7 +103,8 @@ impl Adc {
         }
     }
 
-    fn reg(&self, off: u32) -> u32 {
+    /// A register's value (no side effect), for reports.
+    pub fn reg(&self, off: u32) -> u32 {
         self.regs[(off / 4) as usize]
     }
 
@@ -263,17 +266,19 @@ impl Adc {
     fn write_cr(&mut self, value: u32, now: f64, adc_clock_s: Option<f64>) -> Result<(), Broken> {
         let old = self.reg(0x08);
         let reg = self.r(0x08);
-        let set = value & !old;
-        if old & ADCAL != 0 && value != old {
+        if old & ADCAL != 0 && value & !RS_BITS != old & !RS_BITS {
             return Err(Broken::new(reg, "ADC_CR written during calibration (ADCAL = 1, RM0440 §21.4.8)"));
         }
+        // ADCAL, JADSTP, ADSTP, JADSTART, ADSTART, ADDIS, ADEN are set-only ("rs": writing
+        // 0 has no effect, RM0440 §21.7.3); ADVREGEN, DEEPPWD, ADCALDIF read/write.
+        let mut v = (value & !RS_BITS) | (old & RS_BITS) | (value & RS_BITS);
+        let set = v & !old;
         if set & ADVREGEN != 0 && value & DEEPPWD != 0 {
             return Err(Broken::new(
                 reg,
                 "ADVREGEN set while DEEPPWD = 1: leave deep power-down first (RM0440 §21.4.6)",
             ));
         }
-        let mut v = value;
         if set & ADVREGEN != 0 {
             self.vreg_since = Some(now);
         }

@@ -86,7 +86,8 @@ impl Tim1 {
         }
     }
 
-    fn reg(&self, off: u32) -> u32 {
+    /// A register's value (no side effect), for reports.
+    pub fn reg(&self, off: u32) -> u32 {
         self.regs[(off / 4) as usize]
     }
 
@@ -188,27 +189,20 @@ impl Tim1 {
         Ok(None)
     }
 
-    /// The next counter event at or after `from` sub-ticks: (time, event).
-    pub fn next_event(&self, from: u64) -> Result<Option<(u64, TimerEvent)>, Broken> {
-        let Some(start) = self.started_at else {
-            return Ok(None);
-        };
+    /// The next `event` at or after `from` (bus units).
+    pub fn next(&self, event: TimerEvent, from: u64) -> Option<u64> {
+        let start = self.started_at?;
         let p = self.period_ticks() * self.tick;
         if p == 0 {
-            return Ok(None);
+            return None;
         }
-        let k = from.saturating_sub(start) / p;
-        let mut best: Option<(u64, TimerEvent)> = None;
-        for kk in [k, k + 1] {
-            let base = start + kk * p;
-            let trig = self.trig_phase.map(|ph| (base + ph * self.tick, TimerEvent::Trigger));
-            for (t, e) in [Some((base + p, TimerEvent::Update)), trig].into_iter().flatten() {
-                if t >= from && best.is_none_or(|(bt, _)| t < bt) {
-                    best = Some((t, e));
-                }
-            }
-        }
-        Ok(best)
+        let offset = match event {
+            TimerEvent::Update => p,
+            TimerEvent::Trigger => self.trig_phase? * self.tick,
+        };
+        let k = from.saturating_sub(start + offset).div_ceil(p);
+        let t = start + offset + k * p;
+        Some(if t < from { t + p } else { t })
     }
 
     /// The update event: preloaded compare values become active (OCxPE, RM0440
