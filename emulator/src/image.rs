@@ -33,7 +33,9 @@ impl Image {
             if ph.p_type(endian) != object::elf::PT_LOAD || ph.p_filesz(endian) == 0 {
                 continue;
             }
-            let data = ph.data(endian, bytes).map_err(|()| "segment outside the file".to_string())?;
+            let data = ph
+                .data(endian, bytes)
+                .map_err(|()| "segment outside the file".to_string())?;
             segments.push((ph.p_paddr(endian), data.to_vec()));
         }
         let flash = segments
@@ -71,8 +73,9 @@ pub fn repo() -> PathBuf {
 /// Every motor stem in `motors/`, sorted; `EMULATOR_MOTORS=a,b` restricts the scenarios
 /// to those motors while iterating (CI sets nothing: every motor).
 pub fn motors() -> Vec<String> {
-    let only: Option<Vec<String>> =
-        std::env::var("EMULATOR_MOTORS").ok().map(|v| v.split(',').map(|s| s.trim().to_string()).collect());
+    let only: Option<Vec<String>> = std::env::var("EMULATOR_MOTORS")
+        .ok()
+        .map(|v| v.split(',').map(|s| s.trim().to_string()).collect());
     let mut out: Vec<String> = std::fs::read_dir(repo().join("motors"))
         .map(|d| {
             d.filter_map(|e| e.ok().map(|e| e.path()))
@@ -112,7 +115,9 @@ fn inputs_hash(motor: &str) -> u64 {
         for e in rd.flatten() {
             let p = e.path();
             if p.is_dir() {
-                if p.file_name().is_some_and(|n| n != "target" && n != "tests" && n != "benches") {
+                if p.file_name()
+                    .is_some_and(|n| n != "target" && n != "tests" && n != "benches")
+                {
                     walk(&p, out);
                 }
             } else {
@@ -122,10 +127,22 @@ fn inputs_hash(motor: &str) -> u64 {
     }
     let repo = repo();
     let mut files = Vec::new();
-    for d in ["firmware/app", "firmware/config", "firmware/control", "codegen/src", "templates", "boards"] {
+    for d in [
+        "firmware/app",
+        "firmware/config",
+        "firmware/control",
+        "codegen/src",
+        "templates",
+        "boards",
+    ] {
         walk(&repo.join(d), &mut files);
     }
-    for f in ["Cargo.lock", "firmware/Cargo.lock", "firmware/Cargo.toml", "rust-toolchain.toml"] {
+    for f in [
+        "Cargo.lock",
+        "firmware/Cargo.lock",
+        "firmware/Cargo.toml",
+        "rust-toolchain.toml",
+    ] {
         files.push(repo.join(f));
     }
     files.push(repo.join("motors").join(format!("{motor}.toml")));

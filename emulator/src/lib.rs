@@ -116,7 +116,8 @@ impl Machine {
     pub fn new(image: &Image, soc: Soc) -> Result<Self, Stop> {
         let mut uc = Unicorn::new_with_data(Arch::ARM, Mode::THUMB | Mode::MCLASS, soc).map_err(uc_err)?;
         for (base, len) in [FLASH, (0, FLASH.1)] {
-            uc.mem_map(base, len, Permission::READ | Permission::EXEC).map_err(uc_err)?;
+            uc.mem_map(base, len, Permission::READ | Permission::EXEC)
+                .map_err(uc_err)?;
         }
         for (base, len) in [SRAM, CCM] {
             uc.mem_map(base, len, Permission::ALL).map_err(uc_err)?;
@@ -186,9 +187,7 @@ impl Machine {
         let vtor = self.uc.get_data().scs.vtor();
         if vtor != 0 && vtor != FLASH.0 as u32 {
             let mut b = [0; 4];
-            self.uc
-                .mem_read(u64::from(vtor + 4 * n), &mut b)
-                .map_err(uc_err)?;
+            self.uc.mem_read(u64::from(vtor + 4 * n), &mut b).map_err(uc_err)?;
             return Ok(u32::from_le_bytes(b));
         }
         self.vectors
@@ -286,7 +285,9 @@ impl Machine {
         let xpsr = self.read_word(sp + 28)?;
         for k in 0..16u32 {
             let v = self.read_word(sp + 32 + 4 * k)?;
-            self.uc.reg_write(i32::from(S0) + k as i32, u64::from(v)).map_err(uc_err)?;
+            self.uc
+                .reg_write(i32::from(S0) + k as i32, u64::from(v))
+                .map_err(uc_err)?;
         }
         let fpscr = self.read_word(sp + 96)?;
         self.reg_w(FPSCR, fpscr)?;
@@ -315,7 +316,8 @@ impl Machine {
     /// Runs until `seconds` or until `go_on` returns false (checked at every event);
     /// returns whether `go_on` stopped it.
     pub fn run_while(&mut self, seconds: f64, mut go_on: impl FnMut(&Self) -> bool) -> Result<bool, Stop> {
-        let end = (seconds * UNITS_PER_S) as u64;
+        // Rounded up, so that the time reached is at least `seconds`.
+        let end = (seconds * UNITS_PER_S).ceil() as u64;
         loop {
             {
                 let soc = self.uc.get_data_mut();

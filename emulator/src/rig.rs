@@ -73,7 +73,10 @@ impl Rig {
             .run(limit_s, |_| Some(0.0), |m| first_enabled_period(m).is_some())
             .map_err(|e| format!("{e}; {}", self.machine.summary()))?;
         if !reached {
-            return Err(format!("no enabled PWM period within {limit_s} s; {}", self.machine.summary()));
+            return Err(format!(
+                "no enabled PWM period within {limit_s} s; {}",
+                self.machine.summary()
+            ));
         }
         first_enabled_period(&self.machine).ok_or_else(|| "no enabled period".into())
     }
@@ -102,12 +105,13 @@ impl Rig {
         mut torque: impl FnMut(f64) -> Option<f64>,
         mut stop: impl FnMut(&Machine) -> bool,
     ) -> Result<bool, Stop> {
+        // Times compared in bus units, rounded up as `run_while` rounds its end.
+        let reached = |m: &Machine, x: f64| m.soc().now >= (x * crate::UNITS_PER_S).ceil() as u64;
         loop {
-            let t = self.machine.soc().time_s();
-            if t >= until_s {
+            if reached(&self.machine, until_s) {
                 return Ok(false);
             }
-            if t >= self.next_frame_s {
+            if reached(&self.machine, self.next_frame_s) {
                 if let Some(nm) = torque(self.next_frame_s) {
                     let f = self.setpoint(nm);
                     self.send(&f);

@@ -151,10 +151,13 @@ enum Block {
     Scs,
 }
 
+/// An RCC enable register and bit.
+type Gate = Option<(u32, u32)>;
+
 /// Address map (RM0440 §2.2.2, Table 4) and RCC enable bit of each block (RM0440 §7.4).
-fn decode(addr: u32) -> Option<(Block, u32, Option<(u32, u32)>)> {
+fn decode(addr: u32) -> Option<(Block, u32, Gate)> {
     let b = |base: u32, len: u32| (base..base + len).contains(&addr).then_some(addr - base);
-    let table: [(u32, u32, Block, Option<(u32, u32)>); 17] = [
+    let table: [(u32, u32, Block, Gate); 17] = [
         (0x4000_0400, 0x400, Block::Tim3, Some((APB1ENR1, 1))),
         (0x4000_3000, 0x400, Block::Iwdg, None),
         (0x4000_6400, 0x400, Block::Fdcan, Some((APB1ENR1, 25))),
@@ -436,7 +439,7 @@ impl Soc {
     /// Decodes an address and checks the access: a known block, whole words, its clock
     /// enabled (RM0440 §7.4: with the enable bit clear the peripheral's registers are
     /// not clocked and cannot be accessed).
-    fn route(&mut self, addr: u32, size: usize) -> Result<(Block, u32, Option<(u32, u32)>), Broken> {
+    fn route(&mut self, addr: u32, size: usize) -> Result<(Block, u32, Gate), Broken> {
         let Some((block, off, gate)) = decode(addr) else {
             return Err(Broken::new(
                 format!("{addr:#010x}"),

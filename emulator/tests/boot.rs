@@ -19,19 +19,19 @@ const BOOT_LIMIT_S: f64 = 0.05;
 fn every_motor_boots_to_its_first_enabled_pwm_period() {
     for motor in motors() {
         let mut rig = Rig::new(&motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
-        let enabled = |m: &motor_emulator::Machine| {
-            m.soc()
-                .notes
-                .iter()
-                .any(|n| matches!(n, Note::FirstEnabledPeriod(_)))
-        };
+        let enabled =
+            |m: &motor_emulator::Machine| m.soc().notes.iter().any(|n| matches!(n, Note::FirstEnabledPeriod(_)));
         // Zero torque every setpoint period from reset: frames before the CAN join are lost.
         let reached = rig
             .run(BOOT_LIMIT_S, |_| Some(0.0), |m| enabled(m))
             .unwrap_or_else(|e| panic!("{motor}: {e}; {}", rig.machine.summary()));
         let m = &rig.machine;
         let soc = m.soc();
-        assert!(reached, "{motor}: no enabled PWM period within {BOOT_LIMIT_S} s; {}", rig.machine.summary());
+        assert!(
+            reached,
+            "{motor}: no enabled PWM period within {BOOT_LIMIT_S} s; {}",
+            rig.machine.summary()
+        );
         let first_isr = m
             .handled
             .iter()
@@ -62,10 +62,16 @@ fn every_motor_boots_to_its_first_enabled_pwm_period() {
         // the self-tests on the accelerators.
         assert!(soc.adc[0].sequences > 0 && soc.adc[1].sequences > 0, "{motor}");
         assert!(soc.tim3.slave_resets > 0, "{motor}: TIM3 never reset by TIM1's TRGO");
-        assert!(soc.cordic.calculations >= 16, "{motor}: the CORDIC self-test did not run");
+        assert!(
+            soc.cordic.calculations >= 16,
+            "{motor}: the CORDIC self-test did not run"
+        );
         assert!(soc.tim1.moe(), "{motor}: MOE not set");
         assert!(soc.iwdg.expires_at.is_some(), "{motor}: the watchdog was not started");
-        assert_eq!(soc.adc[0].missed_triggers, 0, "{motor}: a trigger came during a conversion");
+        assert_eq!(
+            soc.adc[0].missed_triggers, 0,
+            "{motor}: a trigger came during a conversion"
+        );
     }
 }
 
@@ -84,7 +90,10 @@ fn lock_in_a_second_bdtr_write_is_refused_with_the_rule() {
     };
     println!("{v}");
     assert_eq!(v.register, "TIM1_BDTR");
-    assert!(v.rule.contains("LOCK written again") && v.rule.contains("RM0440 §28.6.20"), "{v}");
+    assert!(
+        v.rule.contains("LOCK written again") && v.rule.contains("RM0440 §28.6.20"),
+        "{v}"
+    );
 }
 
 /// Review defect 1 reintroduced: ADEN written once after calibration and then only
@@ -100,7 +109,10 @@ fn aden_written_once_after_calibration_is_refused_with_the_rule() {
     let mut rig = Rig::new("fischer-ti085", patches).unwrap();
     let result = rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false);
     let lost = rig.machine.soc().adc.iter().map(|a| a.lost_aden_writes).sum::<u32>();
-    assert!(lost > 0, "the image's first ADEN write was not within the 4-cycle window: {result:?}");
+    assert!(
+        lost > 0,
+        "the image's first ADEN write was not within the 4-cycle window: {result:?}"
+    );
     let Err(Stop::Violation(v)) = result else {
         panic!("expected a strict-mode violation, got {result:?}");
     };
@@ -126,12 +138,19 @@ fn control_interrupt_instructions_fit_the_period() {
         rig.run(end, |_| Some(torque), |_| false)
             .unwrap_or_else(|e| panic!("{motor}: {e}"));
         let counts = &rig.machine.handler_instructions(CONTROL_IRQ)[before..];
-        assert!(counts.len() >= 190, "{motor}: {} interrupts in 200 periods", counts.len());
+        assert!(
+            counts.len() >= 190,
+            "{motor}: {} interrupts in 200 periods",
+            counts.len()
+        );
         let (min, max) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
         let mean = counts.iter().sum::<u64>() as f64 / counts.len() as f64;
         // 170 MHz SYSCLK (firmware/config/src/hw.rs, DS12288 §3.9).
         let cycles = 170e6 / rig.design.drive.switching_frequency_hz;
-        assert!((*max as f64) < cycles, "{motor}: {max} instructions, {cycles} cycles per period");
+        assert!(
+            (*max as f64) < cycles,
+            "{motor}: {max} instructions, {cycles} cycles per period"
+        );
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
              {:.1} % of the {cycles:.0} cycles of a period",

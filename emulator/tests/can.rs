@@ -55,12 +55,23 @@ fn setpoints_drive_and_silence_ramps_to_off_in_the_designed_time() {
             .unwrap_or_else(|e| panic!("{motor}: {e}"));
         let soc = rig.machine.soc();
         assert!(soc.tim1.moe(), "{motor}: off while setpoints arrive");
-        let moved = soc.tim1.compare().iter().map(|&c| (f64::from(c) - half).abs()).fold(0.0, f64::max);
-        assert!(moved > 1.0, "{motor}: compare values stayed at {half} under a torque setpoint");
+        let moved = soc
+            .tim1
+            .compare()
+            .iter()
+            .map(|&c| (f64::from(c) - half).abs())
+            .fold(0.0, f64::max);
+        assert!(
+            moved > 1.0,
+            "{motor}: compare values stayed at {half} under a torque setpoint"
+        );
 
         // Silence: on until the timeout, off after the timeout plus at most the ramp.
         let dt = off_after_silence(&mut rig, &motor, &[]);
-        assert!(dt >= b.setpoint_timeout_s - period, "{motor}: off {dt} s after the last frame");
+        assert!(
+            dt >= b.setpoint_timeout_s - period,
+            "{motor}: off {dt} s after the last frame"
+        );
         assert!(
             dt <= b.setpoint_timeout_s + b.setpoint_ramp_s + 2.0 * period + b.setpoint_period_s,
             "{motor}: off only {dt} s after the last frame"
@@ -107,7 +118,10 @@ fn malformed_frames_are_ignored() {
         // RXGFC (ANFE = reject, RRFS = 1).
         assert!(fdcan.accepted > accepted_before, "{motor}: the image read no frame");
         assert!(fdcan.rejected > 0, "{motor}: no frame rejected by the filters");
-        assert_eq!(fdcan.lost, 0, "{motor}: RX FIFO 0 overflowed: the main loop did not read it");
+        assert_eq!(
+            fdcan.lost, 0,
+            "{motor}: RX FIFO 0 overflowed: the main loop did not read it"
+        );
         assert!(
             dt >= b.setpoint_timeout_s - period,
             "{motor}: a malformed frame was taken as a setpoint? off after {dt} s"

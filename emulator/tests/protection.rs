@@ -14,7 +14,8 @@ fn booted(motor: &str) -> Rig {
     rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
     // A few enabled periods.
     let t = rig.machine.soc().time_s() + 5.0 * rig.pwm_period_s();
-    rig.run(t, |_| Some(0.0), |_| false).unwrap_or_else(|e| panic!("{motor}: {e}"));
+    rig.run(t, |_| Some(0.0), |_| false)
+        .unwrap_or_else(|e| panic!("{motor}: {e}"));
     assert!(rig.machine.soc().tim1.moe(), "{motor}: outputs not on before the test");
     rig
 }
@@ -106,7 +107,11 @@ fn hard_fault_switches_the_gates_off_and_the_watchdog_resets() {
         assert!(!soc.tim1.moe(), "{motor}: MOE still set after the HardFault");
         for g in soc.wiring.gates {
             let port = &soc.gpio[usize::from(g.port)];
-            assert_eq!(port.mode(g.number), Mode::Output, "{motor}: gate pin {g:?} not a GPIO output");
+            assert_eq!(
+                port.mode(g.number),
+                Mode::Output,
+                "{motor}: gate pin {g:?} not a GPIO output"
+            );
             assert!(!port.odr(g.number), "{motor}: gate pin {g:?} high");
         }
         // The handler started the watchdog with its reset timeout (≈ 0.5 s) or kept
@@ -135,7 +140,14 @@ fn stalled_control_interrupt_ends_in_a_watchdog_reset() {
         // One IWDG count at the largest prescaler the image could choose is 4·2^6/32 kHz = 8 ms.
         let dt = t - t0;
         assert!(dt >= timeout - 2.0 * period, "{motor}: reset {dt} s after the stall");
-        assert!(dt <= timeout * 1.25 + period, "{motor}: reset {dt} s after the stall (timeout {timeout} s)");
-        println!("{motor}: stall → watchdog reset after {:.3} ms (timeout {:.3} ms)", dt * 1e3, timeout * 1e3);
+        assert!(
+            dt <= timeout * 1.25 + period,
+            "{motor}: reset {dt} s after the stall (timeout {timeout} s)"
+        );
+        println!(
+            "{motor}: stall → watchdog reset after {:.3} ms (timeout {:.3} ms)",
+            dt * 1e3,
+            timeout * 1e3
+        );
     }
 }

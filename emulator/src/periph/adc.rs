@@ -267,7 +267,10 @@ impl Adc {
         let old = self.reg(0x08);
         let reg = self.r(0x08);
         if old & ADCAL != 0 && value & !RS_BITS != old & !RS_BITS {
-            return Err(Broken::new(reg, "ADC_CR written during calibration (ADCAL = 1, RM0440 §21.4.8)"));
+            return Err(Broken::new(
+                reg,
+                "ADC_CR written during calibration (ADCAL = 1, RM0440 §21.4.8)",
+            ));
         }
         // ADCAL, JADSTP, ADSTP, JADSTART, ADSTART, ADDIS, ADEN are set-only ("rs": writing
         // 0 has no effect, RM0440 §21.7.3); ADVREGEN, DEEPPWD, ADCALDIF read/write.
@@ -287,7 +290,10 @@ impl Adc {
         }
         if set & ADCAL != 0 {
             let Some(clk) = adc_clock_s else {
-                return Err(Broken::new(reg, "ADCAL with no ADC clock (ADC12_CCR.CKMODE, RM0440 §21.4.3)"));
+                return Err(Broken::new(
+                    reg,
+                    "ADCAL with no ADC clock (ADC12_CCR.CKMODE, RM0440 §21.4.3)",
+                ));
             };
             let ready = self.vreg_since.is_some_and(|t| now - t >= VREG_STARTUP_S - 1e-12);
             if !ready {
@@ -300,7 +306,10 @@ impl Adc {
                 ));
             }
             if old & ADEN != 0 {
-                return Err(Broken::new(reg, "ADCAL with ADEN = 1: calibrate a disabled ADC (RM0440 §21.4.8)"));
+                return Err(Broken::new(
+                    reg,
+                    "ADCAL with ADEN = 1: calibrate a disabled ADC (RM0440 §21.4.8)",
+                ));
             }
             self.cal_until = Some(now + CALIBRATION_CYCLES * clk);
         }
@@ -317,7 +326,10 @@ impl Adc {
                 self.lost_aden_polls = Some(0);
             } else {
                 if self.vreg_since.is_none() {
-                    return Err(Broken::new(reg, "ADEN with the regulator off (ADVREGEN = 0, RM0440 §21.4.9)"));
+                    return Err(Broken::new(
+                        reg,
+                        "ADEN with the regulator off (ADVREGEN = 0, RM0440 §21.4.9)",
+                    ));
                 }
                 self.lost_aden_polls = None;
                 // ADRDY once the ADC is ready (t_STAB not modelled: at once).

@@ -130,18 +130,27 @@ impl Fdcan {
             0x94 => {
                 let ai = value & 7;
                 if ai >= RX_ELEMENTS || self.fill == 0 {
-                    return Err(Broken::new("FDCAN1_RXF0A", "acknowledge of an element not in RX FIFO 0"));
+                    return Err(Broken::new(
+                        "FDCAN1_RXF0A",
+                        "acknowledge of an element not in RX FIFO 0",
+                    ));
                 }
                 let n = (ai + RX_ELEMENTS - self.get) % RX_ELEMENTS + 1;
                 if n > self.fill {
-                    return Err(Broken::new("FDCAN1_RXF0A", "acknowledge index beyond the fill level (RM0440 §44.4.22)"));
+                    return Err(Broken::new(
+                        "FDCAN1_RXF0A",
+                        "acknowledge index beyond the fill level (RM0440 §44.4.22)",
+                    ));
                 }
                 self.fill -= n;
                 self.get = (ai + 1) % RX_ELEMENTS;
                 self.regs[0x94 / 4] = ai;
             }
             0x90 | 0x98 | 0x00 | 0x04 | 0x44 => {
-                return Err(Broken::new(format!("FDCAN1+{off:#04x}"), "read-only register (RM0440 §44.4)"));
+                return Err(Broken::new(
+                    format!("FDCAN1+{off:#04x}"),
+                    "read-only register (RM0440 §44.4)",
+                ));
             }
             _ => self.regs[(off / 4) as usize] = value,
         }
@@ -208,7 +217,11 @@ impl Fdcan {
         }
         let put = (self.get + self.fill) % RX_ELEMENTS;
         let base = ((RXF0 + put * RX_ELEMENT_BYTES) / 4) as usize;
-        let id = if f.extended { f.id & 0x1FFF_FFFF } else { (f.id & 0x7FF) << 18 };
+        let id = if f.extended {
+            f.id & 0x1FFF_FFFF
+        } else {
+            (f.id & 0x7FF) << 18
+        };
         self.ram[base] = id | (u32::from(f.extended) << 30) | (u32::from(f.remote) << 29);
         self.ram[base + 1] = (f.data.len().min(8) as u32) << 16;
         let mut bytes = [0u8; 8];

@@ -74,7 +74,7 @@ impl Port {
         match off {
             0x10 => Ok(idr),
             0x18 | 0x28 => Ok(0),
-            0x00..=0x24 if off % 4 == 0 => Ok(self.regs[(off / 4) as usize]),
+            0x00..=0x24 if off.is_multiple_of(4) => Ok(self.regs[(off / 4) as usize]),
             _ => Err(unknown(name, off)),
         }
     }
@@ -93,7 +93,7 @@ impl Port {
             0x10 => {
                 return Err(Broken::new(format!("{name}_IDR"), "IDR is read-only (RM0440 §9.4.5)"));
             }
-            0x00..=0x24 if off % 4 == 0 => self.regs[(off / 4) as usize] = value,
+            0x00..=0x24 if off.is_multiple_of(4) => self.regs[(off / 4) as usize] = value,
             _ => return Err(unknown(name, off)),
         }
         Ok(())

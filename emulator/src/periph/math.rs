@@ -51,7 +51,10 @@ impl Cordic {
         match off {
             0x00 => {
                 if value & (3 << 21) != 0 {
-                    return Err(Broken::new("CORDIC_CSR", "16-bit ARGSIZE/RESSIZE not modelled (RM0440 §17.4.1)"));
+                    return Err(Broken::new(
+                        "CORDIC_CSR",
+                        "16-bit ARGSIZE/RESSIZE not modelled (RM0440 §17.4.1)",
+                    ));
                 }
                 self.csr = value & !(1 << 31);
                 self.args.clear();
@@ -129,11 +132,14 @@ impl Fmac {
             0x14 => Ok(u32::from(self.y.is_empty())),
             0x1C => {
                 if self.y.is_empty() {
-                    return Err(Broken::new("FMAC_RDATA", "read with Y empty (YEMPTY = 1, RM0440 §18.3.7)"));
+                    return Err(Broken::new(
+                        "FMAC_RDATA",
+                        "read with Y empty (YEMPTY = 1, RM0440 §18.3.7)",
+                    ));
                 }
                 Ok(u32::from(self.y.remove(0) as u16))
             }
-            0x00..=0x18 if off % 4 == 0 => Ok(self.regs[(off / 4) as usize]),
+            0x00..=0x18 if off.is_multiple_of(4) => Ok(self.regs[(off / 4) as usize]),
             _ => Err(unknown("FMAC", off)),
         }
     }
@@ -157,7 +163,7 @@ impl Fmac {
                 Ok(())
             }
             0x1C => Err(Broken::new("FMAC_RDATA", "read-only (RM0440 §18.4.8)")),
-            0x00..=0x08 if off % 4 == 0 => {
+            0x00..=0x08 if off.is_multiple_of(4) => {
                 self.regs[(off / 4) as usize] = value;
                 Ok(())
             }
@@ -195,7 +201,12 @@ impl Fmac {
                 self.fir_taps = p;
                 self.load_left = 0;
             }
-            f => return Err(Broken::new("FMAC_PARAM", format!("FUNC {f} not modelled (RM0440 §18.4.4)"))),
+            f => {
+                return Err(Broken::new(
+                    "FMAC_PARAM",
+                    format!("FUNC {f} not modelled (RM0440 §18.4.4)"),
+                ));
+            }
         }
         if self.load_left == 0 && func != 8 {
             self.regs[PARAM] &= !(1 << 31);

@@ -106,7 +106,7 @@ impl Syscfg {
     /// Register read.
     pub fn read(&mut self, off: u32) -> Result<u32, Broken> {
         match off {
-            0x00..=0x24 if off % 4 == 0 => Ok(self.regs[(off / 4) as usize]),
+            0x00..=0x24 if off.is_multiple_of(4) => Ok(self.regs[(off / 4) as usize]),
             _ => Err(unknown("SYSCFG", off)),
         }
     }
@@ -119,7 +119,7 @@ impl Syscfg {
                 let i = 7;
                 self.regs[i] = (self.regs[i] & 0xF) | (value & 0xF);
             }
-            0x00..=0x24 if off % 4 == 0 => self.regs[(off / 4) as usize] = value,
+            0x00..=0x24 if off.is_multiple_of(4) => self.regs[(off / 4) as usize] = value,
             _ => return Err(unknown("SYSCFG", off)),
         }
         Ok(())

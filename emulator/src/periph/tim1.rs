@@ -155,7 +155,7 @@ impl Tim1 {
     /// PWM mode 1 active while CNT < CCR, mode 2 the inverse (RM0440 §28.6.7, OCxM).
     fn oc_ref(&self, ch: usize, cnt: u32) -> Option<bool> {
         let ccmr = self.reg(if ch < 2 { 0x18 } else { 0x1C });
-        let shift = if ch % 2 == 0 { 4 } else { 12 };
+        let shift = if ch.is_multiple_of(2) { 4 } else { 12 };
         let mode = ((ccmr >> shift) & 7) | (((ccmr >> (shift + 12)) & 1) << 3);
         let ccr = self.active_ccr[ch];
         match mode {
@@ -177,7 +177,10 @@ impl Tim1 {
         let arr = u64::from(self.arr);
         let cnt = |ph: u64| (if ph <= arr { ph } else { p - ph }) as u32;
         let mut prev = self.oc_ref(3, cnt(p - 1)).ok_or_else(|| {
-            Broken::new("TIM1_CCMR2", "OC4M not in PWM mode 1/2 or forced: trigger source not modelled")
+            Broken::new(
+                "TIM1_CCMR2",
+                "OC4M not in PWM mode 1/2 or forced: trigger source not modelled",
+            )
         })?;
         for ph in 0..p {
             let now = self.oc_ref(3, cnt(ph)).unwrap_or(false);
@@ -238,7 +241,9 @@ impl Tim1 {
             }
             let dead = u64::from(crate::periph::dead_time_ticks(self.bdtr() as u8)) * self.tick;
             let now = self.oc_ref(ch, self.counter_at(t)).unwrap_or(false);
-            let before = self.oc_ref(ch, self.counter_at(t.saturating_sub(dead))).unwrap_or(false);
+            let before = self
+                .oc_ref(ch, self.counter_at(t.saturating_sub(dead)))
+                .unwrap_or(false);
             out[ch] = e && now && before;
             out[ch + 3] = ne && !now && !before;
         }
