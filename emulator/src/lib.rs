@@ -1,0 +1,446 @@
+//! Test-only harness: the built STM32G474 image (`target/firmware/<motor>.elf`) run from
+//! its reset vector on the Unicorn engine (QEMU's TCG Cortex-M), with register models of
+//! the peripherals it touches ([`periph`]) behind a strict bus ([`soc`]): an access to a
+//! register no model knows, a peripheral touched before its clock is enabled, or a
+//! sequence RM0440 forbids stops the run with the PC, the register and the rule
+//! ([`Violation`]).
+//!
+//! Time is instructions: one instruction per HCLK cycle (the Cortex-M4's pipeline,
+//! flash wait states and the FPU's multi-cycle operations are not timed), so a duration
+//! here is a lower bound of the silicon's. The NVIC's exception entry and return are
+//! done by the harness ([`Machine`]): Unicorn has no NVIC.
+//!
+//! Licences: this crate's source is the workspace's; its test binaries link Debian's
+//! GPL-2.0 `libunicorn`. It is never a dependency of `codegen`/`motorgen` or of the image.
+
+pub mod image;
+pub mod periph;
+pub mod rig;
+pub mod soc;
+pub mod violation;
+pub mod wiring;
+
+use unicorn_engine::unicorn_const::{Arch, Mode, Permission};
+use unicorn_engine::{RegisterARM, Unicorn};
+
+pub use periph::fdcan::Frame;
+pub use soc::{Analog, Note, Patches, Soc, UNITS_PER_S, Wiring};
+pub use violation::Violation;
+
+use image::Image;
+
+/// Flash, its boot alias at 0 (RM0440 §2.6: boot from main flash aliases it at 0), SRAM1 +
+/// SRAM2 + the CCM SRAM's alias as one 128 KiB block (RM0440 §2.3), the CCM SRAM at its own
+/// address (not coherent with its alias in this model) — and the MMIO windows.
+const FLASH: (u64, usize) = (0x0800_0000, 512 * 1024);
+const SRAM: (u64, usize) = (0x2000_0000, 128 * 1024);
+const CCM: (u64, usize) = (0x1000_0000, 32 * 1024);
+const MMIO: [(u64, usize); 4] = [
+    (0x4000_0000, 0x3_0000),
+    (0x4800_0000, 0x2000),
+    (0x5000_0000, 0x1000),
+    (0xE000_0000, 0x10_0000),
+];
+
+/// EXC_RETURN for a return to thread mode on the main stack with an extended (FP)
+/// frame (ARMv7-M B1.5.8, Table B1-8: 0xFFFF_FFE9).
+const EXC_RETURN: u32 = 0xFFFF_FFE9;
+/// Bytes of an extended exception frame: R0–R3, R12, LR, PC, xPSR, S0–S15, FPSCR and
+/// one reserved word (ARMv7-M B1.5.7).
+const FRAME_BYTES: u32 = 0x68;
+/// Cycles from an exception's assertion to its handler's first instruction (Cortex-M4
+/// TRM r0p1 §3.3.1 "Interrupt latency": 12 cycles with zero-wait-state memory).
+const ENTRY_CYCLES: u64 = 12;
+
+/// Exception numbers (ARMv7-M B1.5.2).
+pub const HARD_FAULT: u32 = 3;
+
+/// Why a run stopped early.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stop {
+    /// A strict-mode rule was broken.
+    Violation(Violation),
+    /// The independent watchdog reset the chip at this time \[s\].
+    WatchdogReset(f64),
+    /// A fault inside the HardFault handler: the core locked up (ARMv7-M B1.5.15) at
+    /// this time \[s\].
+    Lockup(f64),
+    /// The emulator failed outside any modelled behaviour.
+    Emulator(String),
+}
+
+impl std::fmt::Display for Stop {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Stop::Violation(v) => write!(f, "{v}"),
+            Stop::WatchdogReset(t) => write!(f, "watchdog reset at t = {:.3} ms", t * 1e3),
+            Stop::Lockup(t) => write!(f, "core lockup at t = {:.3} ms", t * 1e3),
+            Stop::Emulator(e) => write!(f, "emulator: {e}"),
+        }
+    }
+}
+
+/// One handled exception: number, entry and exit instruction counts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Handled {
+    /// Exception number (16 + IRQ for interrupts).
+    pub exception: u32,
+    /// Instructions executed before entry.
+    pub entry: u64,
+    /// Instructions executed at return.
+    pub exit: u64,
+    /// Time of entry in bus units.
+    pub at: u64,
+}
+
+/// The image on the emulated chip.
+pub struct Machine {
+    uc: Unicorn<'static, Soc>,
+    vectors: Vec<u32>,
+    active: Vec<(u32, u64, u64)>,
+    /// Every exception handled so far.
+    pub handled: Vec<Handled>,
+    /// Exceptions the test asked for, raised at the next instruction boundary.
+    injected: Vec<u32>,
+    /// The last fault the emulator raised (Unicorn's error, the PC).
+    pub last_fault: Option<String>,
+}
+
+fn uc_err(e: unicorn_engine::unicorn_const::uc_error) -> Stop {
+    Stop::Emulator(format!("{e:?}"))
+}
+
+impl Machine {
+    /// Loads `image` and resets the core: SP and PC from the vector table (ARMv7-M
+    /// B1.5.5).
+    pub fn new(image: &Image, soc: Soc) -> Result<Self, Stop> {
+        let mut uc = Unicorn::new_with_data(Arch::ARM, Mode::THUMB | Mode::MCLASS, soc).map_err(uc_err)?;
+        for (base, len) in [FLASH, (0, FLASH.1)] {
+            uc.mem_map(base, len, Permission::READ | Permission::EXEC)
+                .map_err(uc_err)?;
+        }
+        for (base, len) in [SRAM, CCM] {
+            uc.mem_map(base, len, Permission::ALL).map_err(uc_err)?;
+        }
+        for (seg_addr, bytes) in &image.segments {
+            let a = u64::from(*seg_addr);
+            uc.mem_write(a, bytes).map_err(uc_err)?;
+            if (FLASH.0..FLASH.0 + FLASH.1 as u64).contains(&a) {
+                uc.mem_write(a - FLASH.0, bytes).map_err(uc_err)?;
+            }
+        }
+        for (base, len) in MMIO {
+            uc.mmio_map(
+                base,
+                len,
+                Some(move |uc: &mut Unicorn<'_, Soc>, off: u64, size: usize| {
+                    let soc = uc.get_data_mut();
+                    match soc.read((base + off) as u32, size) {
+                        Ok(v) => u64::from(v),
+                        Err(b) => {
+                            soc.fail(b);
+                            let _ = uc.emu_stop();
+                            0
+                        }
+                    }
+                }),
+                Some(move |uc: &mut Unicorn<'_, Soc>, off: u64, size: usize, value: u64| {
+                    let soc = uc.get_data_mut();
+                    if let Err(b) = soc.write((base + off) as u32, size, value as u32) {
+                        soc.fail(b);
+                        let _ = uc.emu_stop();
+                    }
+                }),
+            )
+            .map_err(uc_err)?;
+        }
+        // Time: one instruction per HCLK cycle; stop at the deadline.
+        uc.add_code_hook(1, 0, |uc: &mut Unicorn<'_, Soc>, addr: u64, _size: u32| {
+            let soc = uc.get_data_mut();
+            if soc.now + soc.cost > soc.deadline || soc.violation.is_some() {
+                let _ = uc.emu_stop();
+                return;
+            }
+            soc.now += soc.cost;
+            soc.instructions += 1;
+            soc.pc = addr as u32;
+        })
+        .map_err(uc_err)?;
+        let vectors: Vec<u32> = image.vectors.clone();
+        let mut m = Self {
+            uc,
+            vectors,
+            active: Vec::new(),
+            handled: Vec::new(),
+            injected: Vec::new(),
+            last_fault: None,
+        };
+        let sp = m.vector(0)?;
+        let reset = m.vector(1)?;
+        m.reg_w(RegisterARM::MSP, sp)?;
+        m.reg_w(RegisterARM::SP, sp)?;
+        m.reg_w(RegisterARM::PC, reset & !1)?;
+        Ok(m)
+    }
+
+    fn vector(&self, n: u32) -> Result<u32, Stop> {
+        let vtor = self.uc.get_data().scs.vtor();
+        if vtor != 0 && vtor != FLASH.0 as u32 {
+            let mut b = [0; 4];
+            self.uc.mem_read(u64::from(vtor + 4 * n), &mut b).map_err(uc_err)?;
+            return Ok(u32::from_le_bytes(b));
+        }
+        self.vectors
+            .get(n as usize)
+            .copied()
+            .ok_or_else(|| Stop::Emulator(format!("no vector {n} in the image")))
+    }
+
+    fn reg(&self, r: RegisterARM) -> Result<u32, Stop> {
+        self.uc.reg_read(r).map(|v| v as u32).map_err(uc_err)
+    }
+
+    fn reg_w(&mut self, r: RegisterARM, v: u32) -> Result<(), Stop> {
+        self.uc.reg_write(r, u64::from(v)).map_err(uc_err)
+    }
+
+    fn write_word(&mut self, addr: u32, v: u32) -> Result<(), Stop> {
+        self.uc.mem_write(u64::from(addr), &v.to_le_bytes()).map_err(uc_err)
+    }
+
+    fn read_word(&self, addr: u32) -> Result<u32, Stop> {
+        let mut b = [0; 4];
+        self.uc.mem_read(u64::from(addr), &mut b).map_err(uc_err)?;
+        Ok(u32::from_le_bytes(b))
+    }
+
+    /// The chip.
+    pub fn soc(&self) -> &Soc {
+        self.uc.get_data()
+    }
+
+    /// The chip, to drive its inputs.
+    pub fn soc_mut(&mut self) -> &mut Soc {
+        self.uc.get_data_mut()
+    }
+
+    /// A word of memory (RAM or flash).
+    pub fn peek(&self, addr: u32) -> Result<u32, Stop> {
+        self.read_word(addr)
+    }
+
+    /// Raises exception `n` (e.g. [`HARD_FAULT`]) at the next instruction boundary.
+    pub fn inject(&mut self, n: u32) {
+        self.injected.push(n);
+    }
+
+    /// Exception entry (ARMv7-M B1.5.6–B1.5.7): the extended frame pushed on the main
+    /// stack (8-byte aligned, xPSR bit 9 recording the padding), LR = EXC_RETURN, PC =
+    /// the vector.
+    fn enter(&mut self, n: u32) -> Result<(), Stop> {
+        use RegisterARM::*;
+        let mut sp = self.reg(SP)?;
+        let pad = sp & 4;
+        sp = (sp - pad).wrapping_sub(FRAME_BYTES);
+        let mut xpsr = self.reg(XPSR)? & !(1 << 9);
+        if pad != 0 {
+            xpsr |= 1 << 9;
+        }
+        let core = [R0, R1, R2, R3, R12, LR, PC];
+        for (k, r) in core.iter().enumerate() {
+            let v = self.reg(*r)?;
+            self.write_word(sp + 4 * k as u32, v)?;
+        }
+        self.write_word(sp + 28, xpsr)?;
+        for k in 0..16u32 {
+            let v = self.uc.reg_read(i32::from(S0) + k as i32).map_err(uc_err)? as u32;
+            self.write_word(sp + 32 + 4 * k, v)?;
+        }
+        let fpscr = self.reg(FPSCR)?;
+        self.write_word(sp + 96, fpscr)?;
+        let handler = self.vector(n)?;
+        self.reg_w(SP, sp)?;
+        self.reg_w(LR, EXC_RETURN)?;
+        self.reg_w(PC, handler & !1)?;
+        let soc = self.uc.get_data_mut();
+        soc.now += ENTRY_CYCLES * soc.cost;
+        let (at, ins) = (soc.now, soc.instructions);
+        if n >= 16 {
+            soc.scs.set_pending(n - 16, false);
+            soc.irq_active = true;
+        }
+        self.active.push((n, ins, at));
+        Ok(())
+    }
+
+    /// Exception return: the frame popped, the registers restored.
+    fn exit(&mut self) -> Result<(), Stop> {
+        use RegisterARM::*;
+        let sp = self.reg(SP)?;
+        let core = [R0, R1, R2, R3, R12, LR, PC];
+        for (k, r) in core.iter().enumerate() {
+            let v = self.read_word(sp + 4 * k as u32)?;
+            self.reg_w(*r, v)?;
+        }
+        let xpsr = self.read_word(sp + 28)?;
+        for k in 0..16u32 {
+            let v = self.read_word(sp + 32 + 4 * k)?;
+            self.uc
+                .reg_write(i32::from(S0) + k as i32, u64::from(v))
+                .map_err(uc_err)?;
+        }
+        let fpscr = self.read_word(sp + 96)?;
+        self.reg_w(FPSCR, fpscr)?;
+        self.reg_w(APSR_NZCVQ, xpsr & 0xF800_0000)?;
+        self.reg_w(SP, sp + FRAME_BYTES + ((xpsr >> 9) & 1) * 4)?;
+        if let Some((n, ins, at)) = self.active.pop() {
+            if n >= 16 {
+                self.uc.get_data_mut().irq_active = false;
+            }
+            let exit = self.uc.get_data().instructions;
+            self.handled.push(Handled {
+                exception: n,
+                entry: ins,
+                exit,
+                at,
+            });
+        }
+        Ok(())
+    }
+
+    /// Runs until `seconds` of emulated time have passed since reset (or it stops).
+    pub fn run_until(&mut self, seconds: f64) -> Result<(), Stop> {
+        self.run_while(seconds, |_| true).map(|_| ())
+    }
+
+    /// Runs until `seconds` or until `go_on` returns false (checked at every event);
+    /// returns whether `go_on` stopped it.
+    pub fn run_while(&mut self, seconds: f64, mut go_on: impl FnMut(&Self) -> bool) -> Result<bool, Stop> {
+        // Rounded up, so that the time reached is at least `seconds`.
+        let end = (seconds * UNITS_PER_S).ceil() as u64;
+        loop {
+            {
+                let soc = self.uc.get_data_mut();
+                soc.service();
+                if let Some(v) = soc.violation.clone() {
+                    return Err(Stop::Violation(v));
+                }
+                if let Some(t) = soc.watchdog_reset {
+                    return Err(Stop::WatchdogReset(t));
+                }
+            }
+            if !go_on(self) {
+                return Ok(true);
+            }
+            if self.uc.get_data().now >= end {
+                return Ok(false);
+            }
+            self.take_exceptions()?;
+            let next = self.uc.get_data_mut().next_event();
+            let soc = self.uc.get_data_mut();
+            soc.deadline = next.min(end).max(soc.now + soc.cost);
+            let pc = self.reg(RegisterARM::PC)?;
+            match self.uc.emu_start(u64::from(pc | 1), u64::from(EXC_RETURN & !1), 0, 0) {
+                Ok(()) => {
+                    if self.reg(RegisterARM::PC)? == EXC_RETURN & !1 {
+                        self.exit()?;
+                    }
+                }
+                Err(e) => {
+                    if self.uc.get_data().violation.is_some() {
+                        continue;
+                    }
+                    // The M33 model in secure state raises its exception-exit exception for
+                    // a branch to EXC_RETURN even in thread mode (QEMU's FNC_RETURN /
+                    // EXC_RETURN check): that is the handler's return.
+                    let pc = self.reg(RegisterARM::PC)?;
+                    if !self.active.is_empty() && pc >= 0xFEFF_FFFE {
+                        self.exit()?;
+                        continue;
+                    }
+                    // A bus error, undefined instruction or other fault: escalated to
+                    // HardFault, as the image enables no configurable fault handler
+                    // (ARMv7-M B1.5.14).
+                    self.last_fault = Some(format!("{e:?} at PC {:#010x}", self.uc.get_data().pc));
+                    self.fault()?;
+                }
+            }
+        }
+    }
+
+    /// A fault at the current instruction: HardFault, or lockup if already in it.
+    fn fault(&mut self) -> Result<(), Stop> {
+        if self.active.iter().any(|&(n, _, _)| n == HARD_FAULT) {
+            let soc = self.uc.get_data_mut();
+            let t = soc.time_s();
+            // ARMv7-M B1.5.15: a fault in the HardFault handler locks the core up; with
+            // SYSCFG_CFGR2.CLL the LOCKUP output is TIM1's break (RM0440 §11.3.10).
+            if soc.syscfg.lockup_to_break() {
+                soc.break_asserted = true;
+                soc.update_break();
+            }
+            return Err(Stop::Lockup(t));
+        }
+        let pc = self.uc.get_data().pc;
+        self.reg_w(RegisterARM::PC, pc)?;
+        self.enter(HARD_FAULT)
+    }
+
+    /// Takes an injected exception, or a pending enabled interrupt when PRIMASK = 0 and
+    /// no handler is active (the image has one interrupt; ARMv7-M B1.5.4 priorities).
+    fn take_exceptions(&mut self) -> Result<(), Stop> {
+        if let Some(n) = self.injected.pop() {
+            if n == HARD_FAULT && self.active.iter().any(|&(a, _, _)| a == HARD_FAULT) {
+                return self.fault();
+            }
+            return self.enter(n);
+        }
+        if !self.active.is_empty() || self.reg(RegisterARM::PRIMASK)? & 1 != 0 {
+            return Ok(());
+        }
+        if let Some(irq) = self.uc.get_data().scs.active_irq() {
+            self.enter(16 + irq)?;
+        }
+        Ok(())
+    }
+
+    /// A one-line account of the state, for failure messages.
+    pub fn summary(&self) -> String {
+        let s = self.soc();
+        format!(
+            "t = {:.1} µs, PC {:#010x}, {} instructions; TIM1 {} updates {} triggers, MOE {}, SR {:#x}; ADC sequences {}/{}, \
+             missed triggers {}/{}, ADC1 CR {:#x} JSQR {:#x}, TIM1 CR2 {:#x}; NVIC enabled {:#x} pending {:#x}; handlers {:?}; active {:?}; FDCAN accepted {} rejected {}; IWDG refreshes {}; last fault {:?}",
+            s.time_s() * 1e6,
+            s.pc,
+            s.instructions,
+            s.tim1.updates,
+            s.tim1.triggers,
+            s.tim1.moe(),
+            s.tim1.sr(),
+            s.adc[0].sequences,
+            s.adc[1].sequences,
+            s.adc[0].missed_triggers,
+            s.adc[1].missed_triggers,
+            s.adc[0].reg(0x08),
+            s.adc[0].reg(0x4C),
+            s.tim1.reg(0x04),
+            s.scs.enabled[0],
+            s.scs.pending[0],
+            self.handled.iter().map(|h| h.exception).take(8).collect::<Vec<_>>(),
+            self.active,
+            s.fdcan.accepted,
+            s.fdcan.rejected,
+            s.iwdg.refreshes,
+            self.last_fault,
+        )
+    }
+
+    /// Instructions of each completed handler of exception `n`.
+    pub fn handler_instructions(&self, n: u32) -> Vec<u64> {
+        self.handled
+            .iter()
+            .filter(|h| h.exception == n)
+            .map(|h| h.exit - h.entry)
+            .collect()
+    }
+}

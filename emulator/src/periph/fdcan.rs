@@ -1,0 +1,236 @@
+//! FDCAN1 (RM0440 §44) as a receiver of classic frames: configuration protection
+//! (INIT/CCE), the global filter (RXGFC) and standard filter elements in the message RAM,
+//! RX FIFO 0 with its fill level, get/put indices and acknowledge. Frames come from the
+//! test ([`crate::Frame`]).
+
+use super::clock::unknown;
+use crate::violation::Broken;
+
+/// Message RAM base of FDCAN1 (RM0440 §44.3.3, SRAMCAN) and its size (212 words).
+pub const RAM_BASE: u32 = 0x4000_A400;
+/// Bytes of FDCAN1's message RAM.
+pub const RAM_BYTES: u32 = 212 * 4;
+/// RX FIFO 0 offset and elements (RM0440 §44.3.3, fixed layout: 3 elements of 18 words).
+const RXF0: u32 = 0xB0;
+const RX_ELEMENTS: u32 = 3;
+const RX_ELEMENT_BYTES: u32 = 72;
+
+/// CCCR bits (RM0440 §44.4.7).
+const INIT: u32 = 1;
+const CCE: u32 = 1 << 1;
+
+/// Known registers (RM0440 §44.4 register map).
+const KNOWN: &[u32] = &[
+    0x00, 0x04, 0x0C, 0x10, 0x14, 0x18, 0x1C, 0x20, 0x24, 0x28, 0x2C, 0x40, 0x44, 0x48, 0x50, 0x54, 0x58, 0x5C, 0x80,
+    0x84, 0x88, 0x90, 0x94, 0x98, 0x9C, 0xC0, 0xC4, 0xC8, 0xCC, 0xD0, 0xD4, 0xD8, 0xDC, 0xE0, 0xE4, 0xE8, 0x100,
+];
+/// Registers writable only with CCE = 1 and INIT = 1 (RM0440 §44.4: DBTP, TEST, NBTP,
+/// TSCC, TOCC, TDCR, RXGFC, XIDAM, TXBC).
+const PROTECTED: &[u32] = &[0x0C, 0x10, 0x1C, 0x20, 0x28, 0x48, 0x80, 0x84, 0xC0];
+
+/// A classic CAN frame on the bus.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Frame {
+    /// Identifier (11 or 29 bits).
+    pub id: u32,
+    /// Extended identifier.
+    pub extended: bool,
+    /// Remote frame.
+    pub remote: bool,
+    /// Data bytes (0–8), DLC = len.
+    pub data: Vec<u8>,
+}
+
+/// FDCAN1 and its message RAM.
+#[derive(Debug)]
+pub struct Fdcan {
+    regs: [u32; 0x104 / 4],
+    /// Message RAM words.
+    pub ram: Vec<u32>,
+    get: u32,
+    fill: u32,
+    /// Frames accepted into RX FIFO 0 / rejected by the filters / lost (FIFO full).
+    pub accepted: u32,
+    /// Frames the filters rejected.
+    pub rejected: u32,
+    /// Frames lost to a full FIFO.
+    pub lost: u32,
+}
+
+impl Default for Fdcan {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl Fdcan {
+    /// Reset state: CCCR = 0x0000_0001 (INIT), NBTP = 0x0600_0A03, CREL 0x3214_1218, ENDN
+    /// 0x8765_4321, PSR 0x0000_0707 (RM0440 §44.4).
+    pub fn new() -> Self {
+        let mut regs = [0; 0x104 / 4];
+        regs[0] = 0x3214_1218;
+        regs[1] = 0x8765_4321;
+        regs[0x18 / 4] = INIT;
+        regs[0x1C / 4] = 0x0600_0A03;
+        regs[0x44 / 4] = 0x0000_0707;
+        Self {
+            regs,
+            ram: vec![0; (RAM_BYTES / 4) as usize],
+            get: 0,
+            fill: 0,
+            accepted: 0,
+            rejected: 0,
+            lost: 0,
+        }
+    }
+
+    fn cccr(&self) -> u32 {
+        self.regs[0x18 / 4]
+    }
+
+    /// Register read.
+    pub fn read(&mut self, off: u32) -> Result<u32, Broken> {
+        if !KNOWN.contains(&off) {
+            return Err(unknown("FDCAN1", off));
+        }
+        Ok(match off {
+            // RXF0S: F0FL, F0GI, F0PI, F0F (RM0440 §44.4.21).
+            0x90 => {
+                let put = (self.get + self.fill) % RX_ELEMENTS;
+                self.fill | (self.get << 8) | (put << 16) | (u32::from(self.fill == RX_ELEMENTS) << 24)
+            }
+            _ => self.regs[(off / 4) as usize],
+        })
+    }
+
+    /// Register write.
+    pub fn write(&mut self, off: u32, value: u32) -> Result<(), Broken> {
+        if !KNOWN.contains(&off) {
+            return Err(unknown("FDCAN1", off));
+        }
+        if PROTECTED.contains(&off) && self.cccr() & (INIT | CCE) != (INIT | CCE) {
+            return Err(Broken::new(
+                format!("FDCAN1+{off:#04x}"),
+                "protected register written without CCCR.INIT = 1 and CCE = 1 (RM0440 §44.4.7)",
+            ));
+        }
+        match off {
+            0x18 => {
+                // CCE can only be set while INIT = 1; clearing INIT clears CCE (§44.4.7).
+                let mut v = value;
+                if v & INIT == 0 {
+                    v &= !CCE;
+                }
+                if self.cccr() & INIT == 0 && v & INIT == 0 && v & CCE != 0 {
+                    v &= !CCE;
+                }
+                self.regs[0x18 / 4] = v;
+            }
+            // RXF0A: acknowledge up to F0AI (RM0440 §44.4.22).
+            0x94 => {
+                let ai = value & 7;
+                if ai >= RX_ELEMENTS || self.fill == 0 {
+                    return Err(Broken::new(
+                        "FDCAN1_RXF0A",
+                        "acknowledge of an element not in RX FIFO 0",
+                    ));
+                }
+                let n = (ai + RX_ELEMENTS - self.get) % RX_ELEMENTS + 1;
+                if n > self.fill {
+                    return Err(Broken::new(
+                        "FDCAN1_RXF0A",
+                        "acknowledge index beyond the fill level (RM0440 §44.4.22)",
+                    ));
+                }
+                self.fill -= n;
+                self.get = (ai + 1) % RX_ELEMENTS;
+                self.regs[0x94 / 4] = ai;
+            }
+            0x90 | 0x98 | 0x00 | 0x04 | 0x44 => {
+                return Err(Broken::new(
+                    format!("FDCAN1+{off:#04x}"),
+                    "read-only register (RM0440 §44.4)",
+                ));
+            }
+            _ => self.regs[(off / 4) as usize] = value,
+        }
+        Ok(())
+    }
+
+    /// Acceptance filtering (RM0440 §44.3.7, Figures 692–693): the standard filter
+    /// elements (RXGFC.LSS of them at the start of the message RAM: SFT range / dual /
+    /// classic mask, SFEC store-in-FIFO-0/1 or reject), then non-matching frames by
+    /// ANFS/ANFE, remote frames by RRFS/RRFE. Returns the FIFO (0 or 1) or `None`.
+    fn filter(&self, f: &Frame) -> Option<u32> {
+        let gfc = self.regs[0x80 / 4];
+        if f.remote {
+            let reject = if f.extended { gfc & 1 } else { gfc & 2 };
+            if reject != 0 {
+                return None;
+            }
+        }
+        if !f.extended {
+            let lss = ((gfc >> 16) & 0x1F).min(28);
+            for k in 0..lss {
+                let e = self.ram[k as usize];
+                let (sft, sfec, id1, id2) = (e >> 30, (e >> 27) & 7, (e >> 16) & 0x7FF, e & 0x7FF);
+                let hit = match sft {
+                    0 => (id1..=id2).contains(&f.id),
+                    1 => f.id == id1 || f.id == id2,
+                    2 => f.id & id2 == id1 & id2,
+                    _ => false,
+                };
+                if hit {
+                    return match sfec {
+                        1 => Some(0),
+                        2 => Some(1),
+                        _ => None,
+                    };
+                }
+            }
+        }
+        let anf = if f.extended { (gfc >> 2) & 3 } else { (gfc >> 4) & 3 };
+        match anf {
+            0 => Some(0),
+            1 => Some(1),
+            _ => None,
+        }
+    }
+
+    /// A frame on the bus: stored in RX FIFO 0 if the controller is on the bus (INIT =
+    /// 0) and the filters accept it into FIFO 0 (element format RM0440 §44.3.3, "Rx FIFO
+    /// element": R0 = XTD/RTR/ID, R1 = DLC, then the data bytes little-endian).
+    pub fn receive(&mut self, f: &Frame) {
+        if self.cccr() & INIT != 0 {
+            return;
+        }
+        match self.filter(f) {
+            Some(0) => {}
+            _ => {
+                self.rejected += 1;
+                return;
+            }
+        }
+        if self.fill == RX_ELEMENTS {
+            self.lost += 1;
+            return;
+        }
+        let put = (self.get + self.fill) % RX_ELEMENTS;
+        let base = ((RXF0 + put * RX_ELEMENT_BYTES) / 4) as usize;
+        let id = if f.extended {
+            f.id & 0x1FFF_FFFF
+        } else {
+            (f.id & 0x7FF) << 18
+        };
+        self.ram[base] = id | (u32::from(f.extended) << 30) | (u32::from(f.remote) << 29);
+        self.ram[base + 1] = (f.data.len().min(8) as u32) << 16;
+        let mut bytes = [0u8; 8];
+        for (b, d) in bytes.iter_mut().zip(&f.data) {
+            *b = *d;
+        }
+        self.ram[base + 2] = u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]]);
+        self.ram[base + 3] = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
+        self.fill += 1;
+        self.accepted += 1;
+    }
+}

@@ -1,0 +1,98 @@
+//! The board around the chip, from the board file through codegen (the same data the
+//! image is generated from): pins, ADC inputs, sensing gains; and a drive at standstill
+//! as the default analog source.
+
+use codegen::board::Signal;
+use codegen::design::Design;
+
+use crate::soc::{Analog, Pin, Wiring};
+
+/// The default board's design for `motor` (`motors/<motor>.toml` on
+/// `boards/<default>.toml`).
+pub fn design(motor: &str) -> Result<Design, String> {
+    let repo = crate::image::repo();
+    let board = codegen::board::DEFAULT_BOARD;
+    let spec_file = format!("motors/{motor}.toml");
+    let board_file = format!("boards/{board}.toml");
+    let spec = std::fs::read_to_string(repo.join(&spec_file)).map_err(|e| format!("{spec_file}: {e}"))?;
+    let board_text = std::fs::read_to_string(repo.join(&board_file)).map_err(|e| format!("{board_file}: {e}"))?;
+    codegen::design_with_board(&spec_file, &spec, &board_file, &board_text).map_err(|e| e.to_string())
+}
+
+/// The chip's connections on the design's board.
+pub fn wiring(d: &Design) -> Result<Wiring, String> {
+    let out = d.board.as_ref().ok_or("the design has no board")?;
+    let b = &out.board;
+    let pin = |s: Signal| -> Result<Pin, String> {
+        let p = b.pin(s).ok_or_else(|| format!("the board has no {}", s.key()))?;
+        Ok(Pin {
+            port: p.port,
+            number: p.number,
+            af: p.af.unwrap_or(u8::MAX),
+        })
+    };
+    let gates = [
+        pin(Signal::GateUHigh)?,
+        pin(Signal::GateVHigh)?,
+        pin(Signal::GateWHigh)?,
+        pin(Signal::GateULow)?,
+        pin(Signal::GateVLow)?,
+        pin(Signal::GateWLow)?,
+    ];
+    let adc_inputs = b.adc.clone().map(|q| q.iter().map(|s| (s.channel, s.signal)).collect());
+    Ok(Wiring {
+        gates,
+        break_pin: pin(Signal::BreakInput)?,
+        excitation: pin(Signal::ResolverExcitation)?,
+        adc_inputs,
+        vref: b.adc_reference_v,
+        break_idle_high: !codegen::board::design::break_active_high(b),
+    })
+}
+
+/// The inverter at standstill: phase currents `currents` \[A\] through the board's
+/// sensing gain and offset, the DC link at `dc_link_v` through its divider, the resolver
+/// at rotor angle 0 (SIN at mid-scale, COS at +40 % of half the range times the
+/// excitation's sign).
+#[derive(Clone, Debug)]
+pub struct Standstill {
+    /// Phase currents u, v, w \[A\].
+    pub currents: [f64; 3],
+    /// DC-link voltage \[V\].
+    pub dc_link_v: f64,
+    gain_v_per_a: f64,
+    offset_v: f64,
+    divider: f64,
+    vref: f64,
+}
+
+impl Standstill {
+    /// Zero current at the motor's nominal DC-link voltage.
+    pub fn new(d: &Design) -> Self {
+        let b = &d.board.as_ref().expect("a board design").board;
+        Self {
+            currents: [0.0; 3],
+            dc_link_v: d.drive.dc_link_voltage_v,
+            gain_v_per_a: b.current_gain_v_per_a,
+            offset_v: b.current_offset_v,
+            divider: b.dc_link_divider,
+            vref: b.adc_reference_v,
+        }
+    }
+}
+
+impl Analog for Standstill {
+    fn volts(&mut self, signal: Signal, _t: f64, excitation_high: bool) -> f64 {
+        let half = self.vref / 2.0;
+        let sign = if excitation_high { 1.0 } else { -1.0 };
+        match signal {
+            Signal::CurrentU => self.offset_v + self.gain_v_per_a * self.currents[0],
+            Signal::CurrentV => self.offset_v + self.gain_v_per_a * self.currents[1],
+            Signal::CurrentW => self.offset_v + self.gain_v_per_a * self.currents[2],
+            Signal::DcLink => self.dc_link_v * self.divider,
+            Signal::ResolverSin => half,
+            Signal::ResolverCos => half + 0.4 * half * sign,
+            _ => 0.0,
+        }
+    }
+}
