@@ -93,6 +93,10 @@ pub struct Handled {
     pub at: u64,
 }
 
+/// Instructions between looks at an interrupt pending while PRIMASK masks it: the delay
+/// the emulator adds to its entry after CPSIE (the Cortex-M4 takes it at once).
+const MASKED_POLL_INSTRUCTIONS: u64 = 16;
+
 /// The image on the emulated chip.
 pub struct Machine {
     uc: Unicorn<'static, Soc>,
@@ -336,7 +340,15 @@ impl Machine {
                 return Ok(false);
             }
             self.take_exceptions()?;
-            let next = self.uc.get_data_mut().next_event();
+            let mut next = self.uc.get_data_mut().next_event();
+            // An enabled interrupt held off by PRIMASK is taken as soon as the core
+            // clears it (CPSIE, ARMv7-M B1.5.4); the run stops every
+            // `MASKED_POLL_INSTRUCTIONS` to look, instead of at the next peripheral event
+            // (a whole period later, when the next trigger would merge with it).
+            if self.active.is_empty() && self.uc.get_data().scs.active_irq().is_some() {
+                let soc = self.uc.get_data();
+                next = next.min(soc.now + MASKED_POLL_INSTRUCTIONS * soc.cost);
+            }
             let soc = self.uc.get_data_mut();
             soc.deadline = next.min(end).max(soc.now + soc.cost);
             let pc = self.reg(RegisterARM::PC)?;

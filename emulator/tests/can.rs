@@ -61,8 +61,16 @@ fn setpoints_drive_and_silence_ramps_to_off_in_the_designed_time() {
             .iter()
             .map(|&c| (f64::from(c) - half).abs())
             .fold(0.0, f64::max);
-        // Not asserted: on unimotor-142umd300 the compare values stay at 50 % under this
-        // setpoint (an open finding); printed for every motor.
+        // The torque → i_q conversion is 1/K_t (thesis A (2.34)); a spec without ψ_M
+        // (unimotor-142umd300, `motorgen check` warns) has none, so its i_q reference
+        // stays 0 and the compare values must stay at 50 % (±1 tick of rounding).
+        match rig.design.current_loop.feedforward.iq_per_nm {
+            Some(k) if k > 0.0 => assert!(moved >= 1.0, "{motor}: compare values did not move under {torque} N·m"),
+            _ => assert!(
+                moved <= 1.0,
+                "{motor}: compare moved {moved} ticks without a torque constant"
+            ),
+        }
 
         // Silence: on until the timeout, off after the timeout plus at most the ramp.
         let dt = off_after_silence(&mut rig, &motor, &[]);
