@@ -19,6 +19,8 @@
 //! [`FaultCause::Watchdog`] carrying the live state the control interrupt left.
 #![forbid(unsafe_code)]
 
+use motor_control::can_protocol::Crc32;
+
 /// Words of the sealed record: magic, cause, flags, PC, CFSR, HFSR, the control state
 /// ([`STATE_WORDS`]), CRC.
 pub const RECORD_WORDS: usize = 6 + STATE_WORDS + 1;
@@ -268,24 +270,14 @@ pub fn classify_hard_fault(sp: u32, stack: (u32, u32), cfsr: u32) -> (FaultCause
     )
 }
 
-/// CRC-32 (IEEE 802.3: reflected, polynomial 0x04C11DB7 → 0xEDB88320, initial value and
-/// final XOR 0xFFFF_FFFF) of the words' little-endian bytes, bit by bit (no table: it
-/// runs once per fault and at boot).
+/// CRC-32 (IEEE 802.3, `motor_control::can_protocol::Crc32`: the capture's check too) of
+/// the words' little-endian bytes.
 pub fn crc32_words(words: &[u32]) -> u32 {
-    crc32(words.iter().flat_map(|w| w.to_le_bytes()))
-}
-
-/// CRC-32 of bytes (see [`crc32_words`]).
-pub fn crc32(bytes: impl IntoIterator<Item = u8>) -> u32 {
-    let mut crc = u32::MAX;
-    for b in bytes {
-        crc ^= u32::from(b);
-        for _ in 0..8 {
-            let mask = (crc & 1).wrapping_neg();
-            crc = (crc >> 1) ^ (0xEDB8_8320 & mask);
-        }
+    let mut crc = Crc32::new();
+    for w in words {
+        crc.update(&w.to_le_bytes());
     }
-    !crc
+    crc.value()
 }
 
 #[cfg(test)]
@@ -312,13 +304,14 @@ mod tests {
         }
     }
 
-    /// The CRC-32 check value: CRC of the ASCII bytes "123456789" = 0xCBF43926
-    /// (the catalogue value of CRC-32/ISO-HDLC, Greg Cook's CRC RevEng catalogue).
+    /// The record's CRC runs over the words' little-endian bytes: the words of the
+    /// ASCII "12345678" give CRC-32/ISO-HDLC("12345678") = 0x9AE0DAAF (Python
+    /// `zlib.crc32(b"12345678")`); no words give 0 (initial value XOR final value).
     #[test]
-    fn crc_check_value() {
-        assert_eq!(crc32(*b"123456789"), 0xCBF4_3926);
-        // The empty message: initial value XOR final value = 0.
-        assert_eq!(crc32([]), 0);
+    fn crc_over_little_endian_words() {
+        let words = [u32::from_le_bytes(*b"1234"), u32::from_le_bytes(*b"5678")];
+        assert_eq!(crc32_words(&words), 0x9AE0_DAAF);
+        assert_eq!(crc32_words(&[]), 0);
     }
 
     #[test]
