@@ -13,6 +13,7 @@
 //! Licences: this crate's source is the workspace's; its test binaries link Debian's
 //! GPL-2.0 `libunicorn`. It is never a dependency of `codegen`/`motorgen` or of the image.
 
+pub mod drive;
 pub mod image;
 pub mod periph;
 pub mod rig;

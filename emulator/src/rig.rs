@@ -5,7 +5,7 @@ use codegen::design::Design;
 
 use crate::image;
 use crate::periph::fdcan::Frame;
-use crate::soc::{Patches, Soc};
+use crate::soc::{Analog, Patches, Soc};
 use crate::wiring::{self, Standstill};
 use crate::{Machine, Stop};
 
@@ -28,11 +28,21 @@ pub struct Rig {
 impl Rig {
     /// Builds (once per process) and loads `motor`'s image, at reset.
     pub fn new(motor: &str, patches: Patches) -> Result<Self, String> {
+        Self::with_analog(motor, patches, |d| Ok(Box::new(Standstill::new(d))))
+    }
+
+    /// [`Rig::new`] with the analog inputs from `analog` (given the design), e.g. the
+    /// closed loop's [`crate::drive::Drive`].
+    pub fn with_analog(
+        motor: &str,
+        patches: Patches,
+        analog: impl FnOnce(&Design) -> Result<Box<dyn Analog>, String>,
+    ) -> Result<Self, String> {
         let design = wiring::design(motor)?;
         let image = image::image(motor)?;
         let soc = Soc::new(
             wiring::wiring(&design)?,
-            Box::new(Standstill::new(&design)),
+            analog(&design)?,
             OPTR_BOOT_FROM_FLASH,
             patches,
         );
@@ -83,8 +93,13 @@ impl Rig {
 
     /// The standstill analog source, to change currents or the DC link.
     pub fn analog(&mut self) -> &mut Standstill {
+        self.analog_as().expect("the rig's analog source is Standstill")
+    }
+
+    /// The analog source as a `T`, if it is one.
+    pub fn analog_as<T: Analog>(&mut self) -> Option<&mut T> {
         let a: &mut dyn std::any::Any = self.machine.soc_mut().analog.as_mut();
-        a.downcast_mut().expect("the rig's analog source is Standstill")
+        a.downcast_mut()
     }
 
     /// One carrier period \[s\] (the design's switching frequency).

@@ -51,6 +51,12 @@ pub trait Analog: std::any::Any {
     /// Voltage at the pin of `signal` at `t` \[s\]; `excitation_high` is the resolver
     /// excitation's sign at that instant (the level of its square wave).
     fn volts(&mut self, signal: Signal, t: f64, excitation_high: bool) -> f64;
+
+    /// From `t` \[s\] on the bridge applies `duties` (each high side's on-time fraction
+    /// of the carrier period; `None`: not switching). Called at every TIM1 update event
+    /// (where the preloaded compare values become active, RM0440 §28.3.10) and whenever
+    /// MOE changes. A source that does not depend on the bridge ignores it.
+    fn bridge(&mut self, _t: f64, _duties: Option<[f64; 3]>) {}
 }
 
 /// Something the bus recorded.
@@ -308,7 +314,14 @@ impl Soc {
         self.tim1.apply_break();
         if moe && !self.tim1.moe() {
             self.notes.push(Note::MainOutput(self.time_s(), false));
+            self.bridge_changed(self.now);
         }
+    }
+
+    /// Tells the analog source what the bridge applies from `t` (bus units) on.
+    fn bridge_changed(&mut self, t: u64) {
+        let duties = self.tim1.duties();
+        self.analog.bridge(t as f64 / UNITS_PER_S, duties);
     }
 
     /// Records a strict-mode failure (the first one counts).
@@ -394,6 +407,7 @@ impl Soc {
                 self.update_break();
                 if moe != self.tim1.moe() {
                     self.notes.push(Note::MainOutput(ts, self.tim1.moe()));
+                    self.bridge_changed(t);
                 }
             }
             Block::Cordic => self.cordic.write(off, value)?,
@@ -543,6 +557,7 @@ impl Soc {
             }
             TimerEvent::Update => {
                 self.tim1.update();
+                self.bridge_changed(t);
                 if self.tim1.moe() && !self.notes.iter().any(|n| matches!(n, Note::FirstEnabledPeriod(_))) {
                     self.notes.push(Note::FirstEnabledPeriod(t as f64 / UNITS_PER_S));
                 }

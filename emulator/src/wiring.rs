@@ -4,20 +4,39 @@
 
 use codegen::board::Signal;
 use codegen::design::Design;
+use codegen::spec::Spec;
 
 use crate::soc::{Analog, Pin, Wiring};
 
 /// The default board's design for `motor` (`motors/<motor>.toml` on
 /// `boards/<default>.toml`).
 pub fn design(motor: &str) -> Result<Design, String> {
-    let repo = crate::image::repo();
-    let board = codegen::board::DEFAULT_BOARD;
-    let spec_file = format!("motors/{motor}.toml");
-    let board_file = format!("boards/{board}.toml");
-    let spec = std::fs::read_to_string(repo.join(&spec_file)).map_err(|e| format!("{spec_file}: {e}"))?;
-    let board_text = std::fs::read_to_string(repo.join(&board_file)).map_err(|e| format!("{board_file}: {e}"))?;
+    let (spec_file, spec) = read(&format!("motors/{motor}.toml"))?;
+    let (board_file, board_text) = read(&format!("boards/{}.toml", codegen::board::DEFAULT_BOARD))?;
     codegen::design_with_board(&spec_file, &spec, &board_file, &board_text).map_err(|e| e.to_string())
 }
+
+/// `motors/<motor>.toml` parsed: the machine data `motorgen verify`'s plant takes beyond
+/// the design (harmonics, L_q saturation).
+pub fn spec(motor: &str) -> Result<Spec, String> {
+    let (file, text) = read(&format!("motors/{motor}.toml"))?;
+    codegen::spec::parse(codegen::Source {
+        file: &file,
+        text: &text,
+    })
+    .map_err(|e| e.to_string())
+}
+
+/// A repository file's name and text.
+fn read(file: &str) -> Result<(String, String), String> {
+    let text = std::fs::read_to_string(crate::image::repo().join(file)).map_err(|e| format!("{file}: {e}"))?;
+    Ok((file.to_string(), text))
+}
+
+/// Amplitude of the demodulated resolver SIN/COS inputs as a fraction of half the ADC
+/// range (the front end's output swing is the test's choice: 40 % keeps the carrier
+/// extremum and the sampling instant's offset well inside the rails).
+pub const RESOLVER_AMPLITUDE: f64 = 0.4;
 
 /// The chip's connections on the design's board.
 pub fn wiring(d: &Design) -> Result<Wiring, String> {
@@ -52,8 +71,8 @@ pub fn wiring(d: &Design) -> Result<Wiring, String> {
 
 /// The inverter at standstill: phase currents `currents` \[A\] through the board's
 /// sensing gain and offset, the DC link at `dc_link_v` through its divider, the resolver
-/// at rotor angle 0 (SIN at mid-scale, COS at +40 % of half the range times the
-/// excitation's sign).
+/// at rotor angle 0 (SIN at mid-scale, COS at [`RESOLVER_AMPLITUDE`] of half the range
+/// times the excitation's sign).
 #[derive(Clone, Debug)]
 pub struct Standstill {
     /// Phase currents u, v, w \[A\].
@@ -91,7 +110,7 @@ impl Analog for Standstill {
             Signal::CurrentW => self.offset_v + self.gain_v_per_a * self.currents[2],
             Signal::DcLink => self.dc_link_v * self.divider,
             Signal::ResolverSin => half,
-            Signal::ResolverCos => half + 0.4 * half * sign,
+            Signal::ResolverCos => half + RESOLVER_AMPLITUDE * half * sign,
             _ => 0.0,
         }
     }

@@ -16,6 +16,7 @@ use motor_control::step::Demand;
 
 use super::figures::{designed_rise_time, designed_step};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
+use crate::design::Design;
 use crate::design::sampled_loop::{OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
 use crate::spec::Method;
 use motor_sim::bench::Bench;
@@ -124,6 +125,100 @@ fn current(id: f64, iq: f64, feed_forward: bool) -> Demand {
     }
 }
 
+/// Samples of [`current_step`]'s record after the step: 12/α at T_s (the error after
+/// 12/α is judged on the last one).
+pub fn current_step_samples(s: &Setup<'_>) -> usize {
+    samples(s, 12.0 / s.design.current_loop.bandwidth_rad_s)
+}
+
+/// [`current_step`]'s criteria for one axis (`k` = 0: d, 1: q) of `design`: `y` is the
+/// true current sampled every T_s, `y[0]` at the sample where the step is first
+/// processed, then [`current_step_samples`] more; `target` \[A\] the reference after the
+/// step. Rise time within [`RISE_TOLERANCE`] of the designed one (delay-compensated
+/// designs), within 5 % of the sampled-loop prediction, overshoot within the design's
+/// floor, error after 12/α ≤ 1 %. Also used by the emulated image's closed loop
+/// (`motor-emulator`, `tests/closed_loop.rs`), so both are judged alike.
+pub fn current_step_checks(d: &Design, k: usize, y: &[f64], target: f64) -> Vec<Check> {
+    let cl = &d.current_loop;
+    let ts = d.drive.sample_period_s;
+    let axis = if k == 0 { "d" } else { "q" };
+    let rise_design = cl
+        .rise_time_s
+        .unwrap_or_else(|| designed_rise_time(cl.bandwidth_rad_s, second_order(d)));
+    let mut checks = Vec::new();
+    let f = step_figures(y, ts, y[0], target);
+    let rise = f.rise_time * 1e3;
+    let want = rise_design * 1e3;
+    if cl.compensate_delay {
+        // The design promises the requested α in the sampled loop (`discrete_loop`).
+        let rise_ok = (f.rise_time / rise_design - 1.0).abs() <= RISE_TOLERANCE;
+        checks.push(
+            check(format!("{axis}-axis rise time 10–90 %"), rise, Some(want), "ms").criterion(
+                format!(
+                    "within {:.0} % of designed (continuous, delay-compensated)",
+                    RISE_TOLERANCE * 100.0
+                ),
+                rise_ok,
+            ),
+        );
+    }
+    // The same gains in the design's sampled-loop model (`design::sampled_loop`, T_s,
+    // 1.5·T_s delay): tells a sampling effect (both measured and predicted off the
+    // design) from an implementation fault (measured off the prediction).
+    let g = if k == 0 { &cl.d } else { &cl.q };
+    let predicted = g.sampled.rise_time_s.unwrap_or(f64::NAN);
+    checks.push(
+        check(
+            format!("{axis}-axis rise time vs the sampled loop (T_s, 1.5·T_s delay)"),
+            rise,
+            Some(predicted * 1e3),
+            "ms",
+        )
+        .criterion(
+            "within 5 % of the design's z-domain prediction",
+            (f.rise_time / predicted - 1.0).abs() <= 0.05,
+        ),
+    );
+    let limit = cl.floors.max_overshoot_pct;
+    checks.push(
+        check(
+            format!("{axis}-axis overshoot"),
+            f.overshoot * 100.0,
+            g.sampled.overshoot_pct,
+            "%",
+        )
+        .criterion(
+            format!(
+                "≤ {limit:.1} % (designed {:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %, the design's floor)",
+                cl.overshoot * 100.0
+            ),
+            f.overshoot * 100.0 <= limit,
+        ),
+    );
+    checks.push(
+        check(
+            format!("{axis}-axis error after 12/α"),
+            f.final_error.abs() * 100.0,
+            Some(0.0),
+            "%",
+        )
+        .criterion("≤ 1 % (integral action)", f.final_error.abs() <= 0.01),
+    );
+    checks
+}
+
+/// ω_n and ζ of a pole-placement design (the second-order step of thesis A (5.14)–(5.16)).
+fn second_order(d: &Design) -> Option<(f64, f64)> {
+    let cl = &d.current_loop;
+    match cl.method {
+        Method::PolePlacement => Some((
+            cl.natural_frequency_rad_s.unwrap_or(cl.bandwidth_rad_s),
+            cl.damping.unwrap_or(std::f64::consts::FRAC_1_SQRT_2),
+        )),
+        _ => None,
+    }
+}
+
 /// i_d and i_q reference steps at standstill (feed-forward on, ω = 0).
 pub fn current_step(s: &Setup<'_>) -> ScenarioResult {
     let d = s.design;
@@ -131,15 +226,8 @@ pub fn current_step(s: &Setup<'_>) -> ScenarioResult {
     let ts = d.drive.sample_period_s;
     let a = step_amplitude(s);
     let alpha = cl.bandwidth_rad_s;
-    let second = match cl.method {
-        Method::PolePlacement => Some((
-            cl.natural_frequency_rad_s.unwrap_or(alpha),
-            cl.damping.unwrap_or(std::f64::consts::FRAC_1_SQRT_2),
-        )),
-        _ => None,
-    };
-    let rise_design = cl.rise_time_s.unwrap_or_else(|| designed_rise_time(alpha, second));
-    let n = samples(s, 12.0 / alpha);
+    let second = second_order(d);
+    let n = current_step_samples(s);
     let settle = 20;
     let mut checks = Vec::new();
     let mut traces = Vec::new();
@@ -160,64 +248,7 @@ pub fn current_step(s: &Setup<'_>) -> ScenarioResult {
             y.push(b.plant.i[k]);
             other.push(b.plant.i[1 - k]);
         }
-        let f = step_figures(&y, ts, y[0], a);
-        let rise = f.rise_time * 1e3;
-        let want = rise_design * 1e3;
-        if cl.compensate_delay {
-            // The design promises the requested α in the sampled loop (`discrete_loop`).
-            let rise_ok = (f.rise_time / rise_design - 1.0).abs() <= RISE_TOLERANCE;
-            checks.push(
-                check(format!("{axis}-axis rise time 10–90 %"), rise, Some(want), "ms").criterion(
-                    format!(
-                        "within {:.0} % of designed (continuous, delay-compensated)",
-                        RISE_TOLERANCE * 100.0
-                    ),
-                    rise_ok,
-                ),
-            );
-        }
-        // The same gains in the design's sampled-loop model (`design::sampled_loop`, T_s,
-        // 1.5·T_s delay): tells a sampling effect (both measured and predicted off the
-        // design) from an implementation fault (measured off the prediction).
-        let g = if k == 0 { &cl.d } else { &cl.q };
-        let predicted = g.sampled.rise_time_s.unwrap_or(f64::NAN);
-        checks.push(
-            check(
-                format!("{axis}-axis rise time vs the sampled loop (T_s, 1.5·T_s delay)"),
-                rise,
-                Some(predicted * 1e3),
-                "ms",
-            )
-            .criterion(
-                "within 5 % of the design's z-domain prediction",
-                (f.rise_time / predicted - 1.0).abs() <= 0.05,
-            ),
-        );
-        let limit = cl.floors.max_overshoot_pct;
-        checks.push(
-            check(
-                format!("{axis}-axis overshoot"),
-                f.overshoot * 100.0,
-                g.sampled.overshoot_pct,
-                "%",
-            )
-            .criterion(
-                format!(
-                    "≤ {limit:.1} % (designed {:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %, the design's floor)",
-                    cl.overshoot * 100.0
-                ),
-                f.overshoot * 100.0 <= limit,
-            ),
-        );
-        checks.push(
-            check(
-                format!("{axis}-axis error after 12/α"),
-                f.final_error.abs() * 100.0,
-                Some(0.0),
-                "%",
-            )
-            .criterion("≤ 1 % (integral action)", f.final_error.abs() <= 0.01),
-        );
+        checks.extend(current_step_checks(d, k, &y, a));
         let t: Vec<f64> = (0..y.len()).map(|j| j as f64 * ts).collect();
         let designed: Vec<f64> = t.iter().map(|&t| a * designed_step(t, alpha, second)).collect();
         let (this, that) = if k == 0 { ("i_d", "i_q") } else { ("i_q", "i_d") };

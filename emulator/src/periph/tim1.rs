@@ -151,14 +151,18 @@ impl Tim1 {
         (if phase <= arr { phase } else { p - phase }) as u32
     }
 
+    /// OCxM\[3:0\] of channel `ch` (0-based) from CCMR1/CCMR2 (RM0440 §28.6.7, §28.6.9).
+    fn oc_mode(&self, ch: usize) -> u32 {
+        let ccmr = self.reg(if ch < 2 { 0x18 } else { 0x1C });
+        let shift = if ch.is_multiple_of(2) { 4 } else { 12 };
+        ((ccmr >> shift) & 7) | (((ccmr >> (shift + 12)) & 1) << 3)
+    }
+
     /// OCxREF of channel `ch` (0-based) at counter value `cnt`, counting up or down:
     /// PWM mode 1 active while CNT < CCR, mode 2 the inverse (RM0440 §28.6.7, OCxM).
     fn oc_ref(&self, ch: usize, cnt: u32) -> Option<bool> {
-        let ccmr = self.reg(if ch < 2 { 0x18 } else { 0x1C });
-        let shift = if ch.is_multiple_of(2) { 4 } else { 12 };
-        let mode = ((ccmr >> shift) & 7) | (((ccmr >> (shift + 12)) & 1) << 3);
         let ccr = self.active_ccr[ch];
-        match mode {
+        match self.oc_mode(ch) {
             0b0110 => Some(cnt < ccr),
             0b0111 => Some(cnt >= ccr),
             0b0100 => Some(false),
@@ -248,6 +252,37 @@ impl Tim1 {
             out[ch + 3] = ne && !now && !before;
         }
         out
+    }
+
+    /// Fraction of the carrier period each high side u, v, w is on with the active
+    /// compare values, or `None` while the bridge does not switch (MOE = 0: the outputs
+    /// at their idle levels, RM0440 §28.3.17; or a channel with CCxE or CCxNE clear, a
+    /// half-bridge the model does not drive). Centre-aligned counting 0 → ARR → 0 with
+    /// PWM mode 1 (OCxREF active while CNT < CCR, RM0440 §28.6.7 OCxM) gives CCR/ARR,
+    /// mode 2 its complement, forced active/inactive 1/0. The dead time is not counted:
+    /// the plant's inverter is ideal (volt-second average, thesis A (3.3)), as in
+    /// `motorgen verify`.
+    pub fn duties(&self) -> Option<[f64; 3]> {
+        if !self.moe() || self.arr == 0 {
+            return None;
+        }
+        let ccer = self.reg(0x20);
+        let arr = f64::from(self.arr);
+        let mut d = [0.0; 3];
+        for (ch, duty) in d.iter_mut().enumerate() {
+            if ccer & (1 << (4 * ch)) == 0 || ccer & (1 << (4 * ch + 2)) == 0 {
+                return None;
+            }
+            let mode = self.oc_mode(ch);
+            let high = f64::from(self.active_ccr[ch]).min(arr) / arr;
+            *duty = match mode {
+                0b0110 => high,
+                0b0111 => 1.0 - high,
+                0b0101 => 1.0,
+                _ => 0.0,
+            };
+        }
+        Some(d)
     }
 
     /// Register read at `t`.
