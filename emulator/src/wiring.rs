@@ -33,9 +33,10 @@ fn read(file: &str) -> Result<(String, String), String> {
     Ok((file.to_string(), text))
 }
 
-/// Amplitude of the demodulated resolver SIN/COS inputs as a fraction of half the ADC
-/// range (the front end's output swing is the test's choice: 40 % keeps the carrier
-/// extremum and the sampling instant's offset well inside the rails).
+/// Amplitude of the resolver SIN/COS inputs at the excitation's extremum, as a fraction
+/// of half the ADC range around mid-scale. The board file does not state the front end's
+/// swing, so this is the test's choice, inside the rails; the image's angle observer
+/// scales its trig-identity error with it (thesis A (4.10)), an atan2 error does not.
 pub const RESOLVER_AMPLITUDE: f64 = 0.4;
 
 /// The chip's connections on the design's board.
