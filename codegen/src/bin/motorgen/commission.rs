@@ -201,14 +201,14 @@ fn session_failure(e: SessionError, iface: &str, timeout: &str) -> Failure {
     }
 }
 
-/// Opens the SocketCAN interface `iface`.
+/// Opens the SocketCAN interface `iface` (for a drive at `bit_rate` bit/s).
 #[cfg(target_os = "linux")]
-pub fn open(iface: &str) -> Result<socket::LiveBus, Failure> {
+pub fn open(iface: &str, bit_rate: u32) -> Result<socket::LiveBus, Failure> {
     socket::LiveBus::open(iface).map_err(|e| {
         Failure::new(
             Exit::CanUnavailable,
             format!(
-                "error: CAN interface `{iface}`: cannot open it: {e}\n  accepted: a SocketCAN interface that exists and is up, e.g. `sudo ip link set can0 up type can bitrate 500000` (the board's bit rate)"
+                "error: CAN interface `{iface}`: cannot open it: {e}\n  accepted: a SocketCAN interface that exists and is up at the board's bit rate, e.g. `sudo ip link set {iface} up type can bitrate {bit_rate}`"
             ),
         )
     })
@@ -220,7 +220,7 @@ pub fn run(a: &CommissionArgs) -> Result<(), Failure> {
     {
         // Everything that does not need the bus is checked first.
         let plan = plan(a)?;
-        let mut bus = open(&a.can)?;
+        let mut bus = open(&a.can, plan.bit_rate)?;
         run_planned(&mut bus, a, plan)
     }
     #[cfg(not(target_os = "linux"))]
@@ -239,6 +239,7 @@ pub fn run(a: &CommissionArgs) -> Result<(), Failure> {
 /// What `run` checks before touching the bus.
 pub struct Plan {
     layout: Layout,
+    bit_rate: u32,
     command: Command,
     timeout: Duration,
 }
@@ -266,8 +267,10 @@ fn plan(a: &CommissionArgs) -> Result<Plan, Failure> {
                 "a time, e.g. \"30 s\"",
             )
         })?;
+    let bit_rate = d.board.as_ref().map_or(0, |b| b.board.can_bit_rate.round() as u32);
     Ok(Plan {
         layout: cfg.layout,
+        bit_rate,
         command: command(a, &cfg, capacity)?,
         timeout: Duration::from_secs_f64(timeout),
     })
@@ -285,6 +288,7 @@ fn run_planned<B: FrameBus>(bus: &mut B, a: &CommissionArgs, plan: Plan) -> Resu
         layout,
         command,
         timeout,
+        ..
     } = plan;
     let rec = run_session(bus, &a.can, &layout, &command, timeout)
         .map_err(|e| session_failure(e, &a.can, &a.timeout))?;
