@@ -237,7 +237,12 @@ pub fn captures(file: &str, text: &str, frames: &[LoggedFrame], layout: &Layout)
                 )
             })?;
             if let Some((c, _)) = &open {
-                return Err(truncated(f.offset, "CAPTURE_HEADER", "a new capture starts here, but", c));
+                return Err(truncated(
+                    f.offset,
+                    "CAPTURE_HEADER",
+                    "a new capture starts here, but",
+                    c,
+                ));
             }
             let mut crc = Crc32::new();
             crc.update(&f.data);

@@ -63,7 +63,8 @@ impl Recorder {
     /// Appends `f` received at `t` \[s\].
     pub fn push(&mut self, t: f64, f: BusFrame) {
         let offset = self.text.len();
-        self.text.push_str(&frame_line(t, &self.iface, f.id, f.extended, &f.data));
+        self.text
+            .push_str(&frame_line(t, &self.iface, f.id, f.extended, &f.data));
         self.text.push('\n');
         self.times.push(t);
         self.frames.push(LoggedFrame {
@@ -114,29 +115,8 @@ pub fn reason_text(r: Reason) -> &'static str {
 
 /// State and reason of a status frame on `layout`, `None` for any other frame.
 pub fn decode_status(layout: &Layout, f: &BusFrame) -> Option<(State, Reason)> {
-    if f.extended || f.id != u32::from(layout.status_id) || f.data.len() != usize::from(p::STATUS_LEN) {
-        return None;
-    }
-    let state = match f.data[0] {
-        0 => State::Idle,
-        1 => State::Torque,
-        2 => State::Commissioning,
-        3 => State::Streaming,
-        4 => State::Fault,
-        _ => return None,
-    };
-    let reason = match f.data[1] {
-        0 => Reason::None,
-        1 => Reason::NotAtStandstill,
-        2 => Reason::TorqueNotZero,
-        3 => Reason::FaultActive,
-        4 => Reason::BadCommand,
-        5 => Reason::Busy,
-        6 => Reason::Aborted,
-        7 => Reason::Tripped,
-        _ => return None,
-    };
-    Some((state, reason))
+    let id = u16::try_from(f.id).ok().filter(|_| !f.extended)?;
+    p::decode_status(layout, id, &f.data).map(|(s, r, ..)| (s, r))
 }
 
 /// Sends `cmd` and records the bus until the capture's end frame, for at most

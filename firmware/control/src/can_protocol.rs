@@ -220,6 +220,51 @@ pub enum Reason {
     Tripped = 7,
 }
 
+impl State {
+    /// The state with status code `code`.
+    pub fn from_code(code: u8) -> Option<State> {
+        [
+            State::Idle,
+            State::Torque,
+            State::Commissioning,
+            State::Streaming,
+            State::Fault,
+        ]
+        .into_iter()
+        .find(|s| *s as u8 == code)
+    }
+}
+
+impl Reason {
+    /// The reason with status code `code`.
+    pub fn from_code(code: u8) -> Option<Reason> {
+        [
+            Reason::None,
+            Reason::NotAtStandstill,
+            Reason::TorqueNotZero,
+            Reason::FaultActive,
+            Reason::BadCommand,
+            Reason::Busy,
+            Reason::Aborted,
+            Reason::Tripped,
+        ]
+        .into_iter()
+        .find(|r| *r as u8 == code)
+    }
+}
+
+/// A status frame's state, reason, routine code and fault flags; `None` for another
+/// identifier, another length or an unknown state or reason code.
+pub fn decode_status(layout: &Layout, id: u16, data: &[u8]) -> Option<(State, Reason, u8, u8)> {
+    if id != layout.status_id {
+        return None;
+    }
+    let [state, reason, routine, faults] = *data else {
+        return None;
+    };
+    Some((State::from_code(state)?, Reason::from_code(reason)?, routine, faults))
+}
+
 /// Status frame.
 pub fn encode_status(layout: &Layout, state: State, reason: Reason, routine: u8, faults: u8) -> Frame {
     Frame {
@@ -537,10 +582,22 @@ mod tests {
         };
         let f = encode_end(&l, &e);
         assert_eq!(f.bytes(), &[0x26, 0x39, 0xF4, 0xCB, 0x2C, 0x03, 0xFC, 0x03]);
+        let f = encode_status(&l, State::Idle, Reason::TorqueNotZero, 1, 0);
+        assert_eq!(f.bytes(), &[0, 2, 1, 0]);
         assert_eq!(
-            encode_status(&l, State::Idle, Reason::TorqueNotZero, 1, 0).bytes(),
-            &[0, 2, 1, 0]
+            decode_status(&l, 0x101, f.bytes()),
+            Some((State::Idle, Reason::TorqueNotZero, 1, 0))
         );
+        assert_eq!(decode_status(&l, 0x101, &[4, 8, 0, 0]), None);
+        assert_eq!(decode_status(&l, 0x102, f.bytes()), None);
+        // Every state and reason survives the trip through its code.
+        for code in 0..=7u8 {
+            assert_eq!(Reason::from_code(code).map(|r| r as u8), Some(code));
+        }
+        for code in 0..=4u8 {
+            assert_eq!(State::from_code(code).map(|s| s as u8), Some(code));
+        }
+        assert_eq!((State::from_code(5), Reason::from_code(8)), (None, None));
     }
 
     /// Saturation and wrap: currents beyond ±327.67 A saturate, NaN is 0; an angle of

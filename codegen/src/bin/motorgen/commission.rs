@@ -165,7 +165,9 @@ fn session_failure(e: SessionError, iface: &str, timeout: &str) -> Failure {
     match e {
         SessionError::Bus(m) => Failure::new(
             Exit::CanUnavailable,
-            format!("error: CAN interface `{iface}`: {m}\n  accepted: an interface that is up (`ip link show {iface}`)"),
+            format!(
+                "error: CAN interface `{iface}`: {m}\n  accepted: an interface that is up (`ip link show {iface}`)"
+            ),
         ),
         SessionError::Refused(r) => Failure::new(
             Exit::Refused,
@@ -290,8 +292,8 @@ fn run_planned<B: FrameBus>(bus: &mut B, a: &CommissionArgs, plan: Plan) -> Resu
         timeout,
         ..
     } = plan;
-    let rec = run_session(bus, &a.can, &layout, &command, timeout)
-        .map_err(|e| session_failure(e, &a.can, &a.timeout))?;
+    let rec =
+        run_session(bus, &a.can, &layout, &command, timeout).map_err(|e| session_failure(e, &a.can, &a.timeout))?;
     // From here on, the candump path.
     let name = format!("{} (live)", a.can);
     let captures: Vec<LoggedCapture> = crate::identify::captures_from_frames(&name, rec.text, &rec.frames, &layout)?;
@@ -714,9 +716,7 @@ mod tests {
                 // The drive's next frame onto the bus.
                 if let Some(f) = drive.receive(Duration::from_millis(10)).unwrap() {
                     let id = StandardId::new(f.id as u16).unwrap();
-                    board
-                        .write_frame_insist(&CanFrame::new(id, &f.data).unwrap())
-                        .unwrap();
+                    board.write_frame_insist(&CanFrame::new(id, &f.data).unwrap()).unwrap();
                 }
             }
         });
