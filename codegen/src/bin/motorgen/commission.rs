@@ -91,7 +91,8 @@ pub enum RoutineArg {
     },
 }
 
-fn usage(option: &str, problem: String, accepted: &str) -> Failure {
+/// A bad option value: bad input (exit 1), as `identify --date` is.
+fn bad_option(option: &str, problem: String, accepted: &str) -> Failure {
     Failure::new(
         Exit::BadInput,
         format!("error: {option}: {problem}\n  accepted: {accepted}"),
@@ -103,7 +104,7 @@ fn quantity(option: &str, kind: Kind, text: &str, accepted: &str) -> Result<f32,
         .ok()
         .filter(|x| x.is_finite() && *x > 0.0)
         .map(|x| x as f32)
-        .ok_or_else(|| usage(option, format!("`{text}` is not a positive value"), accepted))
+        .ok_or_else(|| bad_option(option, format!("`{text}` is not a positive value"), accepted))
 }
 
 /// The command frame's content for `routine`, decimation from `--decimation` or the
@@ -126,7 +127,7 @@ fn command(a: &CommissionArgs, cfg: &ModeConfig, capacity: usize) -> Result<Comm
     let decimation = match a.decimation {
         Some(d) if d >= 1 && u64::from(d) >= fitting && d <= u16::from(u8::MAX) => d,
         Some(d) => {
-            return Err(usage(
+            return Err(bad_option(
                 "--decimation",
                 format!(
                     "{d} does not fit: the routine runs {periods} periods and the drive captures {capacity} samples"
@@ -136,7 +137,7 @@ fn command(a: &CommissionArgs, cfg: &ModeConfig, capacity: usize) -> Result<Comm
         }
         None if fitting <= u64::from(u8::MAX) => fitting as u16,
         None => {
-            return Err(usage(
+            return Err(bad_option(
                 "--decimation",
                 format!("the routine's {periods} periods do not fit {capacity} samples at any decimation up to 255"),
                 "a design whose commissioning routine is shorter",
@@ -249,11 +250,11 @@ pub struct Plan {
 fn plan(a: &CommissionArgs) -> Result<Plan, Failure> {
     atomic::check_out_dir(&a.out).map_err(|e| Failure::new(Exit::BadInput, e))?;
     if let Some(d) = &a.date {
-        writeback::parse_date(d).map_err(|e| usage("--date", e, "a date YYYY-MM-DD, e.g. --date 2025-03-14"))?;
+        writeback::parse_date(d).map_err(|e| bad_option("--date", e, "a date YYYY-MM-DD, e.g. --date 2025-03-14"))?;
     }
     let d = design_on(&a.spec, Some(&a.board))?;
     let Some((cfg, capacity)) = candump::mode_config(&d) else {
-        return Err(usage(
+        return Err(bad_option(
             &a.board.display().to_string(),
             "the design has no CAN interface".into(),
             "a board file with a [can] section",
@@ -263,7 +264,7 @@ fn plan(a: &CommissionArgs) -> Result<Plan, Failure> {
         .ok()
         .filter(|t| *t > 0.0 && *t <= 3600.0)
         .ok_or_else(|| {
-            usage(
+            bad_option(
                 "--timeout",
                 format!("`{}` is not a time up to an hour", a.timeout),
                 "a time, e.g. \"30 s\"",
