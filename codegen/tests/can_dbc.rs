@@ -1,8 +1,8 @@
 //! The generated DBC file (`templates/motor.dbc.j2`) parsed with `can-dbc`, a maintained
 //! DBC parser, for every seed motor on the reference board: every message has the
 //! identifier and data length of the `can` constants group, and every signal decodes
-//! the bytes the firmware's encoders (`motor_control::can_protocol`) produce back to the
-//! encoded value (within half an LSB of its factor; integers exactly). A signal of the
+//! the bytes the firmware's encoders (`motor_control::can_protocol`, the fault report's
+//! included) produce back to the encoded value (within half an LSB of its factor; integers exactly). A signal of the
 //! DBC that no check covers fails the test, as does a check whose signal is missing.
 
 use std::collections::BTreeSet;
@@ -91,7 +91,7 @@ fn generated_dbc_matches_the_firmware_encoders() {
         let dbc = Dbc::try_from(text.as_str()).unwrap_or_else(|e| panic!("{stem}: {e:?}\n{text}"));
         let l: Layout = layout(&d).unwrap();
         let board = &d.board.as_ref().unwrap().board;
-        assert_eq!(dbc.messages.len(), 6, "{stem}");
+        assert_eq!(dbc.messages.len(), 7, "{stem}");
         // A value at 30 % of each quantity's full scale, and negative.
         let at = |q: Quantity| 0.3 * 32768.0 * l.per_lsb(q);
 
@@ -197,6 +197,40 @@ fn generated_dbc_matches_the_firmware_encoders() {
         check(sigs, &mut seen, "TRIP_SAMPLE", f.bytes(), 812.0);
         check(sigs, &mut seen, "TRIP_CURRENT", f.bytes(), f64::from(e.trip_current));
         assert_eq!(seen, all_names(sigs), "{stem} CAPTURE_END");
+
+        // The fault report: identifier and i_q unit from the generated `can` group (the
+        // firmware's `motor_config::fault_frame` uses the same constants and encoder).
+        let groups = codegen::constants::constants(&d);
+        let can = groups.iter().find(|g| g.name == "can").unwrap();
+        let num = |name: &str| {
+            can.constants
+                .iter()
+                .find(|k| k.name == name)
+                .and_then(|k| k.value.number.as_f64())
+                .unwrap_or_else(|| panic!("{name} missing"))
+        };
+        let (fault_id, amps) = (num("FAULT_REPORT_ID") as u16, num("FAULT_CURRENT_PER_LSB") as f32);
+        assert!(fault_id < l.status_id.min(board.setpoint_id), "{stem}: {fault_id:#x}");
+        let sigs = message(&dbc, "FAULT_REPORT", fault_id, p::FAULT_REPORT_LEN);
+        let r = p::FaultReport {
+            cause: 4,
+            pc: Some(0x0800_1234),
+            state: Some(p::FaultState {
+                running: true,
+                tripped: false,
+                i_q: -212.26,
+            }),
+        };
+        let bytes = p::encode_fault_report(amps, &r);
+        let mut seen = BTreeSet::new();
+        check(sigs, &mut seen, "CAUSE", &bytes, 4.0);
+        check(sigs, &mut seen, "PC_VALID", &bytes, 1.0);
+        check(sigs, &mut seen, "STATE_VALID", &bytes, 1.0);
+        check(sigs, &mut seen, "OUTPUTS_ON", &bytes, 1.0);
+        check(sigs, &mut seen, "TRIPPED", &bytes, 0.0);
+        check(sigs, &mut seen, "PC", &bytes, f64::from(0x0800_1234u32));
+        check(sigs, &mut seen, "I_Q", &bytes, -212.26);
+        assert_eq!(seen, all_names(sigs), "{stem} FAULT_REPORT");
     }
 }
 

@@ -1,8 +1,10 @@
 //! Commissioning over CAN, end to end, for every seed motor on the reference board:
 //! the simulated drive of `verify` (firmware control step + plant) runs the firmware's
 //! commissioning mode (`motor_control::commissioning_mode`: command, routine, capture)
-//! and its CAN encoder streams the capture; the frames, between the vehicle unit's
-//! setpoint frames, become a `candump -l` log; `motorgen identify … --candump` reads it.
+//! and its CAN encoder streams the capture (`codegen::identify::sim_drive`); the frames,
+//! between the vehicle unit's setpoint frames and the drive's status frames, are
+//! recorded by the session `motorgen commission` runs on a live bus into a `candump -l`
+//! log; `motorgen identify … --candump` reads it.
 //!
 //! * Blocked-rotor steps on d and q (§6.2): R and L within 2 % (the accuracy the CSV
 //!   identification tests state, `identify.rs`) of the plant's R, L_d and L_q. The step
@@ -22,11 +24,14 @@ use common::{motor_stems, motorgen, repo, text_of};
 use std::f64::consts::TAU;
 use std::path::{Path, PathBuf};
 
-use codegen::identify::candump::{candump_line, layout};
+use std::time::Duration;
+
+use codegen::identify::candump::layout;
+use codegen::identify::commission::run_session;
+use codegen::identify::sim_drive::SimulatedDrive;
 use codegen::{Design, Source};
-use motor_control::SoftTrig;
-use motor_control::can_protocol::{self as p, Command, Frame, Routine};
-use motor_control::commissioning_mode::{CommissioningMode, Control, Guards, Measured, ModeConfig};
+use motor_control::can_protocol::{Command, Routine};
+use motor_control::commissioning_mode::ModeConfig;
 use motor_sim::bench::Bench;
 use motor_sim::plant::{Shaft, SpeedProfile};
 
@@ -72,53 +77,18 @@ fn decimation(periods: u32) -> u16 {
     periods.div_ceil(N as u32) as u16
 }
 
-/// Runs `cmd` on `bench` until the capture is sent; the log with a zero setpoint frame
-/// every 10 ms (the vehicle unit's heartbeat) and the capture frames as the drive sends
-/// them, one per period.
-fn run(m: &Motor, bench: &mut Bench, cmd: Command, omega_e: f32) -> String {
+/// Runs `cmd` on `bench` until the capture is sent: the drive (`sim_drive`: the
+/// firmware's commissioning mode and CAN encoder on the bench) on a simulated bus with
+/// the vehicle unit's zero setpoint frame every setpoint period and the drive's status
+/// frames, recorded by the session `motorgen commission` runs on a live bus; the
+/// recorded `candump -l` log.
+fn run(m: &Motor, bench: Bench, cmd: Command, omega_e: f32) -> String {
     let cfg = mode_config(&m.design);
-    let mut mode = CommissioningMode::new();
-    let mut buffer = vec![(0.0f32, 0.0f32); N];
-    let guards = Guards::default();
-    let reason = mode.command(&cfg, &cmd, &guards, omega_e, N);
-    assert_eq!(reason, p::Reason::None, "{}: {cmd:?}", m.stem);
-    let ts = m.design.drive.sample_period_s;
-    let setpoint = Frame {
-        id: m.design.board.as_ref().unwrap().board.setpoint_id,
-        len: 2,
-        data: [0; 8],
-    };
-    let mut log = String::new();
-    let mut measured = Measured::default();
-    let mut n = 0u64;
-    loop {
-        let t = 1.7e9 + n as f64 * ts;
-        if n.is_multiple_of((0.01 / ts).round() as u64) {
-            log.push_str(&candump_line(t, "can0", &setpoint));
-            log.push('\n');
-        }
-        match mode.step(&cfg, &guards, &measured, &mut SoftTrig, &mut buffer) {
-            Control::Demand(demand) => {
-                let o = bench.step(demand).out;
-                measured = Measured {
-                    i_dq: o.i_dq,
-                    theta_r: o.theta_r,
-                    omega_e: o.omega_e,
-                    u_q: o.u_dq.q,
-                };
-            }
-            Control::Off => match mode.next_frame(&cfg, &buffer) {
-                Some(f) => {
-                    log.push_str(&candump_line(t + 1e-6, "can0", &f));
-                    log.push('\n');
-                }
-                None => break,
-            },
-            Control::Normal => break,
-        }
-        n += 1;
-    }
-    log
+    let mut drive = SimulatedDrive::new(&m.design, bench, omega_e).unwrap();
+    let rec = run_session(&mut drive, "can0", &cfg.layout, &cmd, Duration::from_secs(3600))
+        .unwrap_or_else(|e| panic!("{}: {cmd:?}: {e:?}", m.stem));
+    assert_eq!(drive.commands, 1);
+    rec.text
 }
 
 fn identify(spec: &Path, args: &[&str]) {
@@ -172,8 +142,7 @@ fn every_seed_motor_identifies_over_can() {
         };
         let mut files = vec![];
         for (axis_q, name) in [(false, "d"), (true, "q")] {
-            let mut bench = setup.bench(0.0);
-            let log = run(&m, &mut bench, step(axis_q), 0.0);
+            let log = run(&m, setup.bench(0.0), step(axis_q), 0.0);
             let f = write(&dir, &format!("step-{name}.log"), &log);
             files.push(f.display().to_string());
             identify(&spec, &["step", "--axis", name, "--candump", &files[files.len() - 1]]);
@@ -202,7 +171,7 @@ fn every_seed_motor_identifies_over_can() {
             current_trip: 0.0,
             decimation: decimation(cfg.flux.average_samples + 1),
         };
-        let log = run(&m, &mut bench, flux, w_e as f32);
+        let log = run(&m, bench, flux, w_e as f32);
         let f = write(&dir, "flux.log", &log);
         identify(&spec, &["flux", "--candump", &f.display().to_string()]);
         // Resolver offset: a free rotor 0.4 rad (electrical) off the α axis, critically
@@ -227,7 +196,7 @@ fn every_seed_motor_identifies_over_can() {
         plant.motor.psi_q = [0.0; 2];
         plant.resolver_offset = OFFSET;
         plant.theta_m = 0.4 / np;
-        let mut bench = Bench::new(setup.cfg, plant);
+        let bench = Bench::new(setup.cfg, plant);
         let align = Command {
             routine: Some(Routine::ResolverOffset),
             axis_q: false,
@@ -235,7 +204,7 @@ fn every_seed_motor_identifies_over_can() {
             current_trip: 0.0,
             decimation: decimation(cfg.align_samples.0 + cfg.align_samples.1 + cfg.align_samples.2),
         };
-        let log = run(&m, &mut bench, align, 0.0);
+        let log = run(&m, bench, align, 0.0);
         let f = write(&dir, "align.log", &log);
         identify(&spec, &["resolver", "--candump", &f.display().to_string()]);
 
@@ -309,7 +278,7 @@ fn corrupted_logs_are_located_errors() {
         current_trip: (0.8 * i_max) as f32,
         decimation: decimation(cfg.step_samples.0 + cfg.step_samples.1),
     };
-    let good = run(&m, &mut setup.bench(0.0), cmd, 0.0);
+    let good = run(&m, setup.bench(0.0), cmd, 0.0);
     let lines: Vec<&str> = good.lines().collect();
     let l = layout(d).unwrap();
     let is = |line: &str, id: u16| line.contains(&format!(" {id:03X}#"));
@@ -317,7 +286,7 @@ fn corrupted_logs_are_located_errors() {
     let end = lines.iter().position(|x| is(x, l.end_id)).unwrap();
     let k = data[500];
 
-    // Dropped data frame 500: the next one (line k + 1 after removal) names it.
+    // Dropped data frame 500: data frame 501 (line data[501] after the removal) names it.
     let mut dropped = lines.clone();
     dropped.remove(k);
     // A flipped bit in channel B of frame 500: the CRC at the end frame.
@@ -339,7 +308,7 @@ fn corrupted_logs_are_located_errors() {
         (
             "dropped",
             dropped.join("\n") + "\n",
-            k + 1,
+            data[501],
             "sequence numbers 500 are missing",
         ),
         ("flipped", flipped.join("\n") + "\n", end + 1, "checksum mismatch"),

@@ -1,6 +1,6 @@
 //! The `can` group: the drive's CAN interface described once — identifiers, data
-//! lengths and signal scalings of the setpoint, status, commissioning-command and
-//! capture frames (only for a design on a board: the identifiers follow the board's
+//! lengths and signal scalings of the setpoint, status, commissioning-command,
+//! capture and fault-report frames (only for a design on a board: the identifiers follow the board's
 //! `can.setpoint_id`). The byte layouts are `motor_control::can_protocol`'s (firmware
 //! and host share them); `templates/motor.dbc.j2` renders this group as a DBC file.
 
@@ -14,6 +14,13 @@ use crate::design::Design;
 /// Frames the drive sends or receives after the setpoint identifier: status, command,
 /// capture header, capture data, capture end (identifiers setpoint_id + 1 … + 5).
 pub const FRAMES_AFTER_SETPOINT: u16 = 5;
+
+/// Standard identifier of the fault report, a choice of the firmware: low (high
+/// priority on the bus), below the drive's other frames on the seed boards.
+pub const FAULT_REPORT_ID: u16 = 0x0E0;
+
+/// The fault report's current unit \[A per LSB\].
+pub const FAULT_CURRENT_PER_LSB: f64 = 0.1;
 
 /// Data length of the setpoint frame (a little-endian i16 torque, `can_frame`).
 pub const SETPOINT_LEN: u8 = 2;
@@ -43,6 +50,14 @@ pub fn group(d: &Design) -> Option<Group> {
             format!("can.setpoint_id = {base:#05x} ({file})"),
         ));
     }
+    v.push(c(
+        "FAULT_REPORT_ID",
+        intv(i64::from(FAULT_REPORT_ID), "u16", "uint16_t"),
+        format!("{FAULT_REPORT_ID:#05x}"),
+        "fixed: standard identifier of the fault report (drive → bus, once after a boot that found a fault record)",
+        proto,
+        "the firmware's choice, outside setpoint_id … setpoint_id + 5 (checked when the image builds)".into(),
+    ));
     for (name, len, what) in [
         ("SETPOINT_LEN", SETPOINT_LEN, "setpoint: bytes 0–1 torque (i16)"),
         ("STATUS_LEN", p::STATUS_LEN, "status: state, reason, routine, faults"),
@@ -62,6 +77,11 @@ pub fn group(d: &Design) -> Option<Group> {
             "data: routine (multiplexor), sequence, channels A and B",
         ),
         ("CAPTURE_END_LEN", p::END_LEN, "end: CRC-32, trip sample, trip current"),
+        (
+            "FAULT_REPORT_LEN",
+            p::FAULT_REPORT_LEN,
+            "fault report: cause, flags, PC, i_q",
+        ),
     ] {
         v.push(c(
             name,
@@ -88,6 +108,14 @@ pub fn group(d: &Design) -> Option<Group> {
             format!("A = {} (scaling)", phys(sc.full_scale, unit)),
         ));
     }
+    v.push(c(
+        "FAULT_CURRENT_PER_LSB",
+        f32v(FAULT_CURRENT_PER_LSB),
+        phys(FAULT_CURRENT_PER_LSB, "A"),
+        "fixed: the fault report's i_q unit, ±3276.7 A in an i16 (beyond any phase-current full scale, so a trip's current is never cut)",
+        proto,
+        "the fault report's layout".into(),
+    ));
     v.push(c(
         "ANGLE_PER_LSB",
         f32v(f64::from(p::ANGLE_PER_LSB)),

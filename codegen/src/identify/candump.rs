@@ -191,14 +191,30 @@ pub struct Capture {
     pub row_offsets: Vec<usize>,
 }
 
+const SEQUENCE_ACCEPTED: &str =
+    "a header frame, then data frames with sequence numbers 0, 1, … count − 1 in order, then the end frame";
+
 /// Reassembles every capture of `frames` (other frames on the bus are ignored).
 pub fn captures(file: &str, text: &str, frames: &[LoggedFrame], layout: &Layout) -> Result<Vec<Capture>, Diagnostics> {
     let src = Source { file, text };
     let err = |at: usize, key: &str, problem: String, accepted: &str| -> Diagnostics {
         src.error(at..at, key, problem, accepted).into()
     };
-    let sequence_accepted =
-        "a header frame, then data frames with sequence numbers 0, 1, … count − 1 in order, then the end frame";
+    let sequence_accepted = SEQUENCE_ACCEPTED;
+    // A capture cut short at `at` (a new header or the end of the log).
+    let truncated = |at: usize, key: &str, what: &str, c: &Capture| -> Diagnostics {
+        err(
+            at,
+            key,
+            format!(
+                "{what} the capture started at line {} is truncated: {} of {} data frames and no end frame",
+                line_of(text, c.header_offset),
+                c.rows.len(),
+                c.header.count
+            ),
+            SEQUENCE_ACCEPTED,
+        )
+    };
     let mut out = Vec::new();
     // The capture being received and the CRC over its bytes.
     let mut open: Option<(Capture, Crc32)> = None;
@@ -221,16 +237,11 @@ pub fn captures(file: &str, text: &str, frames: &[LoggedFrame], layout: &Layout)
                 )
             })?;
             if let Some((c, _)) = &open {
-                return Err(err(
+                return Err(truncated(
                     f.offset,
                     "CAPTURE_HEADER",
-                    format!(
-                        "a new capture starts here, but the one started at line {} is truncated: {} of {} data frames and no end frame",
-                        line_of(text, c.header_offset),
-                        c.rows.len(),
-                        c.header.count
-                    ),
-                    sequence_accepted,
+                    "a new capture starts here, but",
+                    c,
                 ));
             }
             let mut crc = Crc32::new();
@@ -355,17 +366,7 @@ pub fn captures(file: &str, text: &str, frames: &[LoggedFrame], layout: &Layout)
         }
     }
     if let Some((c, _)) = open {
-        return Err(err(
-            text.len(),
-            "CAPTURE_END",
-            format!(
-                "the log is truncated: it ends inside the capture started at line {} ({} of {} data frames, no end frame)",
-                line_of(text, c.header_offset),
-                c.rows.len(),
-                c.header.count
-            ),
-            sequence_accepted,
-        ));
+        return Err(truncated(text.len(), "CAPTURE_END", "the log ends here:", &c));
     }
     if out.is_empty() {
         return Err(err(
@@ -488,8 +489,18 @@ pub fn encode_capture(layout: &Layout, header: &Header, rows: &[(f32, f32)], end
 
 /// A frame as a `candump -l` line at time `t` \[s\] on `iface`.
 pub fn candump_line(t: f64, iface: &str, f: &p::Frame) -> String {
-    let hex: String = f.bytes().iter().map(|b| format!("{b:02X}")).collect();
-    format!("({t:.6}) {iface} {:03X}#{hex}", f.id)
+    frame_line(t, iface, u32::from(f.id), false, f.bytes())
+}
+
+/// A received frame as a `candump -l` line at time `t` \[s\] on `iface`: identifier
+/// in 3 (standard) or 8 (extended) hex digits, `#`, the data bytes in hex.
+pub fn frame_line(t: f64, iface: &str, id: u32, extended: bool, data: &[u8]) -> String {
+    let hex: String = data.iter().map(|b| format!("{b:02X}")).collect();
+    if extended {
+        format!("({t:.6}) {iface} {id:08X}#{hex}")
+    } else {
+        format!("({t:.6}) {iface} {id:03X}#{hex}")
+    }
 }
 
 #[cfg(test)]
@@ -497,16 +508,7 @@ mod tests {
     use super::*;
 
     fn layout() -> Layout {
-        Layout {
-            status_id: 0x101,
-            command_id: 0x102,
-            header_id: 0x103,
-            data_id: 0x104,
-            end_id: 0x105,
-            current_per_lsb: 0.01,
-            voltage_per_lsb: 0.01,
-            speed_per_lsb: 1.0,
-        }
+        p::EXAMPLE_LAYOUT
     }
 
     fn log(frames: &[p::Frame]) -> String {

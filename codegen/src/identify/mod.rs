@@ -10,15 +10,22 @@
 //!   ratio n_p/n_r with the direction check (§6.4).
 //! * [`candump`]: captures sent over CAN (`candump -l` logs or a live socket),
 //!   reassembled, checked and turned into recordings.
+//! * [`commission`]: a session on a live bus (command, status, the capture's frames
+//!   recorded as a `candump -l` log for [`candump`]).
+//! * `sim_drive` (with `verify`): the firmware's commissioning mode on the simulated
+//!   motor behind the same bus trait, for tests.
 //! * [`writeback`]: the new values into the spec text with `toml_edit` (comments and
 //!   layout kept).
 //!
 //! Nothing here does file I/O; `motorgen identify` reads the files and writes the spec.
 
 pub mod candump;
+pub mod commission;
 pub mod flux;
 pub mod recording;
 pub mod resolver;
+#[cfg(feature = "verify")]
+pub mod sim_drive;
 pub mod step;
 pub mod writeback;
 

@@ -1,51 +1,49 @@
 //! The fault-report CAN frame (pure), sent once after a boot that found a fault record
-//! ([`crate::fault_record`]): standard identifier [`crate::hw::FAULT_REPORT_ID`], eight
-//! data bytes:
+//! ([`crate::fault_record`]): the generated `can::FAULT_REPORT_ID` (also in the DBC file
+//! `motorgen generate` writes), eight data bytes laid out by
+//! `motor_control::can_protocol::encode_fault_report` (the encoder the DBC test checks):
 //!
 //! | byte | content |
 //! |---|---|
 //! | 0 | cause code ([`FaultCause`] as `u8`: 1 HardFault, 2 stack overflow, 3 break, 4 trip, 5 lost conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog) |
 //! | 1 | flags: bit 0 PC valid, bit 1 state valid, bit 2 outputs were on, bit 3 tripped |
 //! | 2–5 | stacked PC, little-endian (0 when not valid) |
-//! | 6–7 | i_q of the last period, little-endian `i16` in units of [`crate::hw::FAULT_FRAME_AMPS_PER_LSB`], saturating; `i16::MIN` when not a number; 0 when the state is not valid |
+//! | 6–7 | i_q of the last period, little-endian `i16` in units of the generated `can::FAULT_CURRENT_PER_LSB`, rounded, saturating; `i16::MIN` when not a number; 0 when the state is not valid |
 //!
 //! The full record (currents, angle, speed, DC link, CFSR/HFSR) is read with a probe
 //! (firmware/README.md, "Fault record").
 #![forbid(unsafe_code)]
 
+use motor_control::can_protocol::{FaultReport, FaultState, encode_fault_report};
+
 use crate::fault_record::{FaultCause, FaultRecord};
-use crate::hw;
 use crate::motor::{board, can};
 
 // The report must not be taken for a setpoint or another drive frame by the vehicle
 // unit, nor the reverse: its identifier lies outside the board's setpoint identifier and
 // the generated `can` group's status … capture-end identifiers.
 const _: () = {
-    let id = hw::FAULT_REPORT_ID;
+    let id = can::FAULT_REPORT_ID;
     assert!(
         id != board::SETPOINT_ID && (id < can::STATUS_ID || id > can::CAPTURE_END_ID),
-        "the fault report's identifier (hw::FAULT_REPORT_ID) collides with a drive frame's"
+        "the fault report's identifier (can::FAULT_REPORT_ID) collides with a drive frame's"
     );
 };
 
 /// The eight data bytes of the report of `r`.
 pub fn encode(r: &FaultRecord) -> [u8; 8] {
-    let state = r.state;
-    let flags = u8::from(r.pc.is_some())
-        | u8::from(state.is_some()) << 1
-        | u8::from(state.is_some_and(|s| s.running)) << 2
-        | u8::from(state.is_some_and(|s| s.tripped)) << 3;
-    let [p0, p1, p2, p3] = r.pc.unwrap_or(0).to_le_bytes();
-    let iq = state.map_or(0, |s| {
-        if s.i_q.is_nan() {
-            i16::MIN
-        } else {
-            // `as` saturates at the i16 range (and rounds towards zero).
-            (s.i_q / hw::FAULT_FRAME_AMPS_PER_LSB) as i16
-        }
-    });
-    let [q0, q1] = iq.to_le_bytes();
-    [r.cause as u8, flags, p0, p1, p2, p3, q0, q1]
+    encode_fault_report(
+        can::FAULT_CURRENT_PER_LSB,
+        &FaultReport {
+            cause: r.cause as u8,
+            pc: r.pc,
+            state: r.state.map(|s| FaultState {
+                running: s.running,
+                tripped: s.tripped,
+                i_q: s.i_q,
+            }),
+        },
+    )
 }
 
 /// The cause byte of a report, decoded (for a receiver written in Rust).
@@ -71,21 +69,21 @@ mod tests {
         }
     }
 
-    /// A trip at i_q = 212.25 A with PC 0x0800_1234: i_q/0.1 A = 2122.5 → 2122 =
-    /// 0x084A; flags = PC | state | on | tripped = 0x0F.
+    /// A trip at i_q = 212.26 A with PC 0x0800_1234: i_q/0.1 A = 2122.6 → 2123 =
+    /// 0x084B; flags = PC | state | on | tripped = 0x0F.
     #[test]
     fn trip_report() {
-        assert_eq!(hw::FAULT_FRAME_AMPS_PER_LSB, 0.1);
+        assert_eq!(can::FAULT_CURRENT_PER_LSB, 0.1);
         let r = FaultRecord {
             cause: FaultCause::Trip,
             pc: Some(0x0800_1234),
             cfsr: 0,
             hfsr: 0,
-            state: Some(state(212.25)),
+            state: Some(state(212.26)),
             reported: false,
         };
         let d = encode(&r);
-        assert_eq!(d, [4, 0x0F, 0x34, 0x12, 0x00, 0x08, 0x4A, 0x08]);
+        assert_eq!(d, [4, 0x0F, 0x34, 0x12, 0x00, 0x08, 0x4B, 0x08]);
         assert_eq!(cause_of(&d), Some(FaultCause::Trip));
     }
 
@@ -108,11 +106,12 @@ mod tests {
         assert_eq!(&encode(&r)[6..], &[0x00, 0x80]);
     }
 
-    /// ID 0x0E0 → T0 = 0x0E0 << 18 = 0x0380_0000; DLC 8 → T1 = 0x0008_0000; the
+    /// The generated identifier is 0x0E0; ID 0x0E0 → T0 = 0x0E0 << 18 = 0x0380_0000; DLC 8 → T1 = 0x0008_0000; the
     /// element decodes back through the receive path's `RxFrame::from_words` (same
     /// layout of the first words for Rx and Tx elements, RM0440 §44.3.3).
     #[test]
     fn tx_element_layout() {
+        assert_eq!(can::FAULT_REPORT_ID, 0x0E0);
         let data = [1, 2, 3, 4, 5, 6, 7, 8];
         let w = crate::can_commissioning::tx_element(&motor_control::can_protocol::Frame {
             id: 0x0E0,

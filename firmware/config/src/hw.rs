@@ -55,11 +55,10 @@ pub const FDCAN_TXBUF_OFFSET: usize = 0x278;
 /// Size of one Tx buffer element \[bytes\]: 18 words, as the Rx elements.
 pub const FDCAN_TX_ELEMENT_BYTES: usize = 72;
 /// Standard identifier of the fault-report frame sent once after a boot that found a
-/// fault record (`fault_frame`); a choice of this firmware, checked at compile time to
-/// differ from the board's setpoint identifier.
-pub const FAULT_REPORT_ID: u16 = 0x0E0;
-/// Current unit of the fault report's i_q \[A per LSB\] (±3276.7 A in an `i16`).
-pub const FAULT_FRAME_AMPS_PER_LSB: f32 = 0.1;
+/// fault record (`fault_frame`): the generated `can::FAULT_REPORT_ID` (described in the
+/// DBC file with the other frames), checked at compile time to differ from the drive's
+/// other identifiers.
+pub const FAULT_REPORT_ID: u16 = crate::motor::can::FAULT_REPORT_ID;
 
 /// TIM1 break-input digital filter BKF: f_DTS, N = 8 samples (RM0440 §28.6.20,
 /// code 0b0011 = f_CK_INT, N = 8): ignores glitches shorter than 47 ns.

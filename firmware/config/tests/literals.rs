@@ -26,8 +26,10 @@ use std::path::{Path, PathBuf};
 const FILE_ALLOWLIST: &[(&str, &[f64], &str)] = &[
     (
         "timing.rs",
-        &[64.0, 127.0, 254.0, 504.0, 1008.0, 49.0, 95.0, 185.0, 495.0, 1281.0],
-        "TIMx_BDTR.DTG range boundaries and ADC_SMPR half-cycle counts (RM0440)",
+        &[
+            64.0, 127.0, 254.0, 504.0, 1008.0, 49.0, 95.0, 185.0, 495.0, 1281.0, 224.0,
+        ],
+        "TIMx_BDTR.DTG range boundaries, its DTG[7:5] = 111 prefix 0xE0, and ADC_SMPR half-cycle counts (RM0440)",
     ),
     (
         "can_frame.rs",

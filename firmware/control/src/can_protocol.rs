@@ -20,6 +20,7 @@
 //! | capture header | 8 | 0 routine (bits 0–3), axis (bit 4), tripped (bit 5); 1 decimation; 2–3 T_s in 100 ns (u16); 4–5 sample count (u16); 6–7 trip level (i16) |
 //! | capture data | 7 | 0 routine (multiplexor), 1–2 sequence (u16), 3–4 channel A (i16), 5–6 channel B (i16) |
 //! | capture end | 8 | 0–3 CRC-32 of every header and data byte sent, 4–5 trip sample (u16), 6–7 trip current (i16) |
+//! | fault report | 8 | 0 cause, 1 flags (PC valid, state valid, outputs on, tripped), 2–5 PC (u32), 6–7 i_q (i16) |
 
 /// A classic CAN data frame (standard identifier, up to 8 bytes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -73,6 +74,21 @@ pub struct Layout {
     /// Electrical speed per LSB \[rad/s\] (speed full scale/2^15).
     pub speed_per_lsb: f32,
 }
+
+/// An example interface for tests (here, in the commissioning mode's and in the host's
+/// CAN tests): identifiers 0x101 (status) to 0x105 (capture end); 10 mA, 10 mV and
+/// 1 rad/s per LSB, so a value in LSB reads off its SI value by hand.
+#[cfg(any(test, feature = "example-layout"))]
+pub const EXAMPLE_LAYOUT: Layout = Layout {
+    status_id: 0x101,
+    command_id: 0x102,
+    header_id: 0x103,
+    data_id: 0x104,
+    end_id: 0x105,
+    current_per_lsb: 0.01,
+    voltage_per_lsb: 0.01,
+    speed_per_lsb: 1.0,
+};
 
 /// Angle per LSB of a 16-bit angle signal \[rad\]: π/2^15.
 pub const ANGLE_PER_LSB: f32 = core::f32::consts::PI / 32768.0;
@@ -202,6 +218,51 @@ pub enum Reason {
     Aborted = 6,
     /// The routine's current trip fired (capture still sent, with its trip data).
     Tripped = 7,
+}
+
+impl State {
+    /// The state with status code `code`.
+    pub fn from_code(code: u8) -> Option<State> {
+        [
+            State::Idle,
+            State::Torque,
+            State::Commissioning,
+            State::Streaming,
+            State::Fault,
+        ]
+        .into_iter()
+        .find(|s| *s as u8 == code)
+    }
+}
+
+impl Reason {
+    /// The reason with status code `code`.
+    pub fn from_code(code: u8) -> Option<Reason> {
+        [
+            Reason::None,
+            Reason::NotAtStandstill,
+            Reason::TorqueNotZero,
+            Reason::FaultActive,
+            Reason::BadCommand,
+            Reason::Busy,
+            Reason::Aborted,
+            Reason::Tripped,
+        ]
+        .into_iter()
+        .find(|r| *r as u8 == code)
+    }
+}
+
+/// A status frame's state, reason, routine code and fault flags; `None` for another
+/// identifier, another length or an unknown state or reason code.
+pub fn decode_status(layout: &Layout, id: u16, data: &[u8]) -> Option<(State, Reason, u8, u8)> {
+    if id != layout.status_id {
+        return None;
+    }
+    let [state, reason, routine, faults] = *data else {
+        return None;
+    };
+    Some((State::from_code(state)?, Reason::from_code(reason)?, routine, faults))
 }
 
 /// Status frame.
@@ -377,6 +438,56 @@ pub fn decode_end(layout: &Layout, data: &[u8]) -> Option<End> {
     })
 }
 
+/// Data length of the fault-report frame.
+pub const FAULT_REPORT_LEN: u8 = 8;
+
+/// What the fault-report frame carries: the record the image found at boot
+/// (`motor_config::fault_record`), reduced to what a logger on the bus needs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaultReport {
+    /// The cause code (1 HardFault, 2 stack overflow, 3 break, 4 trip, 5 lost
+    /// conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog).
+    pub cause: u8,
+    /// The stacked PC of a CPU fault.
+    pub pc: Option<u32>,
+    /// The control state of the last period.
+    pub state: Option<FaultState>,
+}
+
+/// The last period's control state in a fault report.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaultState {
+    /// The outputs were on.
+    pub running: bool,
+    /// The drive had tripped.
+    pub tripped: bool,
+    /// i_q \[A\].
+    pub i_q: f32,
+}
+
+/// The fault-report frame's bytes: 0 cause; 1 flags (bit 0 PC valid, bit 1 state valid,
+/// bit 2 outputs were on, bit 3 tripped); 2–5 the PC, little-endian (0 when not valid);
+/// 6–7 i_q in units of `amps_per_lsb` (the generated `FAULT_CURRENT_PER_LSB`), rounded
+/// and saturated to i16, `i16::MIN` for not a number, 0 when the state is not valid.
+pub fn encode_fault_report(amps_per_lsb: f32, r: &FaultReport) -> [u8; 8] {
+    let state = r.state;
+    let flags = u8::from(r.pc.is_some())
+        | u8::from(state.is_some()) << 1
+        | u8::from(state.is_some_and(|s| s.running)) << 2
+        | u8::from(state.is_some_and(|s| s.tripped)) << 3;
+    let [p0, p1, p2, p3] = r.pc.unwrap_or(0).to_le_bytes();
+    let iq = state.map_or(0, |s| {
+        if s.i_q.is_nan() {
+            i16::MIN
+        } else {
+            // Float → integer `as` saturates at the i16 range.
+            libm::roundf(s.i_q / amps_per_lsb) as i16
+        }
+    });
+    let [q0, q1] = iq.to_le_bytes();
+    [r.cause, flags, p0, p1, p2, p3, q0, q1]
+}
+
 /// CRC-32 (IEEE 802.3: reflected polynomial 0xEDB88320, initial value and final XOR
 /// 0xFFFFFFFF), bitwise: 8 shifts per byte, no table in flash. The capture's check runs
 /// over the header frame's data bytes and then every data frame's, in order.
@@ -419,16 +530,7 @@ mod tests {
     use super::*;
 
     fn layout() -> Layout {
-        Layout {
-            status_id: 0x101,
-            command_id: 0x102,
-            header_id: 0x103,
-            data_id: 0x104,
-            end_id: 0x105,
-            current_per_lsb: 0.01,
-            voltage_per_lsb: 0.005,
-            speed_per_lsb: 0.5,
-        }
+        EXAMPLE_LAYOUT
     }
 
     /// The CRC catalogue's check value of CRC-32/ISO-HDLC: "123456789" → 0xCBF43926.
@@ -441,7 +543,7 @@ mod tests {
         assert_eq!(Crc32::new().value(), 0);
     }
 
-    /// Hand-encoded frames: 4 V at 5 mV/LSB = 800 = 0x0320; 10 A at 10 mA/LSB = 1000 =
+    /// Hand-encoded frames: 4 V at 10 mV/LSB = 400 = 0x0190; 10 A at 10 mA/LSB = 1000 =
     /// 0x03E8; 50 µs = 500 units = 0x01F4; 3040 samples = 0x0BE0.
     #[test]
     fn frames_by_hand() {
@@ -454,7 +556,7 @@ mod tests {
             decimation: 1,
         };
         let f = encode_command(&l, &c);
-        assert_eq!((f.id, f.bytes()), (0x102, &[1, 1, 0x20, 0x03, 0xE8, 0x03, 1, 0][..]));
+        assert_eq!((f.id, f.bytes()), (0x102, &[1, 1, 0x90, 0x01, 0xE8, 0x03, 1, 0][..]));
         assert_eq!(decode_command(&l, 0x102, f.bytes()), Some(c));
         assert_eq!(decode_command(&l, 0x102, &f.bytes()[..7]), None);
         let h = Header {
@@ -469,10 +571,10 @@ mod tests {
         let f = encode_header(&l, &h);
         assert_eq!(f.bytes(), &[0x31, 2, 0xF4, 0x01, 0xE0, 0x0B, 0xE8, 0x03]);
         assert_eq!(decode_header(&l, f.bytes()), Some(h));
-        // −1.5 A = −150 = 0xFF6A; 4 V = 0x0320; sequence 0x1234.
+        // −1.5 A = −150 = 0xFF6A; 4 V = 0x0190; sequence 0x1234.
         let f = encode_data(&l, Routine::Step, 0x1234, 4.0, -1.5);
-        assert_eq!(f.bytes(), &[1, 0x34, 0x12, 0x20, 0x03, 0x6A, 0xFF]);
-        assert_eq!(decode_data(f.bytes()), Some((1, 0x1234, 800, -150)));
+        assert_eq!(f.bytes(), &[1, 0x34, 0x12, 0x90, 0x01, 0x6A, 0xFF]);
+        assert_eq!(decode_data(f.bytes()), Some((1, 0x1234, 400, -150)));
         let e = End {
             crc: 0xCBF4_3926,
             trip_sample: 812,
@@ -480,10 +582,22 @@ mod tests {
         };
         let f = encode_end(&l, &e);
         assert_eq!(f.bytes(), &[0x26, 0x39, 0xF4, 0xCB, 0x2C, 0x03, 0xFC, 0x03]);
+        let f = encode_status(&l, State::Idle, Reason::TorqueNotZero, 1, 0);
+        assert_eq!(f.bytes(), &[0, 2, 1, 0]);
         assert_eq!(
-            encode_status(&l, State::Idle, Reason::TorqueNotZero, 1, 0).bytes(),
-            &[0, 2, 1, 0]
+            decode_status(&l, 0x101, f.bytes()),
+            Some((State::Idle, Reason::TorqueNotZero, 1, 0))
         );
+        assert_eq!(decode_status(&l, 0x101, &[4, 8, 0, 0]), None);
+        assert_eq!(decode_status(&l, 0x102, f.bytes()), None);
+        // Every state and reason survives the trip through its code.
+        for code in 0..=7u8 {
+            assert_eq!(Reason::from_code(code).map(|r| r as u8), Some(code));
+        }
+        for code in 0..=4u8 {
+            assert_eq!(State::from_code(code).map(|s| s as u8), Some(code));
+        }
+        assert_eq!((State::from_code(5), Reason::from_code(8)), (None, None));
     }
 
     /// Saturation and wrap: currents beyond ±327.67 A saturate, NaN is 0; an angle of

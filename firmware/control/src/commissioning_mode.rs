@@ -440,8 +440,8 @@ impl CommissioningMode {
 }
 
 /// Periods a routine captures (an upper bound for the rotation, whose last step may be
-/// shorter).
-fn capture_periods(cfg: &ModeConfig, routine: Routine) -> u64 {
+/// shorter): with decimation D it needs ⌈periods/D⌉ samples of the capture buffer.
+pub fn capture_periods(cfg: &ModeConfig, routine: Routine) -> u64 {
     let sum = |a: u32, b: u32, c: u32| u64::from(a).saturating_add(u64::from(b)).saturating_add(u64::from(c));
     match routine {
         Routine::Step => sum(cfg.step_samples.0, cfg.step_samples.1, 0),
@@ -479,16 +479,7 @@ mod tests {
 
     fn cfg() -> ModeConfig {
         ModeConfig {
-            layout: Layout {
-                status_id: 0x101,
-                command_id: 0x102,
-                header_id: 0x103,
-                data_id: 0x104,
-                end_id: 0x105,
-                current_per_lsb: 0.01,
-                voltage_per_lsb: 0.01,
-                speed_per_lsb: 1.0,
-            },
+            layout: p::EXAMPLE_LAYOUT,
             sample_period_units: 500,
             standstill_speed: 1.0,
             zero_torque: 0.005,
@@ -630,6 +621,46 @@ mod tests {
             m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
             Control::Normal
         );
+    }
+
+    /// The break (TIM1_SR.BIF latched, as the board passes it): a running routine is
+    /// aborted to outputs off in the period it is seen, no capture is sent, and while it
+    /// stays active a new command is refused (fault active) and an abort does not clear
+    /// the latch; once it is gone the abort clears it.
+    #[test]
+    fn break_aborts_and_refuses() {
+        let c = cfg();
+        let mut m = CommissioningMode::new();
+        let mut buf = [(0.0f32, 0.0f32); 8];
+        let g = Guards::default();
+        let brk = Guards {
+            break_active: true,
+            ..g
+        };
+        assert_eq!(m.command(&c, &step_cmd(), &brk, 0.0, 8), Reason::FaultActive);
+        assert_eq!(m.state(), (State::Idle, Reason::FaultActive));
+        assert_eq!(m.command(&c, &step_cmd(), &g, 0.0, 8), Reason::None);
+        for _ in 0..3 {
+            assert!(matches!(
+                m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+                Control::Demand(_)
+            ));
+        }
+        assert_eq!(
+            m.step(&c, &brk, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Off
+        );
+        assert_eq!(m.state(), (State::Fault, Reason::Aborted));
+        assert_eq!(m.status(&c, 0).bytes(), &[4, 6, 0, 0]);
+        assert_eq!(m.next_frame(&c, &buf), None);
+        let abort = Command {
+            routine: None,
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &abort, &brk, 0.0, 8), Reason::FaultActive);
+        assert_eq!(m.command(&c, &step_cmd(), &g, 0.0, 8), Reason::FaultActive);
+        assert_eq!(m.command(&c, &abort, &g, 0.0, 8), Reason::None);
+        assert_eq!(m.command(&c, &step_cmd(), &g, 0.0, 8), Reason::None);
     }
 
     /// A trip: the header says tripped, the end frame carries the sample and current.

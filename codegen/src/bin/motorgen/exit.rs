@@ -27,11 +27,20 @@ pub enum Exit {
     Io = crate::output::EXIT_IO as isize,
     /// 5: the firmware build (cargo) failed.
     BuildFailed = 5,
+    /// 6: `commission`: the drive refused the routine or aborted it (its status
+    /// frame's reason is on stderr).
+    Refused = 6,
+    /// 69 (sysexits' EX_UNAVAILABLE): `commission`: the CAN interface cannot be opened
+    /// (no such interface, not up, not Linux) or failed while in use.
+    CanUnavailable = 69,
+    /// 75 (sysexits' EX_TEMPFAIL): `commission`: no complete capture within `--timeout`.
+    Timeout = 75,
 }
 
 impl Exit {
-    /// The exit code of a run that went on after failures: the gravest one (the largest
-    /// code: I/O over a failed build over a failed verification over bad input).
+    /// The exit code of a run that went on after failures (`check`: bad input or I/O):
+    /// the gravest one, the largest code (I/O over a failed build over a failed
+    /// verification over bad input).
     pub fn gravest(failed: &[Exit]) -> Option<Exit> {
         failed.iter().copied().max_by_key(|e| *e as u8)
     }
@@ -51,7 +60,10 @@ Exit codes:
   2  usage: the command line is wrong
   3  verification failed: a simulated figure failed, or the image exceeds its flash budget
   5  the firmware build (cargo) failed
-  74 I/O: a file, directory or standard output could not be read or written, or cargo could not be run";
+  6  commission: the drive refused or aborted the routine (its reason on stderr)
+  69 commission: the CAN interface cannot be opened or failed (no such interface, not up, not Linux)
+  74 I/O: a file, directory or standard output could not be read or written, or cargo could not be run
+  75 commission: no complete capture from the drive within --timeout";
 
 /// A failed command: the message for stderr and the exit code.
 #[derive(Debug)]
@@ -110,6 +122,9 @@ mod tests {
             Exit::VerificationFailed,
             Exit::Io,
             Exit::BuildFailed,
+            Exit::Refused,
+            Exit::CanUnavailable,
+            Exit::Timeout,
         ] {
             let code = e as u8;
             let row = if code < 10 {

@@ -91,6 +91,24 @@ pub struct Common {
     /// The board file whose CAN identifiers the drive uses (needed with --candump).
     #[arg(long, value_name = "BOARD_FILE")]
     pub board: Option<PathBuf>,
+    /// Captures received from a live bus (`motorgen commission`), checked as a log's.
+    #[arg(skip)]
+    pub live: Vec<LoggedCapture>,
+}
+
+impl Common {
+    /// The options of an identification from captures received live on the bus
+    /// (`motorgen commission`): identified exactly as those of a `--candump` log.
+    pub fn live(dry_run: bool, date: Option<String>, board: PathBuf, captures: Vec<LoggedCapture>) -> Self {
+        Common {
+            dry_run,
+            date,
+            sample_period: None,
+            candump: Vec::new(),
+            board: Some(board),
+            live: captures,
+        }
+    }
 }
 
 /// Where a recording came from: a CSV file, or a capture in a CAN log (whose problems
@@ -206,7 +224,7 @@ fn can_recordings(
     spec: &Path,
     kinds: &[RecordingKind],
 ) -> Result<Vec<(Recording, RecordingOrigin)>, Failure> {
-    if common.candump.is_empty() {
+    if common.candump.is_empty() && common.live.is_empty() {
         return Ok(Vec::new());
     }
     let Some(board) = &common.board else {
@@ -218,9 +236,13 @@ fn can_recordings(
         .into());
     };
     let layout = layout(spec, board)?;
+    let mut captures = common.live.clone();
+    if !common.candump.is_empty() {
+        captures.extend(read_logs(&common.candump, &layout)?);
+    }
     let mut out = Vec::new();
     let mut errors = Vec::new();
-    for (k, (file, log, cap, csv)) in read_logs(&common.candump, &layout)?.into_iter().enumerate() {
+    for (k, (file, log, cap, csv)) in captures.into_iter().enumerate() {
         let kind = candump::kind_of(cap.header.routine);
         let origin = RecordingOrigin {
             capture: Some((cap, csv.clone(), file.clone())),
@@ -402,15 +424,23 @@ fn today() -> String {
     writeback::date_from_unix_days((secs / 86_400) as i64)
 }
 
-fn names(files: &[PathBuf], logs: &[PathBuf]) -> Vec<String> {
-    files
+/// The names of the recordings for the provenance: file names of the CSV files and
+/// logs, then the interface of each live capture (`can0 (live)`, once).
+fn names(files: &[PathBuf], common: &Common) -> Vec<String> {
+    let mut out: Vec<String> = files
         .iter()
-        .chain(logs)
+        .chain(&common.candump)
         .map(|f| {
             f.file_name()
                 .map_or_else(|| f.display().to_string(), |n| n.to_string_lossy().into_owned())
         })
-        .collect()
+        .collect();
+    for (name, ..) in &common.live {
+        if !out.contains(name) {
+            out.push(name.clone());
+        }
+    }
+    out
 }
 
 /// The file name without its directory, for the result tables.
@@ -605,7 +635,7 @@ fn step(spec: &Path, axis: AxisArg, csv: &[PathBuf], common: &Common) -> Result<
         design.angle_observer.lead_samples
     );
     let label = format!("step {name}");
-    let files = names(csv, &common.candump);
+    let files = names(csv, common);
     let entries = [
         Entry {
             key: "phase_resistance",
@@ -666,7 +696,7 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
         return Err(plain_error(&spec.display().to_string(), "no recordings".into(), "--csv FILE…").into());
     };
     outln!("  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
-    let files = names(csv, &common.candump);
+    let files = names(csv, common);
     let entries = [Entry {
         key: "flux_linkage",
         value: writeback::webers(s.mean),
@@ -683,7 +713,7 @@ fn flux_cmd(spec: &Path, csv: &[PathBuf], common: &Common) -> Result<(), Failure
 
 fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Common) -> Result<(), Failure> {
     let file = spec.display().to_string();
-    if offset.is_empty() && ratio.is_empty() && common.candump.is_empty() {
+    if offset.is_empty() && ratio.is_empty() && common.candump.is_empty() && common.live.is_empty() {
         return Err(plain_error(
             "motorgen identify resolver",
             "no recordings given".into(),
@@ -801,7 +831,7 @@ fn resolver_cmd(spec: &Path, offset: &[PathBuf], ratio: &[PathBuf], common: &Com
         "  mean: θ_off = {mean:.5} rad (mod 2π·n_r/n_p), runs within ±{:.3}° electrical",
         (dev * f64::from(np) / f64::from(nr)).to_degrees()
     );
-    let files = names(offset, &common.candump);
+    let files = names(offset, common);
     let entries = [Entry {
         key: "resolver_offset",
         value: writeback::radians(mean),

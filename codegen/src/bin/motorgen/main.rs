@@ -1,6 +1,7 @@
 //! `motorgen`: design motor-controller constants from a motor TOML file.
 
 mod atomic;
+mod commission;
 mod exit;
 mod firmware;
 mod identify;
@@ -139,6 +140,11 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
     },
+    /// Run a commissioning routine on the drive over CAN (SocketCAN, Linux): send the
+    /// command, receive the capture, write its CSV recording to DIR and identify from it
+    /// as `identify … --candump` does (exit 6 refused/aborted, 69 no CAN interface,
+    /// 75 timeout; nothing written then).
+    Commission(commission::CommissionArgs),
     /// List the motors in a directory (default: motors/).
     List {
         /// Directory of motor specs.
@@ -427,6 +433,7 @@ fn run(command: Command) -> Result<(), Failure> {
             }
             Ok(())
         }
+        Command::Commission(args) => commission::run(&args),
         Command::List { dir } => {
             let dir = motors_dir(dir);
             let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)

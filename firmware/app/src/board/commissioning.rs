@@ -3,7 +3,7 @@
 //! period), each access inside a critical section.
 //!
 //! The supervisor (`motor_control::commissioning_mode`) decides; this module only moves
-//! data: the interrupt publishes the guards it sees (trip, setpoint timeout, ω_e) for
+//! data: the interrupt publishes the guards it sees (trip, break, setpoint timeout, ω_e) for
 //! the command check, the main loop publishes the last received torque.
 
 use core::cell::RefCell;
@@ -27,6 +27,8 @@ static OMEGA_E: AtomicU32 = AtomicU32::new(0);
 static FAULT: AtomicBool = AtomicBool::new(false);
 /// The setpoint has timed out.
 static TIMED_OUT: AtomicBool = AtomicBool::new(false);
+/// The break was latched (TIM1_SR.BIF) when the interrupt last looked.
+static BREAK: AtomicBool = AtomicBool::new(false);
 /// The last received torque setpoint \[N·m\] as `f32` bits.
 static TORQUE: AtomicU32 = AtomicU32::new(0);
 
@@ -44,7 +46,7 @@ pub fn frame_received(id: Option<u16>, data: &[u8]) {
     let guards = Guards {
         torque_setpoint: f32::from_bits(TORQUE.load(Ordering::Relaxed)),
         fault: FAULT.load(Ordering::Relaxed),
-        break_active: false,
+        break_active: BREAK.load(Ordering::Relaxed),
         setpoint_timeout: TIMED_OUT.load(Ordering::Relaxed),
     };
     let omega_e = f32::from_bits(OMEGA_E.load(Ordering::Relaxed));
@@ -91,6 +93,7 @@ pub fn control_step<T: Trig>(
     OMEGA_E.store(omega_e.to_bits(), Ordering::Relaxed);
     FAULT.store(guards.fault, Ordering::Relaxed);
     TIMED_OUT.store(guards.setpoint_timeout, Ordering::Relaxed);
+    BREAK.store(guards.break_active, Ordering::Relaxed);
     let control = interrupt::free(|cs| {
         match (
             SUPERVISOR.borrow(cs).try_borrow_mut(),

@@ -29,7 +29,7 @@ use stm32g4::stm32g474::interrupt;
 use super::cordic::Cordic;
 use super::{adc, commissioning, fault, pins, pwm};
 use crate::adc_frame::{self, Excitation};
-use crate::bringup;
+use crate::bringup::{self, BreakControl};
 use crate::config::{CONTROLLER, SETPOINT, TRIPS};
 use crate::fault_record::{ControlState, FaultCause};
 use crate::motor::board;
@@ -137,11 +137,16 @@ impl Control {
         } else {
             Demand::Off
         };
-        // A commissioning routine replaces the torque demand (or switches off).
+        // A commissioning routine replaces the torque demand (or switches off). The break
+        // as TIM1 latched it: TIM1_SR.BIF (bit 7) is set by hardware as soon as the break
+        // input goes active, and software can clear it only once the input is inactive
+        // again (RM0440 §29.6.5, TIMx_SR (x = 1, 8, 20)) — so a break since the last
+        // period's MOE decision aborts a routine here, before its demand is run;
+        // `finish_period` reads BIF again before MOE.
         let guards = Guards {
             torque_setpoint: iq,
             fault: self.tripped,
-            break_active: false,
+            break_active: pwm::Break(&self.tim1).break_flag(),
             setpoint_timeout: self.setpoint.timed_out(&SETPOINT),
         };
         let (demand, run) =
