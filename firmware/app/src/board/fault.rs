@@ -176,8 +176,15 @@ fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32) -> FaultRecord
 /// With the `defmt` feature: a fault entry on the probe's RTT channel — the cause
 /// (`FaultCause` code), the stacked PC, CFSR and HFSR. Never from the control
 /// interrupt: its trips only [`record`]; the record reaches the log at the next boot.
+/// Logs once per boot: a fault inside the logger (a HardFault while a line is written,
+/// or the logger's own panic) must not log again and re-enter it.
 #[cfg(feature = "defmt")]
 fn log_fault(r: &FaultRecord) {
+    use core::sync::atomic::{AtomicBool, Ordering};
+    static LOGGED: AtomicBool = AtomicBool::new(false);
+    if LOGGED.swap(true, Ordering::Relaxed) {
+        return;
+    }
     defmt::error!(
         "fault: cause {=u32}, PC {=?}, CFSR {=u32:#010x}, HFSR {=u32:#010x}; outputs off, waiting for the watchdog reset",
         r.cause as u32,
@@ -254,17 +261,20 @@ pub fn report(can: &mut Can, record: FaultRecord) {
     }
 }
 
-/// A panic in a development build: outputs off, wait for the watchdog.
-#[cfg(debug_assertions)]
+/// A panic in a development build, or in an image with the `defmt` feature (defmt-rtt's
+/// logger panics when taken re-entrantly, so that image cannot prove the absence of
+/// panics below): outputs off, wait for the watchdog.
+#[cfg(any(debug_assertions, feature = "defmt"))]
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
     stop(FaultCause::Panic)
 }
 
-/// Release builds prove that no panic is reachable anywhere in the image — the
-/// control interrupt included: the panic handler calls a function that does not
-/// exist, so the image links only if the optimiser removed every path to a panic.
-#[cfg(not(debug_assertions))]
+/// Release builds (without the `defmt` feature) prove that no panic is reachable
+/// anywhere in the image — the control interrupt included: the panic handler calls a
+/// function that does not exist, so the image links only if the optimiser removed every
+/// path to a panic.
+#[cfg(not(any(debug_assertions, feature = "defmt")))]
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
     unsafe extern "C" {

@@ -178,11 +178,11 @@ mod tests {
         assert_eq!(c.current_sense.offset, [32_768; 3]);
         assert_eq!(c.current_sense.amps_per_lsb, [p.current_per_lsb; 3]);
         assert_eq!(c.current_sense.phases, MeasuredPhases::Three);
-        assert_eq!((c.dc_link_sense.offset, c.dc_link_sense.volts_per_lsb), (0, p.dc_link_per_lsb));
         assert_eq!(
-            (c.observer.kp.to_bits(), c.observer.ki.to_bits()),
-            (4_784_957, 8_374)
+            (c.dc_link_sense.offset, c.dc_link_sense.volts_per_lsb),
+            (0, p.dc_link_per_lsb)
         );
+        assert_eq!((c.observer.kp.to_bits(), c.observer.ki.to_bits()), (4_784_957, 8_374));
         assert_eq!(c.observer.error, ObserverError::TrigIdentity);
         assert_eq!(
             (c.angle.motor_pole_pairs, c.angle.resolver_pole_pairs, c.angle.offset),
@@ -212,9 +212,6 @@ mod tests {
         let c = ControllerConfig::from_parameters(&p);
         assert_eq!(c.observer.error, ObserverError::Atan2);
         assert_eq!(c.current_sense.phases, MeasuredPhases::UV);
-        assert_eq!(
-            (c.angle.motor_pole_pairs, c.angle.resolver_pole_pairs),
-            (u16::MAX, 3)
-        );
+        assert_eq!((c.angle.motor_pole_pairs, c.angle.resolver_pole_pairs), (u16::MAX, 3));
     }
 }
