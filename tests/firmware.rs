@@ -39,9 +39,31 @@ fn firmware_control_core_host_tests_pass() {
     cargo_in_firmware(&["test", "--locked", "--workspace"]);
 }
 
+/// Builds the release image (and the control core, motor-config) for the Cortex-M4F, then
+/// checks that the image carries no defmt logging (firmware/README.md, "defmt logging"):
+/// no `.defmt` section (defmt's string table), no `_defmt_*` symbol (its encoder and
+/// logger hooks), no `_SEGGER_RTT` control block (the RTT transport). The image has
+/// symbols (`debug = true`, not stripped), so the names are there to be found.
 #[test]
 fn firmware_control_core_builds_for_the_cortex_m4f() {
+    use object::{Object, ObjectSection, ObjectSymbol};
     cargo_in_firmware(&["build", "--locked", "--release", "--target", "thumbv7em-none-eabihf"]);
+    let elf = motor_tests::repo().join("firmware/target/thumbv7em-none-eabihf/release/motor-firmware");
+    let bytes = std::fs::read(&elf).unwrap_or_else(|e| panic!("{}: {e}", elf.display()));
+    let file = object::File::parse(&*bytes).unwrap_or_else(|e| panic!("{}: {e}", elf.display()));
+    let sections: Vec<&str> = file.sections().filter_map(|s| s.name().ok()).collect();
+    assert!(sections.contains(&".vector_table"), "not the image: {sections:?}");
+    assert!(
+        !sections.iter().any(|s| s.starts_with(".defmt")),
+        "defmt section in the release image: {sections:?}"
+    );
+    let symbols: Vec<&str> = file.symbols().filter_map(|s| s.name().ok()).collect();
+    assert!(symbols.contains(&"MOTOR_FAULT_RECORD"), "image without symbols");
+    let logging: Vec<&&str> = symbols
+        .iter()
+        .filter(|s| s.contains("_defmt_") || s.starts_with("__defmt") || s.contains("SEGGER_RTT"))
+        .collect();
+    assert!(logging.is_empty(), "defmt/RTT in the release image: {logging:?}");
 }
 
 /// A bad spec fails the firmware build with the CLI's located message (`cargo::error=`),

@@ -435,8 +435,8 @@ pub fn constants(d: &Design) -> Vec<Group> {
     let mut observer = vec![
         c(
             "KP",
-            q31v(o.kp_q31),
-            phys(o.kp_scaled, ""),
+            q31v(o.gains.kp_q31),
+            phys(o.gains.kp_scaled, ""),
             &format!("K̃_p = 2ζω_n/(f_s·{norm}), Q1.31"),
             "thesis A (4.15), (4.22)",
             format!("{obs_in}, {fs_in}"),
@@ -444,8 +444,8 @@ pub fn constants(d: &Design) -> Vec<Group> {
         .at("/angle_observer/kp_q31"),
         c(
             "KI",
-            q31v(o.ki_q31),
-            phys(o.ki_scaled, ""),
+            q31v(o.gains.ki_q31),
+            phys(o.gains.ki_scaled, ""),
             &format!("K̃_i = ω_n²/(f_s²·{norm}), Q1.31"),
             "thesis A (4.15), (4.22)",
             format!("{obs_in}, {fs_in}"),

@@ -109,7 +109,7 @@ pub fn summary(d: &Design) -> String {
         writeln!(
             s,
             "  K_p = 2ζω_n = {} 1/s, K_i = ω_n² = {} 1/s² (4.15); Q1.31: K̃_p = {}, K̃_i = {} (4.22)",
-            o.kp, o.ki, o.kp_q31, o.ki_q31
+            o.gains.kp, o.gains.ki, o.gains.kp_q31, o.gains.ki_q31
         )?;
         writeln!(
             s,

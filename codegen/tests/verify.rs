@@ -181,7 +181,7 @@ fn missing_decoupling_fails_the_decoupling_scenario() {
 #[test]
 fn mis_scaled_observer_gain_fails_the_ramp() {
     let (s, mut d) = load(&motor("fischer-ti085"));
-    d.angle_observer.ki_q31 /= 4;
+    d.angle_observer.gains.ki_q31 /= 4;
     let v = run(&s, &d);
     let c = check(&v, "ato_type2", "angle lag during the ramp");
     assert!(!c.pass, "{c:?}");
@@ -293,6 +293,12 @@ fn controller_config_is_the_generated_constants() {
             number(&g, "observer", "KI") as i64,
             "{name}"
         );
+        // The error form the gains were scaled for (generated ERROR_FORM: 0 trig identity, 1 atan2).
+        assert_eq!(
+            u8::from(cfg.observer.error == motor_control::ato::ObserverError::Atan2),
+            number(&g, "observer", "ERROR_FORM") as u8,
+            "{name}"
+        );
         assert_eq!(
             f64::from(cfg.angle.motor_pole_pairs),
             number(&g, "observer", "MOTOR_POLE_PAIRS"),
@@ -362,8 +368,8 @@ fn slow_observer_loses_current_tracking_in_field_weakening() {
     assert!(find(&good, "peak |i_dq − i_dq^ref|").pass, "{:?}", good.checks);
     assert!(find(&good, "peak electrical angle error").pass);
     let g = observer(40.0, 1.0, 20e3, d.angle_observer.error).unwrap();
-    d.angle_observer.kp_q31 = g.kp_q31;
-    d.angle_observer.ki_q31 = g.ki_q31;
+    d.angle_observer.gains.kp_q31 = g.kp_q31;
+    d.angle_observer.gains.ki_q31 = g.ki_q31;
     let r = fw_run(&Setup::new(&s, &d), field_weakening_config(&d));
     let angle = find(&r, "peak electrical angle error");
     assert!(!angle.pass && (angle.measured - 30.1).abs() < 3.0, "{angle:?}");

@@ -115,11 +115,6 @@ impl Sample {
     /// The electrical angle the controller transforms with, minus the true one, wrapped
     /// \[rad\]: its field-orientation error.
     pub fn angle_error(&self) -> f64 {
-        wrap(q31_angle(self.out.theta_e) - self.theta_e)
+        wrap(angle::to_radians_f64(self.out.theta_e) - self.theta_e)
     }
-}
-
-/// π-scaled Q1.31 stored integer → angle \[rad\].
-pub fn q31_angle(bits: i32) -> f64 {
-    f64::from(bits) * PI / Q31
 }

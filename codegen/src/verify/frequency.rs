@@ -23,6 +23,7 @@ use std::f64::consts::PI;
 use nalgebra::Complex;
 
 use crate::design::Design;
+use crate::design::angle_observer::Q31_ONE;
 use crate::design::current_loop::AxisGains;
 use crate::spec::{Method, ObserverError};
 
@@ -129,8 +130,8 @@ pub fn observer(d: &Design, omega: &[f64]) -> (Response, Response) {
         ObserverError::TrigIdentity => PI,
         ObserverError::Atan2 => 1.0,
     };
-    let kp = f64::from(o.kp_q31) / 2_147_483_648.0 * g;
-    let ki = f64::from(o.ki_q31) / 2_147_483_648.0 * g;
+    let kp = f64::from(o.gains.kp_q31) / Q31_ONE * g;
+    let ki = f64::from(o.gains.ki_q31) / Q31_ONE * g;
     let one = Complex::new(1.0, 0.0);
     let (mut open, mut closed) = (Vec::new(), Vec::new());
     for &w in omega {
@@ -150,7 +151,7 @@ pub fn observer_designed(d: &Design, omega: &[f64]) -> Response {
         .iter()
         .map(|&w| {
             let s = Complex::new(0.0, w);
-            (o.kp * s + o.ki) / (s * s + o.kp * s + o.ki)
+            (o.gains.kp * s + o.gains.ki) / (s * s + o.gains.kp * s + o.gains.ki)
         })
         .collect();
     Response {

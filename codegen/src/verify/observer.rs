@@ -20,8 +20,8 @@ use super::scenarios::{check, samples, series, trace};
 use super::{ScenarioResult, Setup, format_value};
 use crate::design::angle_observer::ramp_lag;
 use crate::spec::ObserverError;
-use motor_control::angle::from_radians_f64;
-use motor_sim::bench::{Bench, q31_angle};
+use motor_control::angle::{from_radians_f64, to_radians_f64};
+use motor_sim::bench::Bench;
 use motor_sim::figures::settling_time;
 use motor_sim::plant::{SpeedProfile, wrap};
 
@@ -67,13 +67,13 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
     let mut acc = 0.0f64;
     for k in 0..n {
         let smp = b.step(Demand::Off);
-        let err = wrap(smp.theta_r - q31_angle(smp.out.theta_r));
+        let err = wrap(smp.theta_r - to_radians_f64(smp.out.theta_r));
         acc = if k == 0 { err } else { acc + wrap(err - acc) };
         e.push(err);
         unwrapped.push(acc);
     }
     let lock = settling_time(&e, ts, LOCK_THRESHOLD);
-    let designed = designed_lock_time(o.kp, o.ki, LOCK_INITIAL_ERROR, LOCK_THRESHOLD);
+    let designed = designed_lock_time(o.gains.kp, o.gains.ki, LOCK_INITIAL_ERROR, LOCK_THRESHOLD);
     let slips = unwrapped.last().map_or(0.0, |x| (x / (2.0 * PI)).round().abs());
     // Started at +π/2 (estimate behind), the trig-identity error sin Δ is only 2/π of the
     // linear one at the start: allow 25 % over the linear design.
@@ -94,7 +94,7 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
     let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<_>>();
     let linear: Vec<f64> = {
         // The designed linear response on the same grid, for the plot.
-        let (kp, ki) = (o.kp, o.ki);
+        let (kp, ki) = (o.gains.kp, o.gains.ki);
         let (mut x, mut v) = (LOCK_INITIAL_ERROR, -kp * LOCK_INITIAL_ERROR);
         let sub = 10;
         let h = ts / sub as f64;
@@ -147,8 +147,8 @@ pub const RAMP_LAG_FRACTION: f64 = 0.1;
 fn dead_zone(s: &Setup<'_>) -> f64 {
     let o = &s.design.angle_observer;
     match o.error {
-        ObserverError::TrigIdentity => (0.5 / f64::from(o.ki_q31)).min(1.0).asin(),
-        ObserverError::Atan2 => PI * 0.5 / f64::from(o.ki_q31),
+        ObserverError::TrigIdentity => (0.5 / f64::from(o.gains.ki_q31)).min(1.0).asin(),
+        ObserverError::Atan2 => PI * 0.5 / f64::from(o.gains.ki_q31),
     }
 }
 
@@ -178,7 +178,7 @@ fn observe(s: &Setup<'_>, profile: SpeedProfile, n: usize) -> Run {
     for _ in 0..n {
         let smp = b.step(Demand::Off);
         r.t.push(smp.t);
-        r.error_r.push(wrap(smp.theta_r - q31_angle(smp.out.theta_r)));
+        r.error_r.push(wrap(smp.theta_r - to_radians_f64(smp.out.theta_r)));
         r.error_e.push(smp.angle_error());
         r.w_true.push(nr * smp.omega_m);
         r.w_est.push(f64::from(smp.out.omega_r) * speed_per_lsb);
@@ -211,7 +211,7 @@ pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
     let o = &d.angle_observer;
     let nr = f64::from(o.resolver_pole_pairs);
     let acc_m = d.drive.max_acceleration_rad_s2;
-    let lag_design = ramp_lag(nr * acc_m, o.ki, o.error).unwrap_or(PI / 2.0);
+    let lag_design = ramp_lag(nr * acc_m, o.gains.ki, o.error).unwrap_or(PI / 2.0);
     let w_max = d.motor.max_speed_rad_s;
     let ramp = w_max / acc_m;
     let hold = 20.0 / (o.damping.min(1.0) * o.natural_frequency_rad_s);
@@ -322,8 +322,8 @@ pub fn ato_type2(s: &Setup<'_>) -> ScenarioResult {
     let o = &d.angle_observer;
     let nr = f64::from(o.resolver_pole_pairs);
     // Design intent K_i = ω_n² (4.15); the Q1.31 integer realises it to ki_quantisation_error.
-    let acc_r = RAMP_LAG_FRACTION * o.ki;
-    let lag_design = ramp_lag(acc_r, o.ki, o.error).unwrap_or(PI / 2.0);
+    let acc_r = RAMP_LAG_FRACTION * o.gains.ki;
+    let lag_design = ramp_lag(acc_r, o.gains.ki, o.error).unwrap_or(PI / 2.0);
     let w_full = 0.5 * d.drive.switching_frequency_hz * PI;
     let ramp = (w_full / acc_r).min(40.0 / (o.damping.min(1.0) * o.natural_frequency_rad_s));
     let profile = SpeedProfile {

@@ -12,6 +12,10 @@ use motor_config::{
     adc_frame, bringup, can_commissioning, can_frame, config, fault_frame, fault_record, hw, motor, registers,
 };
 
+// The RTT transport of the `defmt` log lines (README, "defmt logging").
+#[cfg(all(target_os = "none", feature = "defmt"))]
+use defmt_rtt as _;
+
 #[cfg(target_os = "none")]
 mod target {
     use cortex_m_rt::entry;
@@ -19,6 +23,12 @@ mod target {
     /// Reset entry: brings up the board and runs the main loop (never returns).
     #[entry]
     fn main() -> ! {
+        #[cfg(feature = "defmt")]
+        defmt::info!(
+            "motor-firmware {=str}: boot, f_s = {=f32} Hz",
+            env!("CARGO_PKG_VERSION"),
+            crate::motor::limits::SWITCHING_FREQUENCY_HZ
+        );
         crate::board::run()
     }
 }

@@ -1,22 +1,10 @@
 //! Register encodings computed from times and frequencies (pure, host-tested):
-//! TIM1 period and dead time, watchdog prescaler and reload.
+//! TIM1 dead time, watchdog prescaler and reload (the TIM1 period is the control core's
+//! `motor_control::modulation::centre_aligned_period`).
 #![forbid(unsafe_code)]
 
 /// Nanoseconds per second.
 const NS_PER_S: u64 = 1_000_000_000;
-
-/// Centre-aligned (up/down) PWM: one carrier period is `2·ARR` timer ticks, so
-/// `ARR = round(f_tim/(2·f_s))` (RM0440 §28.3.3, thesis A Fig. 3.4). `None` if it does
-/// not fit the 16-bit register or is zero.
-pub const fn centre_aligned_arr(timer_hz: u32, switching_hz: f32) -> Option<u16> {
-    let arr = timer_hz as f32 / (2.0 * switching_hz) + 0.5;
-    // Also rejects NaN, ∞ and f_s ≤ 0 (the comparisons are false).
-    if arr >= 1.0 && arr <= u16::MAX as f32 {
-        Some(arr as u16)
-    } else {
-        None
-    }
-}
 
 /// Dead-time length in `t_DTS` ticks of a TIMx_BDTR.DTG code (RM0440 §28.6.20):
 /// `0xx`: DTG; `10x`: (64 + DTG\[5:0\])·2; `110`: (32 + DTG\[4:0\])·8;
@@ -73,17 +61,6 @@ pub const fn iwdg_setting(lsi_ticks: u32) -> Option<(u8, u16)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Thesis A: f_s = 20 kHz from a 170 MHz timer clock, centre-aligned:
-    /// 170e6/(2·20e3) = 4250 (hand calculation); 16 kHz → 5312.5 → 5313.
-    #[test]
-    fn pwm_period() {
-        assert_eq!(centre_aligned_arr(170_000_000, 20_000.0), Some(4250));
-        assert_eq!(centre_aligned_arr(170_000_000, 16_000.0), Some(5313));
-        assert_eq!(centre_aligned_arr(170_000_000, 1_000.0), None); // 85 000 > 65 535
-        assert_eq!(centre_aligned_arr(170_000_000, 0.0), None);
-        assert_eq!(centre_aligned_arr(170_000_000, f32::NAN), None);
-    }
 
     /// Hand calculations at 170 MHz (5.88 ns per tick):
     /// 500 ns = 85 ticks → DTG 85; 1 µs = 170 ticks → (64 + 21)·2 = 170 → 0x95;

@@ -29,6 +29,14 @@ pub fn from_radians_f64(rad: f64) -> i32 {
     libm::round(wrapped * 2_147_483_648.0) as i64 as i32
 }
 
+/// π-scaled Q1.31 stored integer → angle \[rad\] in `[−π, π)` (4.20), in `f64`: the
+/// exact inverse of [`from_radians_f64`] on its range (every `i32` is exact in `f64`).
+/// The host-side conversion: the simulations read the controller's angles and the
+/// design's θ_off with it.
+pub fn to_radians_f64(theta: i32) -> f64 {
+    f64::from(theta) * core::f64::consts::PI / 2_147_483_648.0
+}
+
 /// Observer speed stored integer → rad/s: `ω = 2^-31·f_s·π·ω^i` (4.20), where
 /// `rad_per_s_per_lsb = π·f_s/2^31` (a configuration constant, see
 /// [`crate::step::ControllerConfig::speed_per_lsb`]).
@@ -187,6 +195,11 @@ mod tests {
         assert_eq!(from_radians_f64(0.6 * PI / 2_147_483_648.0), 1);
         // 0.3 rad = 0.3/π·2^31 = 205 069 582.67 LSB.
         assert_eq!(from_radians_f64(0.3), 205_069_583);
+        // The inverse: 2^30 LSB = π/2, −2^31 = −π, 205 069 583 LSB = 0.3 rad to within half
+        // an LSB (π/2^32 = 7.3e-10 rad).
+        assert_eq!(to_radians_f64(1 << 30), PI / 2.0);
+        assert_eq!(to_radians_f64(i32::MIN), -PI);
+        assert!((to_radians_f64(205_069_583) - 0.3).abs() < PI / 4_294_967_296.0);
         // The f32 form truncates, within the f32 resolution (24 bits: 2^28/2^24 = 16 LSB here).
         assert!((from_radians(0.3) - 205_069_583).abs() < 64);
     }

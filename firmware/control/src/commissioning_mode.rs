@@ -21,6 +21,7 @@
 //! for number, and the log keeps the unfiltered current for inspection; the FMAC stays
 //! free for the control interrupt and the capture needs no second buffer.
 
+use crate::angle::to_radians;
 use crate::can_protocol::{self as p, Command, End, Frame, Header, Layout, Reason, Routine, State};
 use crate::commissioning::{
     Axis, CommissioningError, FluxLinkage, FluxLinkageState, PolePairRatio, PolePairRatioState, Progress,
@@ -347,17 +348,17 @@ impl CommissioningMode {
                     Progress::Running(Demand::VoltageAlphaBeta(v)) => v.alpha,
                     _ => 0.0,
                 };
-                (finish_ok(pr), (u, angle_rad(m.theta_r)))
+                (finish_ok(pr), (u, to_radians(m.theta_r)))
             }
             Running::Rotate(r, st) => {
                 let pr = r.process(st, trig, m.theta_r);
-                let generated = angle_rad(st.generated_angle());
+                let generated = to_radians(st.generated_angle());
                 let outcome = match pr {
                     Progress::Running(d) => Progress::Running(d),
                     Progress::Finished(Ok(_)) => Progress::Finished(None),
                     Progress::Finished(Err(e)) => Progress::Finished(Some(e)),
                 };
-                (outcome, (generated, angle_rad(m.theta_r)))
+                (outcome, (generated, to_radians(m.theta_r)))
             }
             Running::Flux(st) => {
                 let pr = cfg.flux.process(st, m.u_q, m.omega_e);
@@ -465,11 +466,6 @@ fn finish_ok<R>(pr: Progress<R>) -> Progress<Option<CommissioningError>> {
         Progress::Running(d) => Progress::Running(d),
         Progress::Finished(_) => Progress::Finished(None),
     }
-}
-
-/// A π-scaled Q1.31 angle in radians, in \[−π, π).
-fn angle_rad(theta: i32) -> f32 {
-    theta as f32 * (core::f32::consts::PI / 2_147_483_648.0)
 }
 
 #[cfg(test)]

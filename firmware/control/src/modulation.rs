@@ -78,11 +78,37 @@ pub fn compare_values(duties: [f32; 3], period: u16) -> [u16; 3] {
     duties.map(|d| ((unit(d) * p + 0.5) as u16).min(period))
 }
 
+/// The auto-reload of a centre-aligned (up/down) carrier at `switching_hz` from a
+/// `timer_hz` kernel clock: one carrier period is `2·ARR` timer ticks, so
+/// `ARR = round(f_tim/(2·f_s))` (RM0440 §28.3.3, thesis A Fig. 3.4) — the `period` of
+/// [`compare_values`]. `None` if it does not fit the 16-bit register or is zero.
+pub const fn centre_aligned_period(timer_hz: u32, switching_hz: f32) -> Option<u16> {
+    let arr = timer_hz as f32 / (2.0 * switching_hz) + 0.5;
+    // Also rejects NaN, ∞ and f_s ≤ 0 (the comparisons are false).
+    if arr >= 1.0 && arr <= u16::MAX as f32 {
+        Some(arr as u16)
+    } else {
+        None
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use core::f64::consts::PI;
     use proptest::prelude::*;
+
+    /// Thesis A: f_s = 20 kHz from a 170 MHz timer clock, centre-aligned:
+    /// 170e6/(2·20e3) = 4250 (hand calculation); 16 kHz → 5312.5 → 5313; 1 kHz → 85 000,
+    /// beyond the 16-bit register.
+    #[test]
+    fn pwm_period() {
+        assert_eq!(centre_aligned_period(170_000_000, 20_000.0), Some(4250));
+        assert_eq!(centre_aligned_period(170_000_000, 16_000.0), Some(5313));
+        assert_eq!(centre_aligned_period(170_000_000, 1_000.0), None);
+        assert_eq!(centre_aligned_period(170_000_000, 0.0), None);
+        assert_eq!(centre_aligned_period(170_000_000, f32::NAN), None);
+    }
 
     /// f64 reference of (3.7), (3.8), (3.4) with the thesis' formula literally:
     /// u_NM = −U_dc/(6√3)·cos 3(θ + atan2(u_q, u_d)).

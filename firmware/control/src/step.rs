@@ -15,6 +15,9 @@
 //! Three sine/cosine evaluations per step go through [`Trig`] (observer, Park,
 //! inverse Park), so the board layer can use the CORDIC.
 
+mod parameters;
+pub use parameters::ControllerParameters;
+
 use crate::adc::{CurrentSense, DcLinkSense};
 use crate::angle::{ResolverToElectrical, ResolverTurns, lead, speed_to_rad_per_s};
 use crate::ato::{AtoConfig, AtoState, ResolverSample};

@@ -7,7 +7,7 @@ use std::f64::consts::PI;
 use serde::Serialize;
 
 use super::Context;
-use crate::design::angle_observer;
+use crate::design::angle_observer::{self, ObserverGains};
 use crate::spec::{ObserverError, Provenance};
 
 /// The angle-tracking-observer design.
@@ -19,20 +19,10 @@ pub struct ObserverOut {
     pub natural_frequency_rad_s: f64,
     /// ζ.
     pub damping: f64,
-    /// K_p = 2ζω_n (4.15).
-    pub kp: f64,
-    /// K_i = ω_n² (4.15).
-    pub ki: f64,
-    /// K̃_p as a real number (4.22).
-    pub kp_scaled: f64,
-    /// K̃_i as a real number (4.22).
-    pub ki_scaled: f64,
-    /// K̃_p stored integer, Q1.31.
-    pub kp_q31: i32,
-    /// K̃_i stored integer, Q1.31.
-    pub ki_q31: i32,
-    /// Relative rounding error of K̃_i.
-    pub ki_quantisation_error: f64,
+    /// K_p, K_i (4.15) and their Q1.31 forms K̃_p, K̃_i (4.22), with K̃_i's rounding error
+    /// (serialised as fields of this section).
+    #[serde(flatten)]
+    pub gains: ObserverGains,
     /// n_p (motor).
     pub motor_pole_pairs: u32,
     /// n_r (resolver).
@@ -132,13 +122,7 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
         error: o.error,
         natural_frequency_rad_s: o.natural_frequency.value,
         damping: o.damping.value,
-        kp: obs.kp,
-        ki: obs.ki,
-        kp_scaled: obs.kp_scaled,
-        ki_scaled: obs.ki_scaled,
-        kp_q31: obs.kp_q31,
-        ki_q31: obs.ki_q31,
-        ki_quantisation_error: obs.ki_quantisation_error,
+        gains: obs,
         motor_pole_pairs: np,
         resolver_pole_pairs: nr,
         electrical_per_resolver: f64::from(np) / f64::from(nr),

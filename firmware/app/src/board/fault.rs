@@ -44,12 +44,14 @@ pub fn halt() -> ! {
 /// Records `cause` (with the control state of the last period) and stops.
 pub fn stop(cause: FaultCause) -> ! {
     cortex_m::interrupt::disable();
-    seal(cause, None, 0, 0);
-    outputs_off_and_wait()
+    let record = seal(cause, None, 0, 0);
+    outputs_off_and_wait(&record)
 }
 
-/// Switches the outputs off and waits for the watchdog reset.
-fn outputs_off_and_wait() -> ! {
+/// Switches the outputs off, logs `record` (with the `defmt` feature: only after the
+/// outputs are off, since a probe in blocking mode may hold the log) and waits for the
+/// watchdog reset.
+fn outputs_off_and_wait(record: &FaultRecord) -> ! {
     cortex_m::interrupt::disable();
     // SAFETY: interrupts are disabled and this never returns, so the owners of
     // TIM1, GPIOA/B and the IWDG never run again; the writes below only move the
@@ -58,6 +60,7 @@ fn outputs_off_and_wait() -> ! {
     dp.TIM1.bdtr().modify(|_, w| w.moe().clear_bit());
     pins::gates_low(&dp.GPIOA, &dp.GPIOB, &dp.GPIOC);
     watchdog::start_default(&dp.IWDG);
+    log_fault(record);
     loop {
         cortex_m::asm::nop();
     }
@@ -92,8 +95,8 @@ extern "C" fn hard_fault(sp: u32) -> ! {
     // SAFETY: `classify_hard_fault` returns an address only when the whole exception
     // frame lies inside the stack region, which is RAM.
     let pc = pc_at.map(|a| unsafe { core::ptr::read_volatile(a as *const u32) });
-    seal(cause, pc, cfsr, hfsr);
-    outputs_off_and_wait()
+    let record = seal(cause, pc, cfsr, hfsr);
+    outputs_off_and_wait(&record)
 }
 
 /// The main stack's `[bottom, top)` addresses, from memory.x.
@@ -155,8 +158,8 @@ pub fn record(cause: FaultCause) {
     seal(cause, None, 0, 0);
 }
 
-/// Seals a record of `cause` with the live control state.
-fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32) {
+/// Seals a record of `cause` with the live control state; returns it.
+fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32) -> FaultRecord {
     let state = read_words((&raw const MOTOR_CONTROL_STATE).cast());
     let record = FaultRecord {
         cause,
@@ -167,7 +170,33 @@ fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32) {
         reported: false,
     };
     write_words((&raw mut MOTOR_FAULT_RECORD).cast(), &record.to_words());
+    record
 }
+
+/// With the `defmt` feature: a fault entry on the probe's RTT channel — the cause
+/// (`FaultCause` code), the stacked PC, CFSR and HFSR. Never from the control
+/// interrupt: its trips only [`record`]; the record reaches the log at the next boot.
+/// Logs once per boot: a fault inside the logger (a HardFault while a line is written,
+/// or the logger's own panic) must not log again and re-enter it.
+#[cfg(feature = "defmt")]
+fn log_fault(r: &FaultRecord) {
+    use core::sync::atomic::{AtomicBool, Ordering};
+    static LOGGED: AtomicBool = AtomicBool::new(false);
+    if LOGGED.swap(true, Ordering::Relaxed) {
+        return;
+    }
+    defmt::error!(
+        "fault: cause {=u32}, PC {=?}, CFSR {=u32:#010x}, HFSR {=u32:#010x}; outputs off, waiting for the watchdog reset",
+        r.cause as u32,
+        r.pc,
+        r.cfsr,
+        r.hfsr
+    );
+}
+
+/// Without the `defmt` feature: nothing.
+#[cfg(not(feature = "defmt"))]
+fn log_fault(_: &FaultRecord) {}
 
 /// At boot, before anything can fault: the record of the previous run
 /// (`motor_config::fault_record::at_boot`), from RCC_CSR's reset flags (RM0440 §7.4,
@@ -179,6 +208,8 @@ fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32) {
 /// once per boot.
 pub fn take_at_boot(rcc: &pac::RCC) -> Option<FaultRecord> {
     let csr = rcc.csr().read();
+    #[cfg(feature = "defmt")]
+    defmt::info!("boot: RCC_CSR {=u32:#010x} (reset flags, RM0440 §7.4)", csr.bits());
     let record = if csr.borrstf().bit_is_set() {
         None
     } else {
@@ -188,6 +219,19 @@ pub fn take_at_boot(rcc: &pac::RCC) -> Option<FaultRecord> {
             csr.iwdgrstf().bit_is_set(),
         )
     };
+    #[cfg(feature = "defmt")]
+    match &record {
+        Some(r) => defmt::warn!(
+            "previous run: fault record cause {=u32}, PC {=?}, CFSR {=u32:#010x}, HFSR {=u32:#010x}, control state {=bool}, sent on CAN {=bool}",
+            r.cause as u32,
+            r.pc,
+            r.cfsr,
+            r.hfsr,
+            r.state.is_some(),
+            r.reported
+        ),
+        None => defmt::info!("previous run: no fault record"),
+    }
     rcc.csr().modify(|_, w| w.rmvf().set_bit());
     write_words((&raw mut MOTOR_CONTROL_STATE).cast(), &[0; STATE_WORDS]);
     write_words(
@@ -217,17 +261,20 @@ pub fn report(can: &mut Can, record: FaultRecord) {
     }
 }
 
-/// A panic in a development build: outputs off, wait for the watchdog.
-#[cfg(debug_assertions)]
+/// A panic in a development build, or in an image with the `defmt` feature (defmt-rtt's
+/// logger panics when taken re-entrantly, so that image cannot prove the absence of
+/// panics below): outputs off, wait for the watchdog.
+#[cfg(any(debug_assertions, feature = "defmt"))]
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
     stop(FaultCause::Panic)
 }
 
-/// Release builds prove that no panic is reachable anywhere in the image — the
-/// control interrupt included: the panic handler calls a function that does not
-/// exist, so the image links only if the optimiser removed every path to a panic.
-#[cfg(not(debug_assertions))]
+/// Release builds (without the `defmt` feature) prove that no panic is reachable
+/// anywhere in the image — the control interrupt included: the panic handler calls a
+/// function that does not exist, so the image links only if the optimiser removed every
+/// path to a panic.
+#[cfg(not(any(debug_assertions, feature = "defmt")))]
 #[panic_handler]
 fn panic(_: &core::panic::PanicInfo) -> ! {
     unsafe extern "C" {
