@@ -14,7 +14,7 @@ use codegen::verify::Setup;
 use motor_sim::plant::{Measured, Plant, SpeedProfile};
 
 use crate::soc::Analog;
-use crate::wiring::RESOLVER_AMPLITUDE;
+use crate::wiring::Sensing;
 
 /// The plant's state at one bridge change.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -35,10 +35,7 @@ pub struct Drive {
     /// Longest integration step \[s\]: the design's sample period, for which the plant's
     /// RK4 sub-steps are sized ([`motor_sim::plant::SUBSTEPS`]).
     max_step_s: f64,
-    gain_v_per_a: f64,
-    offset_v: f64,
-    divider: f64,
-    vref: f64,
+    sensing: Sensing,
     /// Every bridge change, in time order.
     pub samples: Vec<Sample>,
 }
@@ -50,14 +47,10 @@ impl Drive {
     /// through the design's board.
     pub fn new(setup: &Setup<'_>, speed: SpeedProfile) -> Result<Self, String> {
         let d = setup.design;
-        let b = &d.board.as_ref().ok_or("the design has no board")?.board;
         Ok(Self {
             plant: setup.plant(speed),
             max_step_s: d.drive.sample_period_s,
-            gain_v_per_a: b.current_gain_v_per_a,
-            offset_v: b.current_offset_v,
-            divider: b.dc_link_divider,
-            vref: b.adc_reference_v,
+            sensing: Sensing::new(d)?,
             samples: Vec::new(),
         })
     }
@@ -83,24 +76,12 @@ impl Drive {
 }
 
 impl Analog for Drive {
-    /// The board's sensing: phase current i → offset + gain·i, DC link through its
-    /// divider, resolver SIN/COS at mid-scale ± [`RESOLVER_AMPLITUDE`] of half the range
-    /// times sin/cos θ_r and the excitation's sign (synchronous demodulation, thesis A
-    /// §4.3), as [`crate::wiring::Standstill`] does at θ_r = 0.
+    /// The board's [`Sensing`] of the plant at `t`: its phase currents, DC link and
+    /// resolver angle θ_r.
     fn volts(&mut self, signal: Signal, t: f64, excitation_high: bool) -> f64 {
         let m = self.measure_at(t);
-        let half = self.vref / 2.0;
-        let sign = if excitation_high { 1.0 } else { -1.0 };
-        let current = |k: usize| self.offset_v + self.gain_v_per_a * m.phase_currents[k];
-        match signal {
-            Signal::CurrentU => current(0),
-            Signal::CurrentV => current(1),
-            Signal::CurrentW => current(2),
-            Signal::DcLink => m.dc_link * self.divider,
-            Signal::ResolverSin => half + RESOLVER_AMPLITUDE * half * sign * m.theta_r.sin(),
-            Signal::ResolverCos => half + RESOLVER_AMPLITUDE * half * sign * m.theta_r.cos(),
-            _ => 0.0,
-        }
+        self.sensing
+            .volts(signal, m.phase_currents, m.dc_link, m.theta_r, excitation_high)
     }
 
     fn bridge(&mut self, t: f64, duties: Option<[f64; 3]>) {

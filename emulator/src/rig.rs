@@ -28,7 +28,7 @@ pub struct Rig {
 impl Rig {
     /// Builds (once per process) and loads `motor`'s image, at reset.
     pub fn new(motor: &str, patches: Patches) -> Result<Self, String> {
-        Self::with_analog(motor, patches, |d| Ok(Box::new(Standstill::new(d))))
+        Self::with_analog(motor, patches, |d| Ok(Box::new(Standstill::new(d)?)))
     }
 
     /// [`Rig::new`] with the analog inputs from `analog` (given the design), e.g. the

@@ -70,49 +70,83 @@ pub fn wiring(d: &Design) -> Result<Wiring, String> {
     })
 }
 
-/// The inverter at standstill: phase currents `currents` \[A\] through the board's
-/// sensing gain and offset, the DC link at `dc_link_v` through its divider, the resolver
-/// at rotor angle 0 (SIN at mid-scale, COS at [`RESOLVER_AMPLITUDE`] of half the range
-/// times the excitation's sign).
-#[derive(Clone, Debug)]
-pub struct Standstill {
-    /// Phase currents u, v, w \[A\].
-    pub currents: [f64; 3],
-    /// DC-link voltage \[V\].
-    pub dc_link_v: f64,
+/// The board's analog front end: what the pins of the sensed signals carry for a given
+/// drive state — phase current i → offset + gain·i, the DC link through its divider, the
+/// resolver SIN/COS at mid-scale ± [`RESOLVER_AMPLITUDE`] of half the range times
+/// sin/cos θ_r and the excitation's sign (synchronous demodulation, thesis A §4.3).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sensing {
     gain_v_per_a: f64,
     offset_v: f64,
     divider: f64,
     vref: f64,
 }
 
-impl Standstill {
-    /// Zero current at the motor's nominal DC-link voltage.
-    pub fn new(d: &Design) -> Self {
-        let b = &d.board.as_ref().expect("a board design").board;
-        Self {
-            currents: [0.0; 3],
-            dc_link_v: d.drive.dc_link_voltage_v,
+impl Sensing {
+    /// The sensing of `d`'s board (board file: `current_gain`, `current_offset`,
+    /// `dc_link_divider`, `adc_reference`).
+    pub fn new(d: &Design) -> Result<Self, String> {
+        let b = &d.board.as_ref().ok_or("the design has no board")?.board;
+        Ok(Self {
             gain_v_per_a: b.current_gain_v_per_a,
             offset_v: b.current_offset_v,
             divider: b.dc_link_divider,
             vref: b.adc_reference_v,
+        })
+    }
+
+    /// Voltage at the pin of `signal` with phase currents `currents` \[A\], DC link
+    /// `dc_link_v` \[V\], resolver angle `theta_r` \[rad\] and the excitation's level.
+    pub fn volts(
+        &self,
+        signal: Signal,
+        currents: [f64; 3],
+        dc_link_v: f64,
+        theta_r: f64,
+        excitation_high: bool,
+    ) -> f64 {
+        let half = self.vref / 2.0;
+        let sign = if excitation_high { 1.0 } else { -1.0 };
+        let current = |k: usize| self.offset_v + self.gain_v_per_a * currents[k];
+        match signal {
+            Signal::CurrentU => current(0),
+            Signal::CurrentV => current(1),
+            Signal::CurrentW => current(2),
+            Signal::DcLink => dc_link_v * self.divider,
+            Signal::ResolverSin => half + RESOLVER_AMPLITUDE * half * sign * theta_r.sin(),
+            Signal::ResolverCos => half + RESOLVER_AMPLITUDE * half * sign * theta_r.cos(),
+            _ => 0.0,
         }
+    }
+}
+
+/// The inverter at standstill: phase currents `currents` \[A\] and the DC link at
+/// `dc_link_v` through the board's [`Sensing`], the resolver at rotor angle 0 (SIN at
+/// mid-scale, COS at [`RESOLVER_AMPLITUDE`] of half the range times the excitation's
+/// sign).
+#[derive(Clone, Debug)]
+pub struct Standstill {
+    /// Phase currents u, v, w \[A\].
+    pub currents: [f64; 3],
+    /// DC-link voltage \[V\].
+    pub dc_link_v: f64,
+    sensing: Sensing,
+}
+
+impl Standstill {
+    /// Zero current at the motor's nominal DC-link voltage.
+    pub fn new(d: &Design) -> Result<Self, String> {
+        Ok(Self {
+            currents: [0.0; 3],
+            dc_link_v: d.drive.dc_link_voltage_v,
+            sensing: Sensing::new(d)?,
+        })
     }
 }
 
 impl Analog for Standstill {
     fn volts(&mut self, signal: Signal, _t: f64, excitation_high: bool) -> f64 {
-        let half = self.vref / 2.0;
-        let sign = if excitation_high { 1.0 } else { -1.0 };
-        match signal {
-            Signal::CurrentU => self.offset_v + self.gain_v_per_a * self.currents[0],
-            Signal::CurrentV => self.offset_v + self.gain_v_per_a * self.currents[1],
-            Signal::CurrentW => self.offset_v + self.gain_v_per_a * self.currents[2],
-            Signal::DcLink => self.dc_link_v * self.divider,
-            Signal::ResolverSin => half,
-            Signal::ResolverCos => half + RESOLVER_AMPLITUDE * half * sign,
-            _ => 0.0,
-        }
+        self.sensing
+            .volts(signal, self.currents, self.dc_link_v, 0.0, excitation_high)
     }
 }
