@@ -64,7 +64,7 @@ fn ms(d: Duration) -> f64 {
 
 /// A scratch crate `name` under `root` with `lib` as its `src/lib.rs`.
 fn scratch_crate(root: &Path, name: &str, lib: &str) -> PathBuf {
-    let repo = motor_tests::repo().canonicalize().expect("repo");
+    let repo = motor_test_support::repo().canonicalize().expect("repo");
     let dir = root.join(name);
     std::fs::create_dir_all(dir.join("src")).unwrap();
     let manifest = format!(
@@ -84,13 +84,13 @@ fn scratch_crate(root: &Path, name: &str, lib: &str) -> PathBuf {
 }
 
 fn main() {
-    let repo = motor_tests::repo().canonicalize().expect("repo");
+    let repo = motor_test_support::repo().canonicalize().expect("repo");
     let root = repo.join("target/build-cost");
     let target_dir = root.join("target");
     let build = ["build", "--offline", "--quiet"];
 
     println!("motor_constants! expansion cost (median of {RUNS} rebuilds after touching lib.rs, min–max):");
-    for (stem, rel, text) in motor_tests::motors() {
+    for (stem, rel, text) in motor_test_support::motors() {
         let ident = stem.replace('-', "_");
         let design = codegen::design_source(&rel, &text).expect("seed motor designs");
         let rendered = render(&design, Output::Rust).expect("renders");

@@ -5,7 +5,7 @@
 //! Nothing here is a constant of a motor or a board: identifiers and scalings come in a
 //! [`Layout`], built from the generated `can` constants group (firmware) or from the same
 //! group of the design (host). The generated DBC file (`templates/motor.dbc.j2`) describes
-//! exactly these layouts; `codegen/tests/can_dbc.rs` parses it and checks every signal
+//! exactly these layouts; `crates/commission/tests/it/can_dbc.rs` parses it and checks every signal
 //! against the encoders here.
 //!
 //! All multi-byte fields are little-endian (DBC byte order `1`, "Intel"). Scaled values

@@ -1,5 +1,0 @@
-//! The designed (continuous) responses the sampled figures are compared with, which are
-//! `design::designed_response`'s (the sampled figures themselves are
-//! [`motor_sim::figures`]).
-
-pub use crate::design::designed_response::{designed_rise_time, designed_step};

@@ -1,0 +1,39 @@
+//! Time to design one motor (spec text → complete design, FIR included) and all of `motors/`.
+//! Target (issue): under 10 ms per motor, release build.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{Criterion, criterion_group, criterion_main};
+
+fn specs() -> Vec<(String, String)> {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../motors");
+    let mut v: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok().map(|e| e.path()))
+        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+        .map(|p| (p.display().to_string(), std::fs::read_to_string(&p).unwrap()))
+        .collect();
+    v.sort();
+    v
+}
+
+fn bench(c: &mut Criterion) {
+    let specs = specs();
+    for (file, text) in &specs {
+        let stem = Path::new(file).file_stem().unwrap().to_string_lossy().into_owned();
+        c.bench_function(&format!("design/{stem}"), |b| {
+            b.iter(|| codegen::design_source(black_box(file), black_box(text)).unwrap())
+        });
+    }
+    c.bench_function("design/all-motors", |b| {
+        b.iter(|| {
+            for (file, text) in &specs {
+                black_box(codegen::design_source(file, text).unwrap());
+            }
+        })
+    });
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,75 @@
+//! `codegen`, the design core: a motor description (TOML) in, every tuned controller
+//! constant out, rendered as Rust, C, Markdown and DBC.
+//!
+//! The design path does no file I/O: [`design_source`] takes the file's name and
+//! text and returns the [`Design`] or located [`Diagnostics`]. The `motorgen` CLI, the
+//! firmware's build script and the proc-macros all call it, so a constant cannot differ
+//! between the three paths. ([`files`] holds the one helper the CLI and the build
+//! scripts share to write generated files.)
+//!
+//! Layers inside (each module may use the ones above it, never one below; checked by
+//! `tests/it/layers.rs`): [`units`], [`diagnostic`], [`escape`] → [`spec`], [`board`]
+//! (parsing) → [`design`] → [`constants`] → [`render`], [`summary`].
+//! This crate depends on no simulation, plotting, CLI, CAN or file-editing crate
+//! (`ARCHITECTURE.md`): verification is `motor-verify`, identification and the CAN
+//! session `motor-commission`, the command line `motorgen`.
+
+pub mod board;
+pub mod constants;
+pub mod design;
+pub mod diagnostic;
+pub mod escape;
+pub mod files;
+pub mod render;
+pub mod spec;
+pub mod summary;
+pub mod units;
+
+pub use design::Design;
+pub use diagnostic::{Diagnostic, Diagnostics, Source};
+
+/// Parses and checks one board file. `file` is only used in messages.
+pub fn board_source(file: &str, text: &str) -> Result<board::Board, Diagnostics> {
+    board::parse(Source { file, text })
+}
+
+/// Designs a motor on a board: the motor's design ([`design_source`]) with the board's
+/// constants and the checks that need both (warnings at the board key, see
+/// [`board::design`]).
+pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &str) -> Result<Design, Diagnostics> {
+    let board = board_source(board_file, board_text);
+    let design = design_source(file, text);
+    let (board, mut design) = match (board, design) {
+        (Ok(b), Ok(d)) => (b, d),
+        (Err(mut a), Err(b)) => {
+            a.0.extend(b.0);
+            return Err(a);
+        }
+        (Err(e), _) | (_, Err(e)) => return Err(e),
+    };
+    let (out, warnings) = board::design::design(&board, board_text, &design);
+    if let Some((path, x)) = design::finite::first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&out))) {
+        let src = Source {
+            file: board_file,
+            text: board_text,
+        };
+        return Err(src
+            .error(
+                0..0,
+                "",
+                format!("the board design's `board.{path}` comes out as {x}: the board's values with this motor overflow f64"),
+                "board values in their physically sensible ranges (see boards/nucleo-g474re.toml)",
+            )
+            .into());
+    }
+    design.warnings.extend(warnings);
+    design.board = Some(out);
+    Ok(design)
+}
+
+/// Parses, resolves and designs one spec. `file` is only used in messages.
+pub fn design_source(file: &str, text: &str) -> Result<Design, Diagnostics> {
+    let source = Source { file, text };
+    let spec = spec::parse(source)?;
+    design::design(&spec, source)
+}

@@ -1,0 +1,171 @@
+//! Board files: every file in `boards/` resolves and passes the chip checks; every file
+//! of the corpus `tests/bad-boards/` is refused with a located error (file,
+//! line:column of the offending value, key, what is wrong, what is accepted).
+
+use std::path::Path;
+
+use codegen::Source;
+use codegen::board::{self, Board};
+
+use motor_test_support::repo;
+
+fn parse(path: &Path) -> (String, Result<Board, codegen::Diagnostics>) {
+    let text = std::fs::read_to_string(path).expect("readable");
+    let shown = path.file_name().unwrap().to_string_lossy().into_owned();
+    let r = board::parse(Source {
+        file: &shown,
+        text: &text,
+    });
+    (text, r)
+}
+
+#[test]
+fn every_board_in_boards_resolves() {
+    let mut n = 0;
+    for stem in motor_test_support::board_stems() {
+        let path = repo().join(format!("boards/{stem}.toml"));
+        let (_, r) = parse(&path);
+        if let Err(d) = r {
+            panic!("{}: {d}", path.display());
+        }
+        n += 1;
+    }
+    assert!(n >= 2, "the reference board and the NUCLEO-G474RE + X-NUCLEO-IHM08M1");
+}
+
+/// 1-based line and column of the first occurrence of `needle` in `text` (the
+/// value the error must point at, located independently of the code under test).
+fn position(text: &str, needle: &str) -> (usize, usize) {
+    let at = text
+        .find(needle)
+        .unwrap_or_else(|| panic!("{needle:?} in the corpus file"));
+    let line = text[..at].matches('\n').count() + 1;
+    let col = text[..at].rsplit('\n').next().unwrap().chars().count() + 1;
+    (line, col)
+}
+
+/// One corpus entry: (file, text the error points at, key, words of the problem, words
+/// of the accepted line).
+type Case = (
+    &'static str,
+    &'static str,
+    &'static str,
+    &'static [&'static str],
+    &'static [&'static str],
+);
+
+const CORPUS: &[Case] = &[
+    (
+        "wrong-af.toml",
+        "\"PA5\"",
+        "pins.gate_u_low",
+        &[
+            "PA5 has no TIM1_CH1N function on the STM32G474RE",
+            "alternate functions: AF1 TIM2_CH1",
+        ],
+        &["PA7 (AF6)", "PB13 (AF6)"],
+    ),
+    (
+        "slow-channel-too-fast.toml",
+        "2.5             # every input",
+        "sensing.sampling_cycles",
+        &[
+            "PA4 is ADC2_IN17, a slow channel",
+            "1100 Ω needs ≥ 24.5 cycles",
+            "DS12288 Table 67",
+        ],
+        &["sampling_cycles = 24.5"],
+    ),
+    (
+        "pin-used-twice.toml",
+        "\"PB13\"             # TIM1_CH2N",
+        "pins.gate_v_low",
+        &["two signals on PB13: `pins.gate_u_low` and `pins.gate_v_low`"],
+        &["one pin per signal"],
+    ),
+    (
+        "boot0-unstated.toml",
+        "\"PB8\"",
+        "pins.can_rx",
+        &["PB8 is BOOT0", "DS12288 §3.7", "nSWBOOT0 = 1"],
+        &["[boot0]", "\"option_bytes\"", "\"held_low\""],
+    ),
+    (
+        "boot0-held-low-with-can.toml",
+        "\"held_low\"",
+        "boot0.handling",
+        &["CAN transceiver drives RXD high"],
+        &["\"option_bytes\""],
+    ),
+    (
+        "unknown-pin.toml",
+        "\"PC16\"",
+        "pins.resolver_excitation",
+        &["\"PC16\" is not a pin of the STM32G474RE (LQFP64)"],
+        &["PA0", "PC15", "PG10"],
+    ),
+    (
+        "missing-signal.toml",
+        "[pins]",
+        "pins.gate_w_low",
+        &["missing required key `pins.gate_w_low`"],
+        &["TIM1_CH3N", "PB1 (AF6)", "PB15 (AF4)"],
+    ),
+    (
+        "not-an-adc12-input.toml",
+        "\"PB13\"",
+        "pins.current_v",
+        &["PB13 is not an input of ADC1 or ADC2", "ADC3_IN5"],
+        &["an ADC1/ADC2 input", "PA0"],
+    ),
+    (
+        "trip-beyond-range.toml",
+        "\"150 A\"",
+        "protection.over_current",
+        &["beyond what the board measures, ±110.00 A"],
+        &["up to 110.00 A"],
+    ),
+    (
+        "bare-number.toml",
+        "500 ",
+        "pwm.dead_time",
+        &["bare number 500 where a time belongs"],
+        &["\"1.5 ms\""],
+    ),
+];
+
+#[test]
+fn bad_boards_are_refused_at_the_key() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/bad-boards");
+    let files = std::fs::read_dir(&dir).unwrap().count();
+    assert_eq!(files, CORPUS.len(), "every corpus file has an expectation");
+    for (file, at, key, problem, accepted) in CORPUS {
+        let (text, r) = parse(&dir.join(file));
+        let errors = match r {
+            Ok(_) => panic!("{file} was accepted"),
+            Err(d) => d.0,
+        };
+        let (line, column) = position(&text, at);
+        let d = errors
+            .iter()
+            .find(|d| d.key == *key)
+            .unwrap_or_else(|| panic!("{file}: no error at `{key}`: {errors:#?}"));
+        assert_eq!(
+            (d.file.as_str(), d.line, d.column),
+            (*file, line, column),
+            "{file}: {d}"
+        );
+        for p in *problem {
+            assert!(d.problem.contains(p), "{file}: problem lacks {p:?}:\n{d}");
+        }
+        for a in *accepted {
+            assert!(d.accepted.contains(a), "{file}: accepted lacks {a:?}:\n{d}");
+        }
+        // The rendered message names file:line:column and the key, like a motor spec's.
+        assert!(
+            d.to_string()
+                .starts_with(&format!("error: {file}:{line}:{column}: `{key}`: ")),
+            "{d}"
+        );
+    }
+}

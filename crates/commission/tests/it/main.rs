@@ -1,0 +1,4 @@
+//! `motor-commission`'s integration tests, one binary.
+
+mod can_dbc;
+mod fuzz;

@@ -1,0 +1,156 @@
+//! The real image, run: reset → clocks → peripherals → the first control interrupt → the
+//! first enabled PWM period, on every motor in `motors/` with the default board, in
+//! strict mode; and reintroduced bring-up defects fail with the rule they break.
+
+use crate::BOOT_LIMIT_S;
+use motor_emulator::image::motors;
+use motor_emulator::periph::system::IRQ_ADC1_2;
+use motor_emulator::rig::Rig;
+use motor_emulator::{Note, Patches, Stop};
+
+/// Exception number of the control interrupt (16 + IRQ, ARMv7-M B1.5.2).
+const CONTROL_IRQ: u32 = 16 + IRQ_ADC1_2;
+
+#[test]
+fn every_motor_boots_to_its_first_enabled_pwm_period() {
+    for motor in motors() {
+        let mut rig = Rig::new(&motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
+        let enabled =
+            |m: &motor_emulator::Machine| m.soc().notes.iter().any(|n| matches!(n, Note::FirstEnabledPeriod(_)));
+        // Zero torque every setpoint period from reset: frames before the CAN join are lost.
+        let reached = rig
+            .run(BOOT_LIMIT_S, |_| Some(0.0), |m| enabled(m))
+            .unwrap_or_else(|e| panic!("{motor}: {e}; {}", rig.machine.summary()));
+        let m = &rig.machine;
+        let soc = m.soc();
+        assert!(
+            reached,
+            "{motor}: no enabled PWM period within {BOOT_LIMIT_S} s; {}",
+            rig.machine.summary()
+        );
+        let first_isr = m
+            .handled
+            .iter()
+            .find(|h| h.exception == CONTROL_IRQ)
+            .unwrap_or_else(|| panic!("{motor}: the control interrupt never ran"));
+        let first_enabled = soc
+            .notes
+            .iter()
+            .find_map(|n| match n {
+                Note::FirstEnabledPeriod(t) => Some(*t),
+                _ => None,
+            })
+            .unwrap();
+        let isr = m.handler_instructions(CONTROL_IRQ);
+        println!(
+            "{motor}: first control interrupt at {:.1} µs, first enabled PWM period at {:.1} µs \
+             ({} instructions to reset→first interrupt; {} ADEN writes lost to calibration; \
+             control interrupt {}–{} instructions over {} periods)",
+            first_isr.at as f64 / motor_emulator::UNITS_PER_S * 1e6,
+            first_enabled * 1e6,
+            first_isr.entry,
+            soc.adc[0].lost_aden_writes + soc.adc[1].lost_aden_writes,
+            isr.iter().min().unwrap(),
+            isr.iter().max().unwrap(),
+            isr.len(),
+        );
+        // The peripherals really ran: both converters' sequences, TIM3 reset by TRGO,
+        // the self-tests on the accelerators.
+        assert!(soc.adc[0].sequences > 0 && soc.adc[1].sequences > 0, "{motor}");
+        assert!(soc.tim3.slave_resets > 0, "{motor}: TIM3 never reset by TIM1's TRGO");
+        assert!(
+            soc.cordic.calculations >= 16,
+            "{motor}: the CORDIC self-test did not run"
+        );
+        assert!(soc.tim1.moe(), "{motor}: MOE not set");
+        assert!(soc.iwdg.expires_at.is_some(), "{motor}: the watchdog was not started");
+        assert_eq!(
+            soc.adc[0].missed_triggers, 0,
+            "{motor}: a trigger came during a conversion"
+        );
+    }
+}
+
+/// Review defect 4 reintroduced: LOCK in a second BDTR write (the patch splits the image's
+/// one write into the old two). Strict mode names the write-once rule.
+#[test]
+fn lock_in_a_second_bdtr_write_is_refused_with_the_rule() {
+    let patches = Patches {
+        bdtr_lock_second_write: true,
+        ..Patches::default()
+    };
+    let mut rig = Rig::new("fischer-ti085", patches).unwrap();
+    let err = rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false).unwrap_err();
+    let Stop::Violation(v) = err else {
+        panic!("expected a strict-mode violation, got {err}");
+    };
+    println!("{v}");
+    assert_eq!(v.register, "TIM1_BDTR");
+    assert!(
+        v.rule.contains("LOCK written again") && v.rule.contains("RM0440 §28.6.20"),
+        "{v}"
+    );
+}
+
+/// Review defect 1 reintroduced: ADEN written once after calibration and then only
+/// waited for (the patch drops the image's re-writes). Where that one write falls within
+/// 4 ADC clocks of ADCAL clearing it is lost, and strict mode names RM0440 §21.4.9; where
+/// it does not, the defect cannot show on this image and the converter becomes ready.
+#[test]
+fn aden_written_once_after_calibration_is_refused_with_the_rule() {
+    let patches = Patches {
+        single_aden_write: true,
+        ..Patches::default()
+    };
+    let mut rig = Rig::new("fischer-ti085", patches).unwrap();
+    let result = rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false);
+    let lost = rig.machine.soc().adc.iter().map(|a| a.lost_aden_writes).sum::<u32>();
+    assert!(
+        lost > 0,
+        "the image's first ADEN write was not within the 4-cycle window: {result:?}"
+    );
+    let Err(Stop::Violation(v)) = result else {
+        panic!("expected a strict-mode violation, got {result:?}");
+    };
+    println!("{v}");
+    assert!(v.register.ends_with("_ISR"), "{v}");
+    assert!(v.rule.contains("RM0440 §21.4.9") && v.rule.contains("ADEN"), "{v}");
+}
+
+/// The control interrupt's instructions per period from the emulator (entry to return,
+/// the whole handler: conversions read, trips, setpoint, the control step with the
+/// CORDIC, compare values, BIF/MOE), over 200 periods under a torque setpoint. At one
+/// instruction per cycle the handler must fit in the carrier period's cycles
+/// (SYSCLK/f_s) — a necessary condition; the QEMU figures in firmware/README.md count the
+/// control step alone.
+#[test]
+fn control_interrupt_instructions_fit_the_period() {
+    for motor in motors() {
+        let mut rig = Rig::new(&motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
+        rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
+        let torque = rig.design.board.as_ref().unwrap().board.torque_resolution_nm * 100.0;
+        let before = rig.machine.handler_instructions(CONTROL_IRQ).len();
+        let end = rig.machine.soc().time_s() + 200.0 * rig.pwm_period_s();
+        rig.run(end, |_| Some(torque), |_| false)
+            .unwrap_or_else(|e| panic!("{motor}: {e}"));
+        let counts = &rig.machine.handler_instructions(CONTROL_IRQ)[before..];
+        let (min, max) = (counts.iter().min().unwrap(), counts.iter().max().unwrap());
+        let mean = counts.iter().sum::<u64>() as f64 / counts.len() as f64;
+        assert!(
+            counts.len() >= 190,
+            "{motor}: {} interrupts in 200 periods ({min} / {max} / {mean:.0} instructions each)",
+            counts.len()
+        );
+        // 170 MHz SYSCLK (firmware/config/src/hw.rs, DS12288 §3.9).
+        let cycles = 170e6 / rig.design.drive.switching_frequency_hz;
+        assert!(
+            (*max as f64) < cycles,
+            "{motor}: {max} instructions, {cycles} cycles per period"
+        );
+        println!(
+            "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
+             {:.1} % of the {cycles:.0} cycles of a period",
+            mean / cycles * 100.0
+        );
+    }
+}

@@ -1,0 +1,458 @@
+//! `motorgen`: design motor-controller constants from a motor TOML file.
+
+mod atomic;
+mod commission;
+mod exit;
+mod firmware;
+mod identify;
+mod output;
+mod report;
+mod verify;
+
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+use codegen::render::{Output, render_with};
+use exit::{Exit, Failure};
+use output::{out, outln};
+
+/// Motor description (TOML) → tuned motor-controller constants.
+#[derive(Parser)]
+#[command(name = "motorgen", version, about, after_help = exit::HELP)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Print the whole design of one motor.
+    Design {
+        /// The motor spec, e.g. motors/fischer-ti085.toml.
+        #[arg(value_name = "SPEC")]
+        spec: PathBuf,
+        /// Output format.
+        #[arg(long, value_enum, default_value_t = Format::Summary)]
+        format: Format,
+        /// Directory with replacement templates (for rust, c, markdown).
+        #[arg(long, value_name = "DIR")]
+        templates: Option<PathBuf>,
+        /// A board file (boards/NAME.toml): adds the `board` constants and the checks
+        /// of the motor on that board.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
+    },
+    /// Write the Rust module, C header and Markdown summary of one motor into a directory,
+    /// and with --board the DBC file of its CAN interface (files are only rewritten when
+    /// their bytes change).
+    Generate {
+        /// The motor spec.
+        #[arg(value_name = "SPEC")]
+        spec: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+        /// Directory with replacement templates (motor.rs.j2, motor.h.j2, motor.md.j2,
+        /// motor.dbc.j2).
+        #[arg(long, value_name = "DIR")]
+        templates: Option<PathBuf>,
+        /// A board file: adds its `board` and `can` constants (as `design --board`) and
+        /// writes STEM.dbc.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
+    },
+    /// Validate motor specs and board files (a file with a top-level `chip` is a board);
+    /// warnings go to stderr; exit 1 if any has a problem.
+    Check {
+        /// One or more motor specs or board files.
+        #[arg(required = true, value_name = "FILE")]
+        specs: Vec<PathBuf>,
+    },
+    /// Write a commented starting spec to DIR/STEM.toml, DIR defaulting to motors/
+    /// (never overwrites).
+    New {
+        /// File stem: lowercase letters, digits and '-'.
+        #[arg(value_name = "STEM")]
+        stem: String,
+        /// Directory of motor specs.
+        #[arg(long, value_name = "DIR")]
+        dir: Option<PathBuf>,
+    },
+    /// Build the STM32G474 image of one motor (or --all) on a board into
+    /// target/firmware/STEM.elf and .bin (target/firmware/BOARD/… for a board other than
+    /// the default) and print its flash and RAM use (fails above the 64 KiB flash
+    /// budget); cargo's build progress is shown on stderr.
+    Firmware {
+        /// Motor file stem in the motors folder, e.g. fischer-ti085.
+        #[arg(required_unless_present = "all", conflicts_with = "all", value_name = "STEM")]
+        stem: Option<String>,
+        /// Every motor in the motors folder.
+        #[arg(long)]
+        all: bool,
+        /// Directory of motor specs (default: motors/).
+        #[arg(long, value_name = "DIR")]
+        dir: Option<PathBuf>,
+        /// Board file stem in the boards folder (default: motorgen-reference).
+        #[arg(long, value_name = "BOARD", default_value = codegen::board::DEFAULT_BOARD)]
+        board: String,
+        /// Directory of board files (default: boards/ beside the motors folder).
+        #[arg(long, value_name = "DIR")]
+        boards_dir: Option<PathBuf>,
+    },
+    /// Simulate the firmware's current loop and observer with the motor and print a
+    /// pass/fail table of measured vs designed figures (exit 3 on a failure).
+    Verify {
+        /// The motor spec.
+        #[arg(value_name = "SPEC")]
+        spec: PathBuf,
+    },
+    /// Write a self-contained HTML report (verification table, SVG plots, every constant
+    /// with formula and provenance) to DIR/STEM.html (exit 3 if a figure fails).
+    Report {
+        /// The motor spec.
+        #[arg(value_name = "SPEC")]
+        spec: PathBuf,
+        /// Output directory (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
+    /// Identify R, L, ψ_M or the resolver offset from recorded commissioning runs
+    /// (thesis A chapter 6) and write them into the spec's [motor.identified].
+    Identify {
+        #[command(subcommand)]
+        what: identify::What,
+    },
+    /// Write the captures in CAN logs (`candump -l` format) as the CSV recordings
+    /// `identify --csv` reads, for inspection: DIR/LOGSTEM-N-ROUTINE.csv (all or nothing;
+    /// a corrupted capture is a located error and nothing is written).
+    Capture {
+        /// The motor spec (its scalings decode the signals).
+        #[arg(value_name = "SPEC")]
+        spec: PathBuf,
+        /// The board file whose CAN identifiers the drive uses.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: PathBuf,
+        /// One or more logs.
+        #[arg(long, required = true, num_args = 1.., value_name = "LOG")]
+        candump: Vec<PathBuf>,
+        /// Output directory (created if missing).
+        #[arg(long, value_name = "DIR")]
+        out: PathBuf,
+    },
+    /// Run a commissioning routine on the drive over CAN (SocketCAN, Linux): send the
+    /// command, receive the capture, write its CSV recording to DIR and identify from it
+    /// as `identify … --candump` does (exit 6 refused/aborted, 69 no CAN interface,
+    /// 75 timeout; nothing written then).
+    Commission(commission::CommissionArgs),
+    /// List the motors in a directory (default: motors/).
+    List {
+        /// Directory of motor specs.
+        #[arg(long, value_name = "DIR")]
+        dir: Option<PathBuf>,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Format {
+    /// Human-readable headline constants.
+    Summary,
+    /// The complete design as JSON (SI units).
+    Json,
+    /// Rust module of documented `const` items.
+    Rust,
+    /// C header with the same values.
+    C,
+    /// Markdown summary of every constant.
+    Markdown,
+}
+
+impl Format {
+    fn output(self) -> Option<Output> {
+        match self {
+            Format::Rust => Some(Output::Rust),
+            Format::C => Some(Output::C),
+            Format::Markdown => Some(Output::Markdown),
+            Format::Summary | Format::Json => None,
+        }
+    }
+}
+
+/// Renders `out` with the template from `dir` if given, else the built-in one.
+fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String, Failure> {
+    let bad_template = |e: codegen::render::RenderError| Failure::new(Exit::BadInput, e.to_string());
+    // A template directory made before the DBC output existed: the built-in DBC.
+    let dir = dir.filter(|dir| out != Output::Dbc || dir.join(out.template()).exists());
+    match dir {
+        Some(dir) => {
+            let path = dir.join(out.template());
+            let source = std::fs::read_to_string(&path)
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read template {}: {e}", path.display())))?;
+            render_with(d, &path.display().to_string(), &source).map_err(bad_template)
+        }
+        None => codegen::render::render(d, out).map_err(bad_template),
+    }
+}
+
+/// Reads a spec as UTF-8 text: an unreadable file is an I/O failure, invalid UTF-8 bad
+/// input; both name the file.
+fn read_spec(path: &Path) -> Result<String, Failure> {
+    let file = path.display().to_string();
+    let bytes = std::fs::read(path).map_err(|e| {
+        let d = codegen::Diagnostic {
+            file: file.clone(),
+            line: 1,
+            column: 1,
+            key: String::new(),
+            problem: format!("cannot read the file: {e}"),
+            accepted: "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)".into(),
+            excerpt: String::new(),
+        };
+        Failure::new(Exit::Io, codegen::Diagnostics(vec![d]).to_string())
+    })?;
+    spec_text(path, bytes)
+}
+
+/// A spec's bytes as UTF-8 text, or bad input located at the first invalid byte.
+fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, Failure> {
+    let file = path.display().to_string();
+    String::from_utf8(bytes).map_err(|e| {
+        let at = e.utf8_error().valid_up_to();
+        let text = String::from_utf8_lossy(e.as_bytes());
+        let d = codegen::Source {
+            file: &file,
+            text: &text,
+        }
+        .error(
+            at..at,
+            "",
+            format!("the file is not valid UTF-8 (byte {at})"),
+            "a UTF-8 text file; save the spec as UTF-8",
+        );
+        Failure::from(codegen::Diagnostics::from(d))
+    })
+}
+
+fn design(path: &Path) -> Result<codegen::Design, Failure> {
+    let text = read_spec(path)?;
+    Ok(codegen::design_source(&path.display().to_string(), &text)?)
+}
+
+/// The design of a motor, on `board` if given (its constants and checks added).
+fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failure> {
+    let Some(board) = board else {
+        return design(path);
+    };
+    let text = read_spec(path)?;
+    let board_text = read_spec(board)?;
+    Ok(codegen::design_with_board(
+        &path.display().to_string(),
+        &text,
+        &board.display().to_string(),
+        &board_text,
+    )?)
+}
+
+/// `motors/` in the working directory, else the one in this repository.
+fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
+    dir.unwrap_or_else(|| {
+        let here = PathBuf::from("motors");
+        if here.is_dir() {
+            here
+        } else {
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("motors")
+        }
+    })
+}
+
+fn main() -> ExitCode {
+    let code = match run(Cli::parse().command) {
+        Ok(()) => Exit::Success.into(),
+        Err(f) => f.report(),
+    };
+    output::flush();
+    code
+}
+
+fn run(command: Command) -> Result<(), Failure> {
+    match command {
+        Command::Design {
+            spec,
+            format,
+            templates,
+            board,
+        } => {
+            let d = design_on(&spec, board.as_deref())?;
+            let out = match format.output() {
+                Some(o) => render(&d, o, templates.as_deref())?,
+                None if matches!(format, Format::Json) => serde_json::to_string_pretty(&d)
+                    .map(|s| s + "\n")
+                    .map_err(|e| Failure::new(Exit::Io, format!("error: cannot serialise the design: {e}")))?,
+                None => codegen::summary::summary(&d),
+            };
+            out!("{out}");
+            Ok(())
+        }
+        Command::Generate {
+            spec,
+            out,
+            templates,
+            board,
+        } => {
+            atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+            let d = design_on(&spec, board.as_deref())?;
+            let stem = spec
+                .file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_else(|| "motor".into());
+            // Render everything first: nothing is written unless every output renders.
+            let mut files = Vec::new();
+            // The DBC of the CAN interface needs the board's identifiers.
+            let dbc = d.board.is_some().then_some(Output::Dbc);
+            for o in Output::ALL.into_iter().chain(dbc) {
+                let text = render(&d, o, templates.as_deref())?;
+                files.push((out.join(o.file_name(&stem)), text.into_bytes()));
+            }
+            // All or nothing, each file rewritten only when its bytes change.
+            let written = atomic::write_set(&out, &files)?;
+            for ((path, _), w) in files.iter().zip(written) {
+                outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
+            }
+            Ok(())
+        }
+        Command::Check { specs } => {
+            // Every spec is checked; the exit code is the gravest failure's (I/O over bad input).
+            let mut failed = Vec::new();
+            for path in &specs {
+                // Read once; a file with a top-level `chip` is a board, anything else a motor.
+                let name = path.display().to_string();
+                let checked = read_spec(path).and_then(|text| {
+                    if codegen::board::is_board_file(&text) {
+                        let b = codegen::board_source(&name, &text)?;
+                        outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
+                    } else {
+                        let d = codegen::design_source(&name, &text)?;
+                        outln!("ok: {name} ({})", d.name);
+                        for w in &d.warnings {
+                            output::warn(format_args!("{name}: {w}"));
+                        }
+                    }
+                    Ok(())
+                });
+                if let Err(f) = checked {
+                    failed.push(f.exit);
+                    f.report();
+                }
+            }
+            match Exit::gravest(&failed) {
+                None => Ok(()),
+                Some(exit) => Err(Failure::new(
+                    exit,
+                    format!("check: {} of {} files failed", failed.len(), specs.len()),
+                )),
+            }
+        }
+        Command::New { stem, dir } => {
+            if stem.is_empty()
+                || !stem
+                    .chars()
+                    .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '-')
+                || stem.starts_with('-')
+            {
+                return Err(Failure::new(
+                    Exit::BadInput,
+                    format!(
+                        "error: `{stem}` is not a valid motor stem\n  accepted: lowercase letters, digits and '-', e.g. my-motor-80kw"
+                    ),
+                ));
+            }
+            let dir = motors_dir(dir);
+            let path = dir.join(format!("{stem}.toml"));
+            if path.exists() {
+                return Err(Failure::new(
+                    Exit::BadInput,
+                    format!(
+                        "error: {} already exists\n  accepted: a new stem, or edit the existing file",
+                        path.display()
+                    ),
+                ));
+            }
+            let text = codegen::render::new_spec(&stem).map_err(|e| Failure::new(Exit::BadInput, e.to_string()))?;
+            atomic::create_new(&path, text.as_bytes())?;
+            outln!(
+                "wrote {}; edit it, then run `motorgen check {}`",
+                path.display(),
+                path.display()
+            );
+            Ok(())
+        }
+        Command::Firmware {
+            stem,
+            all,
+            dir,
+            board,
+            boards_dir,
+        } => {
+            let which = match stem {
+                Some(stem) if !all => firmware::Which::One(stem),
+                _ => firmware::Which::All,
+            };
+            let motors = motors_dir(dir);
+            let boards = boards_dir.unwrap_or_else(|| {
+                let beside = motors.join("..").join("boards");
+                if beside.is_dir() {
+                    beside
+                } else {
+                    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("boards")
+                }
+            });
+            firmware::run(which, &motors, &board, &boards)
+        }
+        Command::Verify { spec } => verify::run(&spec),
+        Command::Report { spec, out } => report::run(&spec, &out),
+        Command::Identify { what } => identify::run(what),
+        Command::Capture {
+            spec,
+            board,
+            candump,
+            out,
+        } => {
+            atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+            let layout = identify::layout(&spec, &board)?;
+            let mut files = Vec::new();
+            for (k, (file, _, cap, csv)) in identify::read_logs(&candump, &layout)?.into_iter().enumerate() {
+                let stem = Path::new(&file)
+                    .file_stem()
+                    .map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
+                let kind = motor_commission::candump::kind_of(cap.header.routine).name();
+                files.push((out.join(format!("{stem}-{}-{kind}.csv", k + 1)), csv.into_bytes()));
+            }
+            let written = atomic::write_set(&out, &files)?;
+            for ((path, _), w) in files.iter().zip(written) {
+                outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
+            }
+            Ok(())
+        }
+        Command::Commission(args) => commission::run(&args),
+        Command::List { dir } => {
+            let dir = motors_dir(dir);
+            let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read {}: {e}", dir.display())))?
+                .filter_map(|e| e.ok().map(|e| e.path()))
+                .filter(|p| p.extension().is_some_and(|x| x == "toml"))
+                .collect();
+            entries.sort();
+            for path in entries {
+                let stem = path
+                    .file_stem()
+                    .map(|s| s.to_string_lossy().into_owned())
+                    .unwrap_or_default();
+                match design(&path) {
+                    Ok(d) => outln!("{stem:<24} {}", d.name),
+                    Err(_) => outln!("{stem:<24} INVALID (`motorgen check {}` says why)", path.display()),
+                }
+            }
+            Ok(())
+        }
+    }
+}

@@ -1,0 +1,248 @@
+//! `motorgen verify` and `motorgen report` as a user runs them; the report page is
+//! loaded in headless Chromium (Debian's `chromium`, installed by `.ci/run`): it must
+//! load without console messages, every plot must be in the DOM after load as an
+//! `<svg>` with lines and text, and a screenshot is taken (kept in the test temp dir).
+
+use crate::common::{motor_stems, motorgen, repo};
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn tmp(name: &str) -> PathBuf {
+    crate::common::tmp("report", name)
+}
+
+/// Headless Chromium: `$CHROMIUM` or `/usr/bin/chromium`. Missing is a failure, not a skip.
+fn chromium() -> PathBuf {
+    let path = std::env::var_os("CHROMIUM").map_or_else(|| PathBuf::from("/usr/bin/chromium"), PathBuf::from);
+    assert!(
+        path.exists(),
+        "headless Chromium is needed to test the report page and was not found at {}: install it \
+         (Debian: `apt-get install chromium`; .ci/run does) or set CHROMIUM to its path",
+        path.display()
+    );
+    path
+}
+
+/// Runs Chromium headless on `page` with `extra` arguments; a fresh profile under `dir`.
+fn run_chromium(dir: &Path, page: &Path, extra: &[&str]) -> Output {
+    let profile = dir.join("chromium-profile");
+    let url = format!("file://{}", page.canonicalize().unwrap().display());
+    let out = Command::new(chromium())
+        .args([
+            "--headless",
+            "--no-sandbox",
+            "--disable-gpu",
+            "--disable-quic",
+            "--no-first-run",
+            "--disable-background-networking",
+            "--disable-component-update",
+            "--disable-sync",
+            &format!("--user-data-dir={}", profile.display()),
+        ])
+        .args(extra)
+        .arg(url)
+        .output()
+        .expect("chromium runs");
+    assert!(
+        out.status.success(),
+        "chromium failed on {}:\n{}",
+        page.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Console messages Chromium logged while loading `page` (`--enable-logging=stderr`
+/// prints them as `…:CONSOLE(…)` / `INFO:CONSOLE:…` lines), and the screenshot taken.
+fn console_and_screenshot(dir: &Path, page: &Path, png: &Path) -> Vec<String> {
+    let out = run_chromium(
+        dir,
+        page,
+        &[
+            "--enable-logging=stderr",
+            "--v=0",
+            "--window-size=1200,3000",
+            &format!("--screenshot={}", png.display()),
+        ],
+    );
+    String::from_utf8_lossy(&out.stderr)
+        .lines()
+        .filter(|l| l.contains(":CONSOLE"))
+        .map(str::to_string)
+        .collect()
+}
+
+/// The console check can fail: a page that logs an error is caught.
+#[test]
+fn console_errors_are_detected() {
+    let dir = tmp("console");
+    let page = dir.join("bad.html");
+    std::fs::write(
+        &page,
+        "<!DOCTYPE html><html><body><script>console.error('report-test-marker')</script></body></html>",
+    )
+    .unwrap();
+    let lines = console_and_screenshot(&dir, &page, &dir.join("bad.png"));
+    assert!(
+        lines.iter().any(|l| l.contains("report-test-marker")),
+        "console error not seen: {lines:?}"
+    );
+}
+
+/// The plots every report has (page order), whatever the motor.
+const PLOTS: &[&str] = &[
+    "current-step-0",
+    "current-step-1",
+    "current-bode-d",
+    "current-bode-q",
+    "feed-forward-0",
+    "feed-forward-1",
+    "observer-0",
+    "observer-1",
+    "observer-2",
+    "observer-bode",
+    "fir-response",
+    "dq-plane",
+];
+
+/// The plots of the field-weakening scenario (motors with ψ_M).
+const FIELD_WEAKENING_PLOTS: &[&str] = &[
+    "field-weakening-0",
+    "field-weakening-1",
+    "field-weakening-2",
+    "field-weakening-3",
+];
+
+/// The plots of the estimator scenario (motors with ψ_M and a `[sensorless]` section).
+const SENSORLESS_PLOTS: &[&str] = &["sensorless-0", "sensorless-1", "sensorless-2"];
+
+#[test]
+fn report_loads_in_headless_chromium_with_every_plot() {
+    for stem in motor_stems() {
+        let dir = tmp(&stem);
+        let spec = format!("motors/{stem}.toml");
+        let out = motorgen(&["report", &spec, "--out", dir.to_str().unwrap()]);
+        let page = dir.join(format!("{stem}.html"));
+        let html = std::fs::read_to_string(&page)
+            .unwrap_or_else(|e| panic!("{stem}: no page ({e}):\n{}", String::from_utf8_lossy(&out.stderr)));
+        // Exit status follows the verification verdict shown in the page.
+        let failed = html.contains("<td class=\"result\">FAIL</td>");
+        assert_eq!(
+            out.status.success(),
+            !failed,
+            "{stem}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        // Self-contained: nothing fetched from elsewhere.
+        for needle in ["src=\"http", "href=\"http", "<link ", "<img "] {
+            assert!(!html.contains(needle), "{stem}: external resource {needle}");
+        }
+
+        let dom = String::from_utf8(run_chromium(&dir, &page, &["--dump-dom"]).stdout).unwrap();
+        let ids: Vec<&str> = dom
+            .match_indices("<figure class=\"plot\" id=\"")
+            .map(|(i, m)| {
+                let rest = &dom[i + m.len()..];
+                &rest[..rest.find('"').unwrap()]
+            })
+            .collect();
+        // Motors with ψ_M also get the field-weakening plots, and those with a
+        // `[sensorless]` section the estimator's.
+        let mut want: Vec<&str> = PLOTS.to_vec();
+        if html.contains("Field weakening, ramp") {
+            want.extend(FIELD_WEAKENING_PLOTS);
+        }
+        if html.contains("Angle estimation error") {
+            want.extend(SENSORLESS_PLOTS);
+        }
+        assert_eq!(ids, want, "{stem}: plots in the loaded page");
+        for id in &want {
+            let start = dom.find(&format!("<figure class=\"plot\" id=\"{id}\"")).unwrap();
+            let fig = &dom[start..start + dom[start..].find("</figure>").unwrap()];
+            for part in ["<svg", "</svg>", "<polyline", "<text", "<figcaption>"] {
+                assert!(fig.contains(part), "{stem}: plot {id} lacks {part}");
+            }
+        }
+        // The verification table and every constant group made it into the DOM.
+        assert!(dom.contains("id=\"verification-table\""), "{stem}");
+        for group in ["current_loop", "observer", "scaling", "filter", "limits"] {
+            assert!(
+                dom.contains(&format!("<code>{group}</code>")),
+                "{stem}: constants {group}"
+            );
+        }
+
+        let png = dir.join(format!("{stem}.png"));
+        let console = console_and_screenshot(&dir, &page, &png);
+        assert!(console.is_empty(), "{stem}: console messages:\n{}", console.join("\n"));
+        let bytes = std::fs::read(&png).unwrap();
+        assert!(
+            bytes.starts_with(b"\x89PNG") && bytes.len() > 20_000,
+            "{stem}: screenshot {} bytes",
+            bytes.len()
+        );
+        println!("{stem}: screenshot {}", png.display());
+    }
+}
+
+/// `motorgen verify`: the table on stdout, exit 0 when every scenario passes.
+#[test]
+fn verify_prints_the_table() {
+    let out = motorgen(&["verify", "motors/fischer-ti085.toml"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{stdout}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for word in [
+        "current_step: q-axis rise time 10–90 %",
+        "decoupling:",
+        "dc_link_step:",
+        "ato_lock: cycle slips",
+        "ato_ramp:",
+        "ato_type2:",
+        "field_weakening: peak |v| on the ramp",
+        "field_weakening: peak |i_dq − i_dq^ref|",
+        "7 of 7 scenarios passed",
+    ] {
+        assert!(stdout.contains(word), "{word} missing:\n{stdout}");
+    }
+}
+
+/// A bad spec: located message, non-zero exit, nothing on stdout, no report written.
+#[test]
+fn bad_spec_is_reported_and_nothing_written() {
+    let dir = tmp("bad-spec");
+    let text = std::fs::read_to_string(repo().join("motors/fischer-ti085.toml"))
+        .unwrap()
+        .replacen("inductance = \"0.393 mH\"", "inductance = 0.000393", 1);
+    let line = text[..text.find("inductance = 0.000393").unwrap()]
+        .matches('\n')
+        .count()
+        + 1;
+    let spec = dir.join("bad.toml");
+    std::fs::write(&spec, text).unwrap();
+    let out_dir = dir.join("out");
+    for args in [
+        vec!["verify", spec.to_str().unwrap()],
+        vec!["report", spec.to_str().unwrap(), "--out", out_dir.to_str().unwrap()],
+    ] {
+        let out = motorgen(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert!(!out.status.success(), "{args:?}");
+        assert!(
+            out.stdout.is_empty(),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stdout)
+        );
+        assert!(stderr.contains(&format!("bad.toml:{line}:14")), "{args:?}: {stderr}");
+        assert!(
+            stderr.contains("`motor.datasheet.inductance`") && stderr.contains("accepted:"),
+            "{stderr}"
+        );
+        assert!(!stderr.contains("panicked"), "{stderr}");
+    }
+    assert!(!out_dir.exists(), "report wrote into {}", out_dir.display());
+}

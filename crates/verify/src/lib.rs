@@ -1,0 +1,359 @@
+//! Verification by simulation: the firmware's control step (`motor-control`,
+//! [`ControllerConfig::process`] with [`motor_control::SoftTrig`]) configured from the
+//! design, in closed loop with a discrete-time PMSM (thesis A (2.26), optionally with
+//! thesis B's harmonics (2.14)–(2.16) and L_q saturation (2.25)), same sample period,
+//! 1.5·T_s delay.
+//!
+//! [`SCENARIOS`] is the standard scenario set; each runs on a [`Setup`] and returns
+//! measured vs designed figures with a pass/fail criterion. A new design rule adds its
+//! scenario by appending to the list.
+//!
+//! | module | what |
+//! |---|---|
+//! | [`motor_sim::plant`] | PMSM dq model, inverter, sensors (shared with the control core's tests) |
+//! | [`controller`] | [`ControllerConfig`] from a [`Design`] |
+//! | [`motor_sim::bench`] | controller + plant with the thesis-A §4.6 timing |
+//! | [`motor_sim::figures`] | rise time, overshoot, settling of sampled responses |
+//! | [`figures`] | the designed responses they are compared with |
+//! | [`scenarios`] | the current-loop scenarios and their criteria |
+//! | [`observer`] | the angle-observer scenarios: lock, run-up at the drive's acceleration, type-2 lag |
+//! | [`frequency`] | frequency responses of the discrete designs (for the report) |
+//! | [`field_weakening`] | field weakening to 2× base speed (thesis B Fig. 2.15) |
+//! | [`estimator`] | sensorless estimator recovery, cycle slips (thesis B Figs. 4.17, 4.18) |
+//! | [`report`] | the self-contained HTML report with SVG plots (`motorgen report`) |
+//!
+//! May depend on `codegen` (the design core), `motor-control` and `motor-sim`; never on
+//! `motor-commission` or `motorgen` (ARCHITECTURE.md).
+
+pub mod controller;
+pub mod estimator;
+pub mod field_weakening;
+pub mod figures;
+pub mod frequency;
+pub mod observer;
+pub mod report;
+pub mod scenarios;
+
+use std::fmt::Write as _;
+
+use motor_control::step::ControllerConfig;
+use serde::Serialize;
+
+use codegen::design::Design;
+use codegen::diagnostic::{Diagnostics, Source};
+use codegen::spec::Spec;
+use motor_sim::bench::Bench;
+use motor_sim::plant::{MotorModel, Plant, Shaft, SpeedProfile};
+
+/// One measured figure and its criterion.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Check {
+    /// What is measured, e.g. "q-axis rise time 10–90 %".
+    pub quantity: String,
+    /// Measured value, in `unit`.
+    pub measured: f64,
+    /// Designed (predicted) value, in `unit`, where the design predicts one.
+    pub designed: Option<f64>,
+    /// Display unit of `measured` and `designed`.
+    pub unit: &'static str,
+    /// The pass criterion in words, e.g. "within 10 % of designed".
+    pub criterion: String,
+    /// Whether the criterion holds.
+    pub pass: bool,
+}
+
+/// One named signal over time.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Series {
+    /// Legend label.
+    pub label: String,
+    /// Values at the trace's time points.
+    pub values: Vec<f64>,
+}
+
+/// A labelled series.
+pub(crate) fn series(label: &str, values: Vec<f64>) -> Series {
+    Series {
+        label: label.into(),
+        values,
+    }
+}
+
+/// Recorded signals of a scenario, for plots.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Trace {
+    /// Plot title.
+    pub title: String,
+    /// y-axis label with unit.
+    pub y_label: String,
+    /// Time points \[ms\].
+    pub t_ms: Vec<f64>,
+    /// The signals.
+    pub series: Vec<Series>,
+}
+
+/// The outcome of one scenario.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ScenarioResult {
+    /// Stable identifier, e.g. `current_step`.
+    pub id: &'static str,
+    /// Human title with the operating point.
+    pub title: String,
+    /// Where the criterion comes from (thesis figures/equations).
+    pub reference: &'static str,
+    /// The figures.
+    pub checks: Vec<Check>,
+    /// Signals for the report.
+    pub traces: Vec<Trace>,
+}
+
+impl ScenarioResult {
+    /// Whether every check passed.
+    pub fn passed(&self) -> bool {
+        self.checks.iter().all(|c| c.pass)
+    }
+}
+
+/// Everything [`verify`] found for one motor.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verification {
+    /// Motor name.
+    pub motor: String,
+    /// Spec file.
+    pub spec_file: String,
+    /// Whether the plant carried harmonic or saturation terms.
+    pub plant_model: String,
+    /// Results in [`SCENARIOS`] order.
+    pub scenarios: Vec<ScenarioResult>,
+}
+
+impl Verification {
+    /// Whether every scenario passed.
+    pub fn passed(&self) -> bool {
+        self.scenarios.iter().all(ScenarioResult::passed)
+    }
+
+    /// The pass/fail table as plain text.
+    pub fn table(&self) -> String {
+        let mut s = format!(
+            "verify {} ({})\nplant: {}\n",
+            self.spec_file, self.motor, self.plant_model
+        );
+        let rows: Vec<[String; 5]> = self
+            .scenarios
+            .iter()
+            .flat_map(|sc| {
+                sc.checks.iter().map(move |c| {
+                    [
+                        format!("{}: {}", sc.id, c.quantity),
+                        format_value(c.measured, c.unit),
+                        c.designed.map_or("—".into(), |d| format_value(d, c.unit)),
+                        c.criterion.clone(),
+                        if c.pass { "pass".into() } else { "FAIL".into() },
+                    ]
+                })
+            })
+            .collect();
+        let head = ["check", "measured", "designed", "criterion", "result"];
+        let width = |k: usize| {
+            rows.iter()
+                .map(|r| r[k].chars().count())
+                .chain([head[k].len()])
+                .max()
+                .unwrap_or(0)
+        };
+        let w: Vec<usize> = (0..5).map(width).collect();
+        let mut line = |cells: [&str; 5]| {
+            let mut l = String::new();
+            for (k, c) in cells.iter().enumerate() {
+                let pad = w[k].saturating_sub(c.chars().count());
+                let _ = write!(l, "{c}{}  ", " ".repeat(pad));
+            }
+            s.push_str(l.trim_end());
+            s.push('\n');
+        };
+        line(head);
+        for r in &rows {
+            line([&r[0], &r[1], &r[2], &r[3], &r[4]]);
+        }
+        let failed = self.scenarios.iter().filter(|s| !s.passed()).count();
+        let _ = writeln!(
+            s,
+            "{} of {} scenarios passed{}",
+            self.scenarios.len() - failed,
+            self.scenarios.len(),
+            if failed == 0 { "" } else { " — FAILED" }
+        );
+        s
+    }
+}
+
+/// `x` with 4 significant digits and its unit.
+pub fn format_value(x: f64, unit: &str) -> String {
+    let s = if !x.is_finite() {
+        format!("{x}")
+    } else if x == 0.0 {
+        "0".into()
+    } else {
+        let digits = (3 - x.abs().log10().floor() as i32).clamp(0, 8) as usize;
+        format!("{x:.digits$}")
+    };
+    if unit.is_empty() { s } else { format!("{s} {unit}") }
+}
+
+/// What every scenario starts from: the design, the plant's machine model and the
+/// firmware configuration.
+#[derive(Clone, Debug)]
+pub struct Setup<'a> {
+    /// The design under test.
+    pub design: &'a Design,
+    /// The simulated machine.
+    pub motor: MotorModel,
+    /// The firmware configuration built from the design.
+    pub cfg: ControllerConfig,
+}
+
+impl<'a> Setup<'a> {
+    /// The setup for `design`, with the harmonic and saturation data of `spec`.
+    pub fn new(spec: &Spec, design: &'a Design) -> Self {
+        let m = &spec.motor;
+        let h = &m.harmonics;
+        let v = |p: &Option<codegen::spec::Param>| p.as_ref().map_or(0.0, |p| p.value);
+        Self {
+            design,
+            motor: MotorModel {
+                pole_pairs: design.motor.pole_pairs,
+                resistance: design.motor.phase_resistance_ohm,
+                ld: design.motor.d_inductance_h,
+                lq: design.motor.q_inductance_h,
+                psi: design.motor.flux_linkage_wb.unwrap_or(0.0),
+                l6: v(&h.inductance_6),
+                psi_d: [v(&h.d_flux_6), v(&h.d_flux_12)],
+                psi_q: [v(&h.q_flux_6), v(&h.q_flux_12)],
+                q_saturation: m.q_saturation.clone(),
+            },
+            cfg: controller::controller_config(design),
+        }
+    }
+
+    /// A plant at rest at θ_m = 0 with the nominal DC link and the given speed profile.
+    pub fn plant(&self, speed: SpeedProfile) -> Plant {
+        let d = self.design;
+        let mut p = Plant::new(
+            self.motor.clone(),
+            Shaft::Imposed(speed),
+            d.drive.sample_period_s,
+            d.drive.dc_link_voltage_v,
+        );
+        p.resolver_pole_pairs = d.angle_observer.resolver_pole_pairs;
+        p.resolver_offset = controller::resolver_offset_rad(d);
+        p
+    }
+
+    /// Controller + plant at a constant mechanical speed [rad/s], observer locked.
+    pub fn bench(&self, omega_m: f64) -> Bench {
+        Bench::new(self.cfg, self.plant(SpeedProfile::constant(omega_m)))
+    }
+
+    /// Description of the plant's optional terms.
+    pub fn plant_model(&self) -> String {
+        let mut parts = vec!["dq model (thesis A 2.26)".to_string()];
+        if self.motor.has_harmonics() {
+            parts.push("flux/inductance harmonics (thesis B 2.14–2.16)".into());
+        }
+        if !self.motor.q_saturation.is_empty() {
+            parts.push("L_q(|i_q|) saturation (thesis B 2.25)".into());
+        }
+        if self.motor.psi == 0.0 {
+            parts.push("ψ_M unknown: simulated as 0".into());
+        }
+        parts.join(" + ")
+    }
+}
+
+/// A scenario of the standard set.
+#[derive(Clone, Copy, Debug)]
+pub struct Scenario {
+    /// Identifier (as in [`ScenarioResult::id`]).
+    pub id: &'static str,
+    /// Runs it.
+    pub run: fn(&Setup<'_>) -> ScenarioResult,
+    /// Whether it applies to the setup's motor (e.g. ψ_M known); if not, it is not run
+    /// and not listed.
+    pub applies: fn(&Setup<'_>) -> bool,
+}
+
+/// [`Scenario::applies`] of the scenarios every motor runs.
+pub fn always(_: &Setup<'_>) -> bool {
+    true
+}
+
+impl Scenario {
+    /// The scenarios of [`SCENARIOS`] that apply to `setup`.
+    pub fn applicable(setup: &Setup<'_>) -> Vec<&'static Scenario> {
+        SCENARIOS.iter().filter(|s| (s.applies)(setup)).collect()
+    }
+}
+
+/// The standard scenario set, in report order.
+pub const SCENARIOS: &[Scenario] = &[
+    Scenario {
+        id: "current_step",
+        run: scenarios::current_step,
+        applies: always,
+    },
+    Scenario {
+        id: "decoupling",
+        run: scenarios::decoupling,
+        applies: always,
+    },
+    Scenario {
+        id: "dc_link_step",
+        run: scenarios::dc_link_step,
+        applies: always,
+    },
+    Scenario {
+        id: "ato_lock",
+        run: observer::ato_lock,
+        applies: always,
+    },
+    Scenario {
+        id: "ato_ramp",
+        run: observer::ato_ramp,
+        applies: always,
+    },
+    Scenario {
+        id: "ato_type2",
+        run: observer::ato_type2,
+        applies: always,
+    },
+    Scenario {
+        id: "field_weakening",
+        run: field_weakening::field_weakening,
+        applies: field_weakening::applies,
+    },
+    Scenario {
+        id: "estimator_recovery",
+        run: estimator::estimator_recovery,
+        applies: estimator::applies,
+    },
+];
+
+/// Runs every scenario of [`SCENARIOS`] that applies to `setup`.
+pub fn verify(setup: &Setup<'_>) -> Verification {
+    Verification {
+        motor: setup.design.name.clone(),
+        spec_file: setup.design.spec_file.clone(),
+        plant_model: setup.plant_model(),
+        scenarios: Scenario::applicable(setup).iter().map(|s| (s.run)(setup)).collect(),
+    }
+}
+
+/// Parses and designs `text` (named `file` in messages), then verifies the design.
+pub fn verify_source(file: &str, text: &str) -> Result<(Design, Verification), Diagnostics> {
+    let source = Source { file, text };
+    let spec = codegen::spec::parse(source)?;
+    let design = codegen::design::design(&spec, source)?;
+    let v = verify(&Setup::new(&spec, &design));
+    Ok((design, v))
+}

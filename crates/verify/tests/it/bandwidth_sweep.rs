@@ -1,0 +1,191 @@
+//! `check`'s verdict on the current loop against `verify`'s measured step, swept over the
+//! bandwidth α for each method on every motor in `motors/`.
+//!
+//! At each α (a fraction of ω_s = 2π·f_s) the spec's `[current_loop]` is replaced by the
+//! method at α (ζ = 1/√2 for pole placement, delay compensation on: the default):
+//!
+//! * accepted ⇒ the firmware's control step in the simulated drive (`current_step`)
+//!   passes every criterion: rise time, overshoot within the design's floor, settling;
+//! * refused at `current_loop.bandwidth` ⇒ the message names a largest bandwidth below α;
+//!   the design at that bandwidth is accepted and its `current_step` passes; and the
+//!   refused gains, put into that design, fail `current_step` when the refusal was for a
+//!   margin or overshoot breach (the sampled loop's prediction, checked on the firmware's
+//!   fixed-point step and the continuous plant).
+//!
+//! Errors at other keys (a right-half-plane zero of pole placement, field-weakening or
+//! estimator rules that depend on α_c) are not current-loop feasibility verdicts and are
+//! skipped; the test requires enough accepted and refused points to mean something.
+
+use codegen::design::Design;
+use codegen::design::discrete_loop;
+use codegen::{Source, design, spec};
+use motor_verify::{Setup, scenarios::current_step};
+
+/// `text` with its `[current_loop]` section replaced by `body`.
+fn with_loop(text: &str, body: &str) -> String {
+    let start = text.find("\n[current_loop]").expect("a [current_loop] section") + 1;
+    let rest = &text[start + 1..];
+    let end = rest.find("\n[").map_or(text.len(), |i| start + 1 + i + 1);
+    format!("{}[current_loop]\n{body}\n{}", &text[..start], &text[end..])
+}
+
+fn body(method: &str, alpha: f64, compensate: bool) -> String {
+    let damping = if method == "pole_placement" {
+        "\ndamping = 0.7071"
+    } else {
+        ""
+    };
+    format!("method = \"{method}\"\nbandwidth = \"{alpha:.1} rad/s\"{damping}\ncompensate_delay = {compensate}")
+}
+
+enum Verdict {
+    Accepted(Box<(spec::Spec, Design)>),
+    /// Refused at `current_loop.bandwidth` by the sampled-loop floors: the problem text and
+    /// the largest bandwidth named.
+    Refused(String, Option<f64>),
+    /// An error at another key.
+    Other(String),
+}
+
+fn judge(file: &str, text: &str) -> Verdict {
+    let src = Source { file, text };
+    let s = spec::parse(src).unwrap_or_else(|e| panic!("{file}: {e:?}"));
+    match design::design(&s, src) {
+        Ok(d) => Verdict::Accepted(Box::new((s, d))),
+        Err(e) => match e
+            .0
+            .iter()
+            .find(|d| d.key == "current_loop.bandwidth" && d.problem.contains("sampled"))
+        {
+            Some(d) => {
+                let best = d
+                    .accepted
+                    .strip_prefix("a bandwidth up to ")
+                    .and_then(|r| r.split(' ').next())
+                    .and_then(|n| n.parse().ok());
+                Verdict::Refused(d.problem.clone(), best)
+            }
+            None => Verdict::Other(format!(
+                "{:?}",
+                e.0.iter().map(|d| (&d.key, &d.problem)).collect::<Vec<_>>()
+            )),
+        },
+    }
+}
+
+/// Failed checks of `current_step` for `d`.
+fn step_failures(s: &spec::Spec, d: &Design) -> Vec<String> {
+    current_step(&Setup::new(s, d))
+        .checks
+        .iter()
+        .filter(|c| !c.pass)
+        .map(|c| format!("{}: {} ({})", c.quantity, c.measured, c.criterion))
+        .collect()
+}
+
+#[test]
+fn check_verdict_matches_the_simulated_step() {
+    let (mut accepted, mut refused, mut unstable_seen) = (0, 0, 0);
+    let mut problems = Vec::new();
+    for stem in motor_test_support::motor_stems() {
+        let text = std::fs::read_to_string(motor_test_support::repo().join(format!("motors/{stem}.toml"))).unwrap();
+        let fs = {
+            let src = Source {
+                file: &stem,
+                text: &text,
+            };
+            spec::parse(src).unwrap().drive.switching_frequency.value
+        };
+        let ws = 2.0 * std::f64::consts::PI * fs;
+        // Delay compensation on (the default) at three bandwidths, and off at the two
+        // higher ones, where the plain loop loses its margins or its stability.
+        let points = [(0.02, true), (0.06, true), (0.2, true), (0.06, false), (0.2, false)];
+        for method in ["imc", "pole_placement", "imc_active_damping"] {
+            for (frac, compensate) in points {
+                let alpha = frac * ws;
+                let name = format!("{stem} {method} α = {alpha:.0} rad/s compensate_delay = {compensate}");
+                match judge(&name, &with_loop(&text, &body(method, alpha, compensate))) {
+                    Verdict::Accepted(sd) => {
+                        accepted += 1;
+                        let f = step_failures(&sd.0, &sd.1);
+                        if !f.is_empty() {
+                            problems.push(format!("{name}: accepted but current_step fails: {f:?}"));
+                        }
+                    }
+                    Verdict::Refused(problem, best) => {
+                        refused += 1;
+                        let Some(best) = best else {
+                            println!("{name}: refused, no bandwidth meets the floors: {problem}");
+                            continue;
+                        };
+                        if best >= alpha {
+                            problems.push(format!("{name}: refused but names {best} rad/s ≥ α"));
+                            continue;
+                        }
+                        // The named bandwidth is accepted and its step passes.
+                        let Verdict::Accepted(sd) = judge(&name, &with_loop(&text, &body(method, best, compensate)))
+                        else {
+                            problems.push(format!("{name}: the named {best} rad/s is not accepted"));
+                            continue;
+                        };
+                        let (s, mut d) = *sd;
+                        let f = step_failures(&s, &d);
+                        if !f.is_empty() {
+                            problems.push(format!("{name}: named {best} rad/s accepted but its step fails: {f:?}"));
+                        }
+                        // The refused gains in that design fail the step (margin or
+                        // overshoot breaches; a rise-time breach is not about stability).
+                        if problem.contains("rise time")
+                            && !problem.contains("margin")
+                            && !problem.contains("overshoot")
+                        {
+                            continue;
+                        }
+                        let m = &s.motor;
+                        let zeta = s.current_loop.damping.as_ref().map_or(0.0, |z| z.value);
+                        let ts = 1.0 / fs;
+                        let r = m.phase_resistance.value;
+                        let (Ok(gd), Ok(gq)) = (
+                            discrete_loop::axis(
+                                s.current_loop.method,
+                                'd',
+                                r,
+                                m.d_inductance.value,
+                                alpha,
+                                zeta,
+                                ts,
+                                compensate,
+                            ),
+                            discrete_loop::axis(
+                                s.current_loop.method,
+                                'q',
+                                r,
+                                m.q_inductance.value,
+                                alpha,
+                                zeta,
+                                ts,
+                                compensate,
+                            ),
+                        ) else {
+                            continue;
+                        };
+                        let unstable = gd.sampled.spectral_radius >= 1.0 || gq.sampled.spectral_radius >= 1.0;
+                        unstable_seen += usize::from(unstable);
+                        d.current_loop.d = gd;
+                        d.current_loop.q = gq;
+                        if step_failures(&s, &d).is_empty() {
+                            problems.push(format!("{name}: refused ({problem}) but its gains pass current_step"));
+                        }
+                    }
+                    Verdict::Other(keys) => println!("{name}: skipped (errors at {keys})"),
+                }
+            }
+        }
+    }
+    println!("accepted {accepted}, refused {refused} (of which unstable in the model: {unstable_seen})");
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert!(
+        accepted >= 10 && refused >= 10 && unstable_seen >= 3,
+        "accepted {accepted}, refused {refused}, unstable {unstable_seen}"
+    );
+}
