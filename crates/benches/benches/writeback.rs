@@ -3,7 +3,7 @@
 //! (`writeback::apply`), the updated spec designed (`design_source`, as identify checks
 //! it) and the change printed (`writeback::line_diff`).
 //!
-//! `cargo bench -p codegen --bench writeback`. Each size runs in a child process of this
+//! `cargo bench -p motor-benches --bench writeback`. Each size runs in a child process of this
 //! binary so that its peak resident memory (VmHWM, /proc/self/status) is its own.
 
 use std::path::Path;

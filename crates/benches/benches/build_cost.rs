@@ -9,7 +9,7 @@
 //!    after touching `motors/fischer-ti085.toml`: the build script re-designs the motor
 //!    and the crate recompiles against the new constants.
 //!
-//! Run with `cargo bench -p motor-tests --bench build_cost`. Each figure is the median of
+//! Run with `cargo bench -p motor-benches --bench build_cost`. Each figure is the median of
 //! [`RUNS`] timed builds after one warm-up build; the machine's load shows in the spread,
 //! which is printed too.
 
