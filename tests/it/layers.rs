@@ -28,7 +28,12 @@ struct Crate {
 
 fn has_cfg_test(attrs: &[syn::Attribute]) -> bool {
     attrs.iter().any(|a| {
-        a.path().is_ident("cfg") && a.meta.to_token_stream().to_string().replace(' ', "").contains("cfg(test)")
+        a.path().is_ident("cfg")
+            && a.meta
+                .to_token_stream()
+                .to_string()
+                .replace(' ', "")
+                .contains("cfg(test)")
     })
 }
 
@@ -246,7 +251,11 @@ fn cycles(krate: &Crate) -> Vec<String> {
                 .windows(2)
                 .map(|w| format!("{} → {}: {}", w[0], w[1], e[&(w[0].clone(), w[1].clone())].display()))
                 .collect();
-            let at = if parent.is_empty() { "crate root".to_string() } else { parent.join("::") };
+            let at = if parent.is_empty() {
+                "crate root".to_string()
+            } else {
+                parent.join("::")
+            };
             found.push(format!("in {at}: {}\n    {}", ring.join(" → "), files.join("\n    ")));
         }
     }
@@ -259,7 +268,11 @@ fn crate_roots() -> Vec<PathBuf> {
     let mut roots = Vec::new();
     for parent in ["crates", "firmware"] {
         let rd = std::fs::read_dir(repo.join(parent)).unwrap();
-        let mut dirs: Vec<PathBuf> = rd.flatten().map(|e| e.path()).filter(|p| p.join("Cargo.toml").exists()).collect();
+        let mut dirs: Vec<PathBuf> = rd
+            .flatten()
+            .map(|e| e.path())
+            .filter(|p| p.join("Cargo.toml").exists())
+            .collect();
         dirs.sort();
         for d in dirs {
             for root in ["src/lib.rs", "src/main.rs"] {
@@ -289,7 +302,12 @@ fn no_module_cycles_within_a_layer() {
         }
     }
     assert!(modules > 100, "only {modules} modules read: the walk missed files");
-    assert!(problems.is_empty(), "{} module cycles:\n{}", problems.len(), problems.join("\n"));
+    assert!(
+        problems.is_empty(),
+        "{} module cycles:\n{}",
+        problems.len(),
+        problems.join("\n")
+    );
 }
 
 /// The checker finds a cycle it is shown (so the test above can fail).
@@ -299,9 +317,11 @@ fn a_cycle_between_siblings_is_found() {
     for m in [vec![], vec!["a".to_string()], vec!["b".to_string()]] {
         k.modules.insert(m, PathBuf::from("x.rs"));
     }
-    k.refs.push((vec!["a".into()], vec!["b".into(), "Item".into()], PathBuf::from("a.rs")));
+    k.refs
+        .push((vec!["a".into()], vec!["b".into(), "Item".into()], PathBuf::from("a.rs")));
     assert!(cycles(&k).is_empty(), "one direction is not a cycle");
-    k.refs.push((vec!["b".into()], vec!["a".into(), "f".into()], PathBuf::from("b.rs")));
+    k.refs
+        .push((vec!["b".into()], vec!["a".into(), "f".into()], PathBuf::from("b.rs")));
     let c = cycles(&k);
     assert_eq!(c.len(), 1, "{c:?}");
     assert!(c[0].contains("a → b → a") || c[0].contains("b → a → b"), "{c:?}");
@@ -310,8 +330,16 @@ fn a_cycle_between_siblings_is_found() {
     for m in [vec![], vec!["p".to_string()], vec!["p".to_string(), "c".to_string()]] {
         k.modules.insert(m, PathBuf::from("x.rs"));
     }
-    k.refs.push((vec!["p".into(), "c".into()], vec!["p".into(), "T".into()], PathBuf::from("c.rs")));
-    k.refs.push((vec!["p".into()], vec!["p".into(), "c".into(), "f".into()], PathBuf::from("p.rs")));
+    k.refs.push((
+        vec!["p".into(), "c".into()],
+        vec!["p".into(), "T".into()],
+        PathBuf::from("c.rs"),
+    ));
+    k.refs.push((
+        vec!["p".into()],
+        vec!["p".into(), "c".into(), "f".into()],
+        PathBuf::from("p.rs"),
+    ));
     assert!(cycles(&k).is_empty());
 }
 

@@ -22,7 +22,7 @@ use std::ops::Range;
 use serde::Serialize;
 
 use crate::diagnostic::{Diagnostics, Source};
-use crate::spec::{Param, Provenance, Resolver_};
+use crate::spec::{Param, Provenance, ResolveContext};
 use crate::units::Kind;
 use chip::Chip;
 pub use raw::{Boot0Handling, Polarity, SampleInstant};
@@ -302,7 +302,7 @@ pub fn parse(source: Source<'_>) -> Result<Board, Diagnostics> {
             .into());
     }
     let raw: RawBoard = crate::spec::deserialize(source, EXAMPLE)?;
-    let mut cx = Resolver_::new(source);
+    let mut cx = ResolveContext::new(source);
     let board = resolve(&mut cx, &raw);
     match board {
         Some(b) if cx.errors.is_empty() => Ok(b),
@@ -345,7 +345,7 @@ fn port_and_number(pin: &str) -> Option<(u8, u8)> {
     (port.is_ascii_uppercase() && number < 16).then(|| (port as u8 - b'A', number))
 }
 
-fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
+fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
     let mut spans = Vec::new();
     let name = raw.name.get_ref().trim().to_string();
     if name.is_empty() {
@@ -374,7 +374,7 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
         boot0_check(cx, raw, pins);
     }
 
-    let q = |cx: &mut Resolver_<'_>,
+    let q = |cx: &mut ResolveContext<'_>,
              spans: &mut Vec<(String, Range<usize>)>,
              key: &str,
              v: &crate::spec::Val,
@@ -586,7 +586,7 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
 }
 
 /// Every signal's pin: exists, carries the function, used once.
-fn pins(cx: &mut Resolver_<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<Vec<PinUse>> {
+fn pins(cx: &mut ResolveContext<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<Vec<PinUse>> {
     let table = raw.pins.get_ref();
     let mut out: Vec<PinUse> = Vec::new();
     let mut seen: Vec<(&'static str, Signal)> = Vec::new();
@@ -684,7 +684,7 @@ fn pins(cx: &mut Resolver_<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<V
 }
 
 /// PB8 is BOOT0: a signal there needs `[boot0]`, and a CAN receiver cannot hold it low.
-fn boot0_check(cx: &mut Resolver_<'_>, raw: &RawBoard, pins: &[PinUse]) {
+fn boot0_check(cx: &mut ResolveContext<'_>, raw: &RawBoard, pins: &[PinUse]) {
     let Some(on_boot0) = pins.iter().find(|p| p.pin == chip::BOOT0_PIN) else {
         return;
     };

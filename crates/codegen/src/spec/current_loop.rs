@@ -3,7 +3,7 @@
 use std::ops::Range;
 
 use super::raw::{Method, RawSpec};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -24,7 +24,7 @@ pub struct CurrentLoopSpec {
     pub compensate_delay: bool,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn current_loop(&mut self, raw: &RawSpec) -> Option<CurrentLoopSpec> {
         let c = raw.current_loop.get_ref();
         let method = *c.method.get_ref();

@@ -8,7 +8,7 @@ use std::ops::Range;
 use serde::Serialize;
 
 use super::raw::{Amplitude, Between, Connection, RawMotor, RawParams, SpeedAxis, Val};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -77,7 +77,7 @@ fn voltage_name(a: Amplitude, line_to_line: bool) -> String {
     }
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     /// ψ_M: given, or derived from K_e (preferred: it is ψ_M by definition, 6.11), k_n, or
     /// K_t (2.34); and every source the spec gives, for the design's cross-check.
     pub(super) fn flux(&mut self, m: &RawMotor, np: u32) -> (Option<Param>, Vec<FluxSource>) {
