@@ -17,7 +17,6 @@ pub mod sampled_loop;
 pub mod field_weakening;
 pub mod finite;
 pub mod fir;
-pub mod flux_linkage;
 pub mod loss_minimisation;
 pub mod modulation;
 pub mod per_unit;
