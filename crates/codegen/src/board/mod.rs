@@ -32,6 +32,11 @@ pub use sequence::{AdcSlot, Converter};
 /// The board `motorgen firmware` and the firmware build use when none is named.
 pub const DEFAULT_BOARD: &str = "motorgen-reference";
 
+/// Frames the drive sends or receives after the setpoint identifier: status, command,
+/// capture header, capture data, capture end (identifiers setpoint_id + 1 … + 5, the
+/// `can` constants group); a board's `can.setpoint_id` leaves room for them.
+pub const FRAMES_AFTER_SETPOINT: u16 = 5;
+
 /// The ADC kernel clock the firmware runs the converters at \[Hz\]: HCLK/4 = 170 MHz/4
 /// (synchronous clock, ADC12_CCR.CKMODE = 0b11, RM0440 §21.4.3), below the 52 MHz of
 /// DS12288 Table 66 for several ADCs at V_DDA ≥ 2.7 V. The firmware checks at compile
@@ -522,7 +527,7 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         &c.setpoint_id,
         0,
         // The drive's own frames take the identifiers after it (constants group `can`).
-        0x7FF - i64::from(crate::constants::can::FRAMES_AFTER_SETPOINT),
+        0x7FF - i64::from(FRAMES_AFTER_SETPOINT),
         "a standard (11-bit) identifier 0 … 0x7FA (the drive's status, command and capture frames take the 5 after it), e.g. 0x100",
     );
     let period = q(cx, &mut spans, "can.setpoint_period", &c.setpoint_period, Kind::Time);
