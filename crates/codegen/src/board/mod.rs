@@ -10,9 +10,12 @@
 //! carries two signals; PB8 (BOOT0) only with a stated `[boot0] handling`; the sampling
 //! time of every analog input against DS12288 Table 67 for its channel class and source
 //! resistance ([`sampling`]); trip levels inside the measurable ranges.
+//!
+//! This layer knows no motor: a board with a motor (its ADC scalings and trips in the
+//! firmware's units, and the checks that need both) is a section of the design,
+//! [`crate::design::on_board`].
 
 pub mod chip;
-pub mod design;
 mod raw;
 pub mod sampling;
 mod sequence;
@@ -162,6 +165,20 @@ impl Signal {
         self == Signal::CurrentW
     }
 
+    /// Its code in the generated ADC sequences (`board::ADCx_SIGNALS`); `u8::MAX` for a
+    /// signal that is not an analog input.
+    pub fn adc_code(self) -> u8 {
+        match self {
+            Signal::CurrentU => 0,
+            Signal::CurrentV => 1,
+            Signal::CurrentW => 2,
+            Signal::DcLink => 3,
+            Signal::ResolverSin => 4,
+            Signal::ResolverCos => 5,
+            _ => u8::MAX,
+        }
+    }
+
     fn raw(self, p: &RawPins) -> Option<&PinName> {
         match self {
             Signal::GateUHigh => p.gate_u_high.as_ref(),
@@ -289,6 +306,32 @@ impl Board {
     pub fn dc_link_full_scale_v(&self) -> f64 {
         self.adc_reference_v / self.dc_link_divider
     }
+}
+
+/// Worst trigger-to-end time of a converter's sequence: latency 3 ADC cycles (DS12288
+/// Table 66, t_LATRINJ ≤ 3.125 cycles with CKMODE = 0b11) plus, per rank, sampling +
+/// 12.5 conversion cycles (RM0440 §21.4.12: T_CONV = sampling + 12.5 cycles at 12 bits).
+pub fn sequence_time(board: &Board, adc_hz: f64) -> f64 {
+    board
+        .adc
+        .iter()
+        .map(|q| (3.125 + q.iter().map(|s| s.sampling.cycles + 12.5).sum::<f64>()) / adc_hz)
+        .fold(0.0, f64::max)
+}
+
+/// Whether the image must check the BOOT0 option bytes at start-up.
+pub fn checks_option_bytes(board: &Board) -> bool {
+    board.boot0 == Some(Boot0Handling::OptionBytes)
+}
+
+/// The break input's polarity as TIM1_BDTR.BKP (1 = active high, RM0440 §29.6.20).
+pub fn break_active_high(board: &Board) -> bool {
+    board.break_polarity == Polarity::ActiveHigh
+}
+
+/// Whether the currents are sampled at the carrier maximum (low-side pulse centre).
+pub fn samples_at_carrier_maximum(board: &Board) -> bool {
+    board.sample_instant == SampleInstant::LowSideCentre
 }
 
 /// Example of a complete board file for messages.
