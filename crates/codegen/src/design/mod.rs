@@ -14,9 +14,6 @@ pub mod angle_observer;
 pub mod cross_check;
 pub mod current_loop;
 pub mod dead_time;
-pub mod designed_response;
-pub mod discrete_loop;
-pub mod sampled_loop;
 
 pub mod field_weakening;
 pub mod finite;
