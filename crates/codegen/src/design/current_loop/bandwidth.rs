@@ -1,6 +1,8 @@
 //! Stage 4 of the current-loop pipeline ([`super`]): the largest bandwidth whose sampled
-//! loop meets the floors of [`super::analysis`] on both axes, what an error at
-//! `current_loop.bandwidth` names when the requested one does not.
+//! loop meets the floors of [`super::analysis`] on both axes (phase and gain margin,
+//! overshoot, rise time), searched above the smallest bandwidth each method accepts
+//! (thesis A §5.4.1, thesis B (2.43)): what an error at `current_loop.bandwidth` names
+//! when the requested one does not meet them.
 
 use super::continuous::{Promise, natural_frequency};
 use super::{Request, axis_letter, design};

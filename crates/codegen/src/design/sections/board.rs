@@ -1,9 +1,11 @@
 //! The board section (`design.board`), a motor on an inverter board: the ADC-to-SI
-//! constants from the board's sensing, the dead time, trips and bus timing in the units
-//! the firmware needs, and the checks that can only be made with both — a board whose
-//! current range is below the motor's peak current, a DC link above what the divider
-//! measures, trips below the motor's ratings, conversions that take too much of the
-//! control period. It runs on the motor's finished design ([`crate::design::on_board`]).
+//! constants from the board's sensing (the 16-bit left-aligned codes of thesis A (4.16),
+//! Table 4.1; the sequences' timing of RM0440 §21.4.12), the dead time, trips and bus
+//! timing in the units the firmware needs, and the checks that can only be made with
+//! both — a board whose current range is below the motor's peak current, a DC link above
+//! what the divider measures, trips below the motor's ratings, conversions that take too
+//! much of the control period. It runs on the motor's finished design
+//! ([`crate::design::on_board`]).
 //!
 //! Those are warnings at the board key, not errors: an engineer may well run a large
 //! motor on a small board at reduced current (the firmware trips at the board's levels
