@@ -6,6 +6,7 @@ mod firmware;
 mod generated;
 mod golden;
 mod injection;
+mod layers;
 mod motors;
 
 /// The design of `motors/<stem>.toml` as JSON.

@@ -35,11 +35,11 @@ pub fn board_source(file: &str, text: &str) -> Result<board::Board, Diagnostics>
 
 /// Designs a motor on a board: the motor's design ([`design_source`]) with the board's
 /// constants and the checks that need both (warnings at the board key, see
-/// [`board::design`]).
+/// [`design::on_board`]).
 pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &str) -> Result<Design, Diagnostics> {
     let board = board_source(board_file, board_text);
     let design = design_source(file, text);
-    let (board, mut design) = match (board, design) {
+    let (board, design) = match (board, design) {
         (Ok(b), Ok(d)) => (b, d),
         (Err(mut a), Err(b)) => {
             a.0.extend(b.0);
@@ -47,24 +47,14 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
         }
         (Err(e), _) | (_, Err(e)) => return Err(e),
     };
-    let (out, warnings) = board::design::design(&board, board_text, &design);
-    if let Some((path, x)) = design::finite::first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&out))) {
-        let src = Source {
+    design::on_board(
+        design,
+        &board,
+        Source {
             file: board_file,
             text: board_text,
-        };
-        return Err(src
-            .error(
-                0..0,
-                "",
-                format!("the board design's `board.{path}` comes out as {x}: the board's values with this motor overflow f64"),
-                "board values in their physically sensible ranges (see boards/nucleo-g474re.toml)",
-            )
-            .into());
-    }
-    design.warnings.extend(warnings);
-    design.board = Some(out);
-    Ok(design)
+        },
+    )
 }
 
 /// Parses, resolves and designs one spec. `file` is only used in messages.

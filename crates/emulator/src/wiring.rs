@@ -66,7 +66,7 @@ pub fn wiring(d: &Design) -> Result<Wiring, String> {
         excitation: pin(Signal::ResolverExcitation)?,
         adc_inputs,
         vref: b.adc_reference_v,
-        break_idle_high: !codegen::board::design::break_active_high(b),
+        break_idle_high: !codegen::board::break_active_high(b),
     })
 }
 

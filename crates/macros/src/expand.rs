@@ -3,7 +3,8 @@
 use std::collections::BTreeMap;
 use std::path::PathBuf;
 
-use codegen::design::{angle_observer, current_loop};
+use codegen::design::angle_observer;
+use codegen::design::current_loop::{self, continuous};
 use codegen::render::{Output, render};
 use codegen::spec::{Method, ObserverError};
 use codegen::units::{self, Kind};
@@ -303,14 +304,26 @@ pub fn pi_gains(input: TokenStream) -> syn::Result<TokenStream> {
         }
         (_, None) => 0.0,
     };
-    let g = current_loop::design_axis(method, 'd', r, l, alpha, zeta, 1.0 / fs).map_err(|e| {
+    let ts = 1.0 / fs;
+    let req = current_loop::Request {
+        method,
+        axis: current_loop::Axis::D,
+        resistance_ohm: r,
+        inductance_h: l,
+        bandwidth_rad_s: alpha,
+        damping: zeta,
+        sample_period_s: ts,
+        loop_delay_s: current_loop::FIRMWARE_LOOP_DELAY_PERIODS * ts,
+        compensate_delay: false,
+    };
+    let g = continuous::design(&req).map_err(|e| {
         let msg = match e {
-            current_loop::CurrentLoopError::RhpZero { min_bandwidth_rad_s, .. } => format!("right-half-plane zero (ω_n·ζ < R/(2L), thesis A §5.4.1); accepted: a bandwidth above {min_bandwidth_rad_s:.1} rad/s"),
-            current_loop::CurrentLoopError::NegativeActiveDamping { min_bandwidth_rad_s, .. } => format!("negative active damping (α·L < R, thesis B 2.43); accepted: a bandwidth above {min_bandwidth_rad_s:.1} rad/s"),
+            continuous::CurrentLoopError::RhpZero { min_bandwidth_rad_s, .. } => format!("right-half-plane zero (ω_n·ζ < R/(2L), thesis A §5.4.1); accepted: a bandwidth above {min_bandwidth_rad_s:.1} rad/s"),
+            continuous::CurrentLoopError::NegativeActiveDamping { min_bandwidth_rad_s, .. } => format!("negative active damping (α·L < R, thesis B 2.43); accepted: a bandwidth above {min_bandwidth_rad_s:.1} rad/s"),
         };
         syn::Error::new_spanned(&n.args["bandwidth"].value, msg)
     })?;
-    let limit = current_loop::bandwidth_limit(method, fs);
+    let limit = continuous::bandwidth_limit(method, fs);
     if alpha >= limit {
         return Err(syn::Error::new_spanned(
             &n.args["bandwidth"].value,

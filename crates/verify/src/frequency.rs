@@ -239,13 +239,13 @@ mod tests {
     #[test]
     fn discrete_step_settles_at_one_after_the_delay() {
         let d = fischer();
-        let y = codegen::design::discrete_loop::step_response(
-            &d.current_loop.q.loop_gains(),
+        use codegen::design::current_loop::discrete::{SampledPlant, step_response};
+        let plant = SampledPlant::new(
             d.motor.phase_resistance_ohm,
             d.motor.q_inductance_h,
             d.drive.sample_period_s,
-            20_000,
         );
+        let y = step_response(&d.current_loop.q.loop_gains(), &plant, 20_000);
         assert_eq!((y[0], y[1]), (0.0, 0.0));
         assert!(y[2] > 0.0);
         assert!((y[19_999] - 1.0).abs() < 1e-6, "{}", y[19_999]);

@@ -4,7 +4,7 @@
 //!   of the designed one (ln 9/α, thesis A (5.8), thesis B (2.41); the second-order step
 //!   of (5.14)–(5.16)) when the design compensates the delay, within 5 % of the design's
 //!   sampled-loop prediction always, overshoot within the design's floor (designed + 2 %,
-//!   `design::sampled_loop`).
+//!   `design::current_loop::analysis`).
 //! * [`decoupling`] — i_q step at speed with and without the feed-forward (5.3): the
 //!   i_d excursion must shrink at least 3× (thesis A Figs. 5.4 vs 5.6).
 //! * [`dc_link_step`] — U_dc drops 20 % at speed under load; the 1/U_dc feed-forward
@@ -17,7 +17,7 @@ use motor_control::step::Demand;
 use super::figures::{designed_rise_time, designed_step};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use codegen::design::Design;
-use codegen::design::sampled_loop::{OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
+use codegen::design::current_loop::analysis::{OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
 use codegen::spec::Method;
 use motor_sim::bench::Bench;
 use motor_sim::figures::step_figures;
@@ -150,7 +150,7 @@ pub fn current_step_checks(d: &Design, k: usize, y: &[f64], target: f64) -> Vec<
     let rise = f.rise_time * 1e3;
     let want = rise_design * 1e3;
     if cl.compensate_delay {
-        // The design promises the requested α in the sampled loop (`discrete_loop`).
+        // The design promises the requested α in the sampled loop (`current_loop::discrete`).
         let rise_ok = (f.rise_time / rise_design - 1.0).abs() <= RISE_TOLERANCE;
         checks.push(
             check(format!("{axis}-axis rise time 10–90 %"), rise, Some(want), "ms").criterion(
@@ -162,7 +162,7 @@ pub fn current_step_checks(d: &Design, k: usize, y: &[f64], target: f64) -> Vec<
             ),
         );
     }
-    // The same gains in the design's sampled-loop model (`design::sampled_loop`, T_s,
+    // The same gains in the design's sampled-loop model (`current_loop::analysis`, T_s,
     // 1.5·T_s delay): tells a sampling effect (both measured and predicted off the
     // design) from an implementation fault (measured off the prediction).
     let g = if k == 0 { &cl.d } else { &cl.q };

@@ -10,9 +10,12 @@
 //! carries two signals; PB8 (BOOT0) only with a stated `[boot0] handling`; the sampling
 //! time of every analog input against DS12288 Table 67 for its channel class and source
 //! resistance ([`sampling`]); trip levels inside the measurable ranges.
+//!
+//! This layer knows no motor: a board with a motor (its ADC scalings and trips in the
+//! firmware's units, and the checks that need both) is a section of the design,
+//! [`crate::design::on_board`].
 
 pub mod chip;
-pub mod design;
 mod raw;
 pub mod sampling;
 mod sequence;
@@ -22,7 +25,7 @@ use std::ops::Range;
 use serde::Serialize;
 
 use crate::diagnostic::{Diagnostics, Source};
-use crate::spec::{Param, Provenance, Resolver_};
+use crate::spec::{Param, Provenance, ResolveContext};
 use crate::units::Kind;
 use chip::Chip;
 pub use raw::{Boot0Handling, Polarity, SampleInstant};
@@ -31,6 +34,11 @@ pub use sequence::{AdcSlot, Converter};
 
 /// The board `motorgen firmware` and the firmware build use when none is named.
 pub const DEFAULT_BOARD: &str = "motorgen-reference";
+
+/// Frames the drive sends or receives after the setpoint identifier: status, command,
+/// capture header, capture data, capture end (identifiers setpoint_id + 1 … + 5, the
+/// `can` constants group); a board's `can.setpoint_id` leaves room for them.
+pub const FRAMES_AFTER_SETPOINT: u16 = 5;
 
 /// The ADC kernel clock the firmware runs the converters at \[Hz\]: HCLK/4 = 170 MHz/4
 /// (synchronous clock, ADC12_CCR.CKMODE = 0b11, RM0440 §21.4.3), below the 52 MHz of
@@ -155,6 +163,20 @@ impl Signal {
     /// Whether a board may leave it out (the third phase current).
     pub fn optional(self) -> bool {
         self == Signal::CurrentW
+    }
+
+    /// Its code in the generated ADC sequences (`board::ADCx_SIGNALS`); `u8::MAX` for a
+    /// signal that is not an analog input.
+    pub fn adc_code(self) -> u8 {
+        match self {
+            Signal::CurrentU => 0,
+            Signal::CurrentV => 1,
+            Signal::CurrentW => 2,
+            Signal::DcLink => 3,
+            Signal::ResolverSin => 4,
+            Signal::ResolverCos => 5,
+            _ => u8::MAX,
+        }
     }
 
     fn raw(self, p: &RawPins) -> Option<&PinName> {
@@ -286,6 +308,32 @@ impl Board {
     }
 }
 
+/// Worst trigger-to-end time of a converter's sequence: latency 3 ADC cycles (DS12288
+/// Table 66, t_LATRINJ ≤ 3.125 cycles with CKMODE = 0b11) plus, per rank, sampling +
+/// 12.5 conversion cycles (RM0440 §21.4.12: T_CONV = sampling + 12.5 cycles at 12 bits).
+pub fn sequence_time(board: &Board, adc_hz: f64) -> f64 {
+    board
+        .adc
+        .iter()
+        .map(|q| (3.125 + q.iter().map(|s| s.sampling.cycles + 12.5).sum::<f64>()) / adc_hz)
+        .fold(0.0, f64::max)
+}
+
+/// Whether the image must check the BOOT0 option bytes at start-up.
+pub fn checks_option_bytes(board: &Board) -> bool {
+    board.boot0 == Some(Boot0Handling::OptionBytes)
+}
+
+/// The break input's polarity as TIM1_BDTR.BKP (1 = active high, RM0440 §29.6.20).
+pub fn break_active_high(board: &Board) -> bool {
+    board.break_polarity == Polarity::ActiveHigh
+}
+
+/// Whether the currents are sampled at the carrier maximum (low-side pulse centre).
+pub fn samples_at_carrier_maximum(board: &Board) -> bool {
+    board.sample_instant == SampleInstant::LowSideCentre
+}
+
 /// Example of a complete board file for messages.
 const EXAMPLE: &str = "boards/motorgen-reference.toml";
 
@@ -302,7 +350,7 @@ pub fn parse(source: Source<'_>) -> Result<Board, Diagnostics> {
             .into());
     }
     let raw: RawBoard = crate::spec::deserialize(source, EXAMPLE)?;
-    let mut cx = Resolver_::new(source);
+    let mut cx = ResolveContext::new(source);
     let board = resolve(&mut cx, &raw);
     match board {
         Some(b) if cx.errors.is_empty() => Ok(b),
@@ -345,7 +393,7 @@ fn port_and_number(pin: &str) -> Option<(u8, u8)> {
     (port.is_ascii_uppercase() && number < 16).then(|| (port as u8 - b'A', number))
 }
 
-fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
+fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
     let mut spans = Vec::new();
     let name = raw.name.get_ref().trim().to_string();
     if name.is_empty() {
@@ -374,7 +422,7 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
         boot0_check(cx, raw, pins);
     }
 
-    let q = |cx: &mut Resolver_<'_>,
+    let q = |cx: &mut ResolveContext<'_>,
              spans: &mut Vec<(String, Range<usize>)>,
              key: &str,
              v: &crate::spec::Val,
@@ -522,7 +570,7 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
         &c.setpoint_id,
         0,
         // The drive's own frames take the identifiers after it (constants group `can`).
-        0x7FF - i64::from(crate::constants::can::FRAMES_AFTER_SETPOINT),
+        0x7FF - i64::from(FRAMES_AFTER_SETPOINT),
         "a standard (11-bit) identifier 0 … 0x7FA (the drive's status, command and capture frames take the 5 after it), e.g. 0x100",
     );
     let period = q(cx, &mut spans, "can.setpoint_period", &c.setpoint_period, Kind::Time);
@@ -586,7 +634,7 @@ fn resolve(cx: &mut Resolver_<'_>, raw: &RawBoard) -> Option<Board> {
 }
 
 /// Every signal's pin: exists, carries the function, used once.
-fn pins(cx: &mut Resolver_<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<Vec<PinUse>> {
+fn pins(cx: &mut ResolveContext<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<Vec<PinUse>> {
     let table = raw.pins.get_ref();
     let mut out: Vec<PinUse> = Vec::new();
     let mut seen: Vec<(&'static str, Signal)> = Vec::new();
@@ -684,7 +732,7 @@ fn pins(cx: &mut Resolver_<'_>, raw: &RawBoard, chip: &'static Chip) -> Option<V
 }
 
 /// PB8 is BOOT0: a signal there needs `[boot0]`, and a CAN receiver cannot hold it low.
-fn boot0_check(cx: &mut Resolver_<'_>, raw: &RawBoard, pins: &[PinUse]) {
+fn boot0_check(cx: &mut ResolveContext<'_>, raw: &RawBoard, pins: &[PinUse]) {
     let Some(on_boot0) = pins.iter().find(|p| p.pin == chip::BOOT0_PIN) else {
         return;
     };

@@ -9,7 +9,18 @@
 //! shortest sampling option whose time is at least the table time of the first row
 //! that allows the source resistance.
 
-use crate::design::adc::{STM32G4_SAMPLE_CYCLES, settling_multiple};
+/// STM32G4 ADC_SMPR sampling-time options in ADC clock cycles, codes 0..=7 (RM0440).
+pub const STM32G4_SAMPLE_CYCLES: [f64; 8] = [2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5];
+
+/// t_sample/τ needed to settle to 1 LSB of an N-bit converter: −ln(2^−N) (7.4).
+pub fn settling_time_constants(bits: u32) -> f64 {
+    f64::from(bits) * std::f64::consts::LN_2
+}
+
+/// The whole number of time constants used: ⌈N·ln 2⌉ (thesis A: 8.32 → "use ≥ 9").
+pub fn settling_multiple(bits: u32) -> u32 {
+    settling_time_constants(bits).ceil() as u32
+}
 
 /// DS12288 Table 67, 12-bit rows: (sampling cycles at 60 MHz, sampling time \[ns\],
 /// R_AIN max fast \[Ω\], R_AIN max slow \[Ω\], `None` = not allowed).
@@ -110,6 +121,13 @@ mod tests {
     use super::*;
 
     const F: f64 = 42.5e6;
+
+    /// Thesis A (7.4): −ln(1/2^12) ≈ 8.32, rounded up to 9.
+    #[test]
+    fn twelve_bits_need_nine_time_constants() {
+        assert!((settling_time_constants(12) - 8.3178).abs() < 1e-4);
+        assert_eq!(settling_multiple(12), 9);
+    }
 
     /// The case: PA4 is ADC2_IN17, a slow channel; 1.1 kΩ needs the 1.2 kΩ row
     /// (24.5 cycles, 408.33 ns); at 42.5 MHz 12.5 cycles is 294 ns (too short), 24.5

@@ -15,7 +15,7 @@ use super::chip::{self, Chip};
 use super::raw::RawBoard;
 use super::sampling::{self, Sampling};
 use super::{ADC_CLOCK_HZ, PinUse, Signal};
-use crate::spec::{Param, Resolver_};
+use crate::spec::{Param, ResolveContext};
 
 /// ADC1 or ADC2.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -80,7 +80,7 @@ fn cost(seqs: &[Vec<Signal>; 2]) -> u32 {
 
 /// The sequences of ADC1 and ADC2, or located errors.
 pub(super) fn plan(
-    cx: &mut Resolver_<'_>,
+    cx: &mut ResolveContext<'_>,
     raw: &RawBoard,
     chip: &'static Chip,
     pins: &[PinUse],

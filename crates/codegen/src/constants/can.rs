@@ -11,10 +11,6 @@ use motor_control::can_protocol as p;
 use super::{Constant, Group, c, f32v, intv, phys};
 use crate::design::Design;
 
-/// Frames the drive sends or receives after the setpoint identifier: status, command,
-/// capture header, capture data, capture end (identifiers setpoint_id + 1 … + 5).
-pub const FRAMES_AFTER_SETPOINT: u16 = 5;
-
 /// Standard identifier of the fault report, a choice of the firmware: low (high
 /// priority on the bus), below the drive's other frames on the seed boards.
 pub const FAULT_REPORT_ID: u16 = 0x0E0;

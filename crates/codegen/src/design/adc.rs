@@ -1,19 +1,12 @@
-//! ADC sampling time from the sample-and-hold settling rule, thesis A (7.2)–(7.4).
+//! ADC sampling time from the sample-and-hold settling rule, thesis A (7.2)–(7.4), for
+//! the spec's `[adc]` circuit: τ = (R_ADC + R_EXT)·C_ADC (7.2) and the shortest STM32G4
+//! sampling option of at least ⌈N·ln 2⌉·τ. The settling multiple (7.4) and the chip's
+//! sampling options are facts the board checks use too, so they live in the board layer
+//! ([`crate::board::sampling`]).
 
 use serde::Serialize;
 
-/// STM32G4 ADC_SMPR sampling-time options in ADC clock cycles, codes 0..=7 (RM0440).
-pub const STM32G4_SAMPLE_CYCLES: [f64; 8] = [2.5, 6.5, 12.5, 24.5, 47.5, 92.5, 247.5, 640.5];
-
-/// t_sample/τ needed to settle to 1 LSB of an N-bit converter: −ln(2^−N) (7.4).
-pub fn settling_time_constants(bits: u32) -> f64 {
-    f64::from(bits) * std::f64::consts::LN_2
-}
-
-/// The whole number of time constants used: ⌈N·ln 2⌉ (thesis A: 8.32 → "use ≥ 9").
-pub fn settling_multiple(bits: u32) -> u32 {
-    settling_time_constants(bits).ceil() as u32
-}
+use crate::board::sampling::{STM32G4_SAMPLE_CYCLES, settling_multiple};
 
 /// A chosen STM32G4 sampling time.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -56,13 +49,6 @@ pub fn choose_sample_time(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// Thesis A (7.4): −ln(1/2^12) ≈ 8.32, rounded up to 9.
-    #[test]
-    fn twelve_bits_need_nine_time_constants() {
-        assert!((settling_time_constants(12) - 8.3178).abs() < 1e-4);
-        assert_eq!(settling_multiple(12), 9);
-    }
 
     /// Hand calculation: τ = (1 kΩ + 0.1 kΩ)·5 pF = 5.5 ns; 9τ = 49.5 ns;
     /// at 42.5 MHz that is 2.10 cycles → 2.5 cycles (code 0). With R_EXT = 10 kΩ:

@@ -55,9 +55,29 @@ pub fn onset_speed(m: &LossModel, v_prime: f64) -> f64 {
     (-b + (b * b - 4.0 * a * c).max(0.0).sqrt()) / (2.0 * a)
 }
 
-/// How far |v| rises above V'_max \[V\] while the speed rises at `acceleration`
-/// [rad/s², electrical] into field weakening at `onset` [rad/s] ([`onset_speed`]), with
-/// the full torque demand on the current circle (Mode B (2.57), i_q = √(I_max² − i_d²)).
+/// Where the field-weakening loop is judged against the drive's largest acceleration: the
+/// onset of field weakening, approached at that acceleration with the current loop
+/// lagging behind its reference ([`voltage_overshoot`], [`min_bandwidth_for_overshoot`]).
+/// Speeds and the acceleration are electrical.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OperatingPoint {
+    /// V'_max, the voltage the loop holds |v| to \[V\] (2.55).
+    pub voltage_limit_v: f64,
+    /// ω_on, where field weakening starts ([`onset_speed`]) [rad/s].
+    pub onset_speed_rad_s: f64,
+    /// ω_base of (2.60) [rad/s].
+    pub base_speed_rad_s: f64,
+    /// The shaft's acceleration n_p·ω̇_m [rad/s²].
+    pub acceleration_rad_s2: f64,
+    /// τ_v, the current loop's lag behind a ramp of i_d^ref \[s\]
+    /// (`current_loop::discrete::ramp_lag`).
+    pub current_lag_s: f64,
+}
+
+/// How far |v| rises above V'_max \[V\] while the speed rises at `op`'s acceleration into
+/// field weakening at its onset ([`onset_speed`]), with the full torque demand on the
+/// current circle (Mode B (2.57), i_q = √(I_max² − i_d²)), for the loop bandwidth
+/// `alpha_fw` [rad/s].
 ///
 /// Linearised at the onset's MTPA corner (i_d, i_q) and voltage (v_d, v_q) (2.52): (2.55)
 /// moves i_d at γ·(V'² − |v|²) ≈ −2γV'·δ with δ = |v| − V'_max, and |v| answers with
@@ -65,21 +85,13 @@ pub fn onset_speed(m: &LossModel, v_prime: f64) -> f64 {
 /// ∂v_q/∂i_d = ω·L_d − R·i_d/i_q. With γ of (2.60) (ω_fw = max(ω_base, ω)) the loop's
 /// bandwidth is α = α_fw·s/(ω_fw·L_d) — below α_fw, since (2.60) assumes s = ω·L_d. The
 /// speed drives δ at ψ_s·ω̇_e (ψ_s = V'_max/ω, the stator flux), so dδ/dt = −α·δ + ψ_s·ω̇_e,
-/// and the current loop follows i_d^ref a ramp lag `lag` \[s\] behind
-/// (`discrete_loop::ramp_lag`): δ = ψ_s·ω̇_e·(1/α + τ_v). The onset is where δ is largest
-/// and α smallest (deeper in field weakening v_q/|v| → 1 and s → ω·L_d), so the estimate
-/// is on the safe side.
-pub fn voltage_overshoot(
-    m: &LossModel,
-    v_prime: f64,
-    onset: f64,
-    base_speed: f64,
-    acceleration: f64,
-    alpha_fw: f64,
-    lag: f64,
-) -> f64 {
-    let alpha = alpha_fw * voltage_sensitivity(m, onset) / (base_speed.max(onset) * m.ld);
-    v_prime / onset * acceleration * (1.0 / alpha + lag)
+/// and the current loop follows i_d^ref its ramp lag τ_v behind: δ = ψ_s·ω̇_e·(1/α + τ_v).
+/// The onset is where δ is largest and α smallest (deeper in field weakening
+/// v_q/|v| → 1 and s → ω·L_d), so the estimate is on the safe side.
+pub fn voltage_overshoot(m: &LossModel, op: &OperatingPoint, alpha_fw: f64) -> f64 {
+    let onset = op.onset_speed_rad_s;
+    let alpha = alpha_fw * voltage_sensitivity(m, onset) / (op.base_speed_rad_s.max(onset) * m.ld);
+    op.voltage_limit_v / onset * op.acceleration_rad_s2 * (1.0 / alpha + op.current_lag_s)
 }
 
 /// s = ∂|v|/∂i_d [V/A] at the full-current MTPA corner at speed `w` on the current circle
@@ -94,19 +106,12 @@ pub fn voltage_sensitivity(m: &LossModel, w: f64) -> f64 {
     (vd * dvd + vq * dvq) / vd.hypot(vq)
 }
 
-/// The smallest α_fw [rad/s] whose [`voltage_overshoot`] stays within `allowed` \[V\];
-/// `None` when the current loop's lag alone uses it up.
-pub fn min_bandwidth_for_overshoot(
-    m: &LossModel,
-    v_prime: f64,
-    onset: f64,
-    base_speed: f64,
-    acceleration: f64,
-    lag: f64,
-    allowed: f64,
-) -> Option<f64> {
-    let per_rate = allowed / (v_prime / onset * acceleration) - lag;
-    let ratio = voltage_sensitivity(m, onset) / (base_speed.max(onset) * m.ld);
+/// The smallest α_fw [rad/s] whose [`voltage_overshoot`] at `op` stays within `allowed`
+/// \[V\]; `None` when the current loop's lag alone uses it up.
+pub fn min_bandwidth_for_overshoot(m: &LossModel, op: &OperatingPoint, allowed: f64) -> Option<f64> {
+    let onset = op.onset_speed_rad_s;
+    let per_rate = allowed / (op.voltage_limit_v / onset * op.acceleration_rad_s2) - op.current_lag_s;
+    let ratio = voltage_sensitivity(m, onset) / (op.base_speed_rad_s.max(onset) * m.ld);
     (per_rate > 0.0).then(|| 1.0 / (per_rate * ratio))
 }
 

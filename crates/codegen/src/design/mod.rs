@@ -1,8 +1,12 @@
 //! The design: every constant the controller needs, computed from a resolved [`Spec`].
 //!
-//! Each submodule computes one thing and cites its equation. [`design()`] assembles
-//! them through `step`, one step per section of the [`Design`]; each step applies its
-//! design-rule checks and reports violations at the key that caused them.
+//! Two layers. The computation modules (`current_loop`, `angle_observer`, `fir`, …)
+//! each compute one thing and cite its equation; they read no spec file and report at
+//! no key, so the proc-macros and `motor-verify` call them directly. Above them,
+//! `sections` has one module per section of the [`Design`] (named after it): each reads
+//! the resolved spec, applies its section's design-rule checks and reports violations
+//! at the key that caused them. [`design()`] assembles the sections of a motor;
+//! [`on_board()`] adds the section of a motor on an inverter board.
 
 pub mod acceleration;
 pub mod adc;
@@ -10,35 +14,33 @@ pub mod angle_observer;
 pub mod cross_check;
 pub mod current_loop;
 pub mod dead_time;
-pub mod designed_response;
-pub mod discrete_loop;
-pub mod sampled_loop;
 
 pub mod field_weakening;
 pub mod finite;
 pub mod fir;
-pub mod flux_linkage;
 pub mod loss_minimisation;
 pub mod modulation;
 pub mod per_unit;
 pub mod sampling;
 pub mod scaling;
+mod sections;
 pub mod sensorless;
-mod step;
 pub mod thermal;
 
 use serde::Serialize;
 
+use crate::board::Board;
 use crate::diagnostic::{Diagnostics, Source};
 use crate::spec::Spec;
-use step::Context;
-pub use step::adc::AdcOut;
-pub use step::angle_observer::ObserverOut;
-pub use step::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
-pub use step::drive::DriveOut;
-pub use step::motor::{MotorOut, Origin};
-pub use step::per_unit::PerUnitOut;
-pub use step::scaling::ScalingsOut;
+use sections::Context;
+pub use sections::adc::AdcOut;
+pub use sections::angle_observer::ObserverOut;
+pub use sections::board::BoardOut;
+pub use sections::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
+pub use sections::drive::DriveOut;
+pub use sections::motor::{MotorOut, Origin};
+pub use sections::per_unit::PerUnitOut;
+pub use sections::scaling::ScalingsOut;
 
 /// Version of the design's JSON form (`motorgen design --format json`): raised whenever
 /// a key is removed or renamed or changes meaning or unit, so that a consumer can refuse
@@ -76,9 +78,9 @@ pub struct Design {
     pub field_weakening: Option<field_weakening::FieldWeakeningOut>,
     /// Sensorless estimator (thesis B chapter 4), when ψ_M is known.
     pub sensorless: Option<sensorless::SensorlessOut>,
-    /// The inverter board's values with this motor (`crate::design_with_board`); `None`
-    /// for a motor designed on its own.
-    pub board: Option<crate::board::design::BoardOut>,
+    /// The inverter board's values with this motor ([`on_board()`]); `None` for a motor
+    /// designed on its own.
+    pub board: Option<BoardOut>,
     /// Non-fatal observations.
     pub warnings: Vec<String>,
 }
@@ -92,20 +94,20 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         errors: Vec::new(),
         warnings: Vec::new(),
     };
-    let drive = step::drive::drive(&mut cx);
-    let current_loop = step::current_loop::current_loop(&mut cx);
-    let angle_observer = step::angle_observer::angle_observer(&mut cx);
-    let fir = step::fir::fir(&mut cx);
-    let adc = step::adc::adc(&mut cx);
-    let field_weakening = step::field_weakening::field_weakening(&mut cx, current_loop.as_ref());
+    let drive = sections::drive::drive(&mut cx);
+    let current_loop = sections::current_loop::current_loop(&mut cx);
+    let angle_observer = sections::angle_observer::angle_observer(&mut cx);
+    let fir = sections::fir::fir(&mut cx);
+    let adc = sections::adc::adc(&mut cx);
+    let field_weakening = sections::field_weakening::field_weakening(&mut cx, current_loop.as_ref());
     let (true, Some(current_loop), Some(angle_observer), Some(fir)) =
         (cx.errors.is_empty(), current_loop, angle_observer, fir)
     else {
         return Err(Diagnostics(cx.errors));
     };
-    let motor = step::motor::motor(&mut cx, current_loop.hot.as_ref().map(|h| h.phase_resistance_ohm));
-    let per_unit = step::per_unit::per_unit(spec);
-    let sensorless = match step::sensorless::sensorless(&cx, &per_unit) {
+    let motor = sections::motor::motor(&mut cx, current_loop.hot.as_ref().map(|h| h.phase_resistance_ohm));
+    let per_unit = sections::per_unit::per_unit(spec);
+    let sensorless = match sections::sensorless::sensorless(&cx, &per_unit) {
         Ok((out, notes)) => {
             cx.warnings.extend(notes);
             out
@@ -120,7 +122,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         drive,
         current_loop,
         angle_observer,
-        scaling: step::scaling::scalings(spec),
+        scaling: sections::scaling::scalings(spec),
         per_unit,
         fir,
         modulation: modulation::modulation(spec.drive.dc_link_voltage.value, spec.drive.dc_link_voltage_min.value),
@@ -131,5 +133,26 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         warnings: cx.warnings,
     };
     finite::check(&design, spec, src).map_err(|e| Diagnostics(vec![*e]))?;
+    Ok(design)
+}
+
+/// The motor's `design` on `board` (read from `board_src`): the board section (the
+/// board's constants with this motor, and the checks that need both, as warnings at the
+/// board key, see `sections::board`), added to the design with its warnings; an error
+/// if a board value comes out non-finite with this motor.
+pub fn on_board(mut design: Design, board: &Board, board_src: Source<'_>) -> Result<Design, Diagnostics> {
+    let (out, warnings) = sections::board::board(board, board_src.text, &design);
+    if let Some((path, x)) = finite::first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&out))) {
+        return Err(board_src
+            .error(
+                0..0,
+                "",
+                format!("the board design's `board.{path}` comes out as {x}: the board's values with this motor overflow f64"),
+                "board values in their physically sensible ranges (see boards/nucleo-g474re.toml)",
+            )
+            .into());
+    }
+    design.warnings.extend(warnings);
+    design.board = Some(out);
     Ok(design)
 }

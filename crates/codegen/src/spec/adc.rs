@@ -1,7 +1,7 @@
 //! `[adc]`: the sample-and-hold data of the settling rule (7.2)–(7.4).
 
 use super::raw::RawAdc;
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -20,7 +20,7 @@ pub struct AdcSpec {
     pub source_resistance: Param,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn adc(&mut self, a: &RawAdc) -> Option<AdcSpec> {
         let bits = match &a.resolution_bits {
             Some(v) => self

@@ -2,7 +2,7 @@
 //! angle-tracking observer (thesis A §4).
 
 use super::raw::{ObserverError, RawSpec};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -19,7 +19,7 @@ pub struct ObserverSpec {
     pub lead_samples: Param,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn observer(&mut self, raw: &RawSpec) -> Option<ObserverSpec> {
         let o = raw.angle_observer.get_ref();
         let wn = self.quantity(

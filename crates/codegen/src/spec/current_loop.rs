@@ -3,7 +3,7 @@
 use std::ops::Range;
 
 use super::raw::{Method, RawSpec};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -20,11 +20,11 @@ pub struct CurrentLoopSpec {
     pub damping: Option<Param>,
     /// Design each axis so that the sampled loop with its 1.5·T_s delay delivers α (the
     /// rise time ln 9/α of the first-order methods, the dominant pole pair of pole
-    /// placement; see `design::discrete_loop`). On unless `compensate_delay = false`.
+    /// placement; see `design::current_loop::discrete`). On unless `compensate_delay = false`.
     pub compensate_delay: bool,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn current_loop(&mut self, raw: &RawSpec) -> Option<CurrentLoopSpec> {
         let c = raw.current_loop.get_ref();
         let method = *c.method.get_ref();

@@ -2,7 +2,7 @@
 //! time) and the largest shaft acceleration the drive must follow.
 
 use super::raw::RawSpec;
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -22,7 +22,7 @@ pub struct Drive {
     pub max_acceleration: Option<Param>,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn drive(&mut self, raw: &RawSpec) -> Option<Drive> {
         let d = raw.drive.get_ref();
         let fs = self.quantity(

@@ -2,11 +2,8 @@
 //! loss-minimisation design rules (thesis B §2.3, chapter 3). Both sections are
 //! optional; every key has a documented default or is optional.
 
-use serde::Deserialize;
-use serde_spanned::Spanned;
-
-use super::raw::{RawSpec, Val};
-use super::{Param, Provenance, Resolver_};
+use super::raw::RawSpec;
+use super::{Param, Provenance, ResolveContext};
 use crate::units::Kind;
 
 /// Smallest accepted V'_max/V_max: below half the inverter's voltage the field-weakening
@@ -16,30 +13,6 @@ pub const MIN_VOLTAGE_FRACTION: f64 = 0.5;
 /// V'_max/V_max when `field_weakening.voltage_fraction` is not given: thesis B Fig. 2.15
 /// ("V'_max is set to 0.9 pu", V_max = 1 pu).
 pub const DEFAULT_VOLTAGE_FRACTION: f64 = 0.9;
-
-/// `[field_weakening]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawFieldWeakening {
-    /// V'_max/V_max, 0 < x < 1.
-    #[serde(default)]
-    pub voltage_fraction: Option<Val>,
-    /// α_s of a closed speed loop, if the drive has one.
-    #[serde(default)]
-    pub speed_loop_bandwidth: Option<Val>,
-}
-
-/// `[losses]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawLosses {
-    /// R_c of Fig. 2.7.
-    #[serde(default)]
-    pub core_resistance: Option<Val>,
-    /// Include the inverter losses (3.11)–(3.14) of `[inverter]`.
-    #[serde(default)]
-    pub include_inverter: Option<Spanned<bool>>,
-}
 
 /// The resolved field-weakening and loss inputs.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,7 +27,7 @@ pub struct FieldWeakeningSpec {
     pub include_inverter: bool,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn field_weakening(&mut self, raw: &RawSpec) -> Option<FieldWeakeningSpec> {
         let fw = raw.field_weakening.as_ref().map(|s| s.get_ref());
         let losses = raw.losses.as_ref().map(|s| s.get_ref());

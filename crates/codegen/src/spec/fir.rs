@@ -4,7 +4,7 @@
 use std::ops::Range;
 
 use super::raw::RawSpec;
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -25,7 +25,7 @@ pub struct FirSpec {
     pub span: Range<usize>,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn fir(&mut self, raw: &RawSpec) -> Option<FirSpec> {
         let f = raw.fir.get_ref();
         let pass_edge = self.quantity(

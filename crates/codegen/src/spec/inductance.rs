@@ -2,11 +2,11 @@
 //! `d_inductance` and `q_inductance` per section, identified over datasheet axis by axis.
 
 use super::raw::RawMotor;
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     /// At most one inductance form per section, and both axes where d/q is used.
     pub(super) fn inductance_forms(&mut self, m: &RawMotor) {
         for (section, name) in [(&m.datasheet, "datasheet"), (&m.identified, "identified")] {

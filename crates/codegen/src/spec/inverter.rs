@@ -1,7 +1,7 @@
 //! `[inverter]`: switch and diode loss data (thesis B Table B.3) for the loss model (3.11)–(3.14).
 
 use super::raw::RawInverter;
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -26,7 +26,7 @@ pub struct InverterSpec {
     pub recovery_energy: Param,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn inverter(&mut self, i: &RawInverter) -> Option<InverterSpec> {
         Some(InverterSpec {
             part: i.part.clone(),

@@ -42,7 +42,7 @@ pub use motor::{Harmonics, Motor};
 use raw::RawSpec;
 pub(crate) use raw::Val;
 pub use raw::{Amplitude, Between, Connection, Method, ObserverError, SpeedAxis};
-pub(crate) use resolve::Resolver_;
+pub(crate) use resolve::ResolveContext;
 pub use resolver::Resolver;
 pub use sensorless::{DEFAULT_ANGLE_ERROR_DEG, DEFAULT_RESISTANCE_ERROR, SensorlessSpec, angle_error_rad};
 pub use thermal::ThermalSpec;
@@ -123,7 +123,7 @@ pub fn parse(source: Source<'_>) -> Result<Spec, Diagnostics> {
             .into());
     }
     let raw: RawSpec = deserialize(source, "motors/fischer-ti085.toml")?;
-    let mut cx = Resolver_::new(source);
+    let mut cx = ResolveContext::new(source);
     let spec = cx.spec(&raw);
     match spec {
         Some(spec) if cx.errors.is_empty() => Ok(spec),

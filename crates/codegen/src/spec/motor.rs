@@ -7,7 +7,7 @@ use std::ops::Range;
 
 use super::flux_linkage::FluxSource;
 use super::raw::{Connection, RawHarmonics, RawMotor, RawParams, RawSpec, Val};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -90,7 +90,7 @@ fn identification(m: &RawMotor) -> Option<String> {
     }
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn motor(&mut self, raw: &RawSpec) -> Option<Motor> {
         let m = raw.motor.get_ref();
         let motor_span = raw.motor.span();

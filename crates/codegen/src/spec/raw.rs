@@ -31,11 +31,11 @@ pub struct RawSpec {
     #[serde(default)]
     pub inverter: Option<Spanned<RawInverter>>,
     #[serde(default)]
-    pub field_weakening: Option<Spanned<super::field_weakening::RawFieldWeakening>>,
+    pub field_weakening: Option<Spanned<RawFieldWeakening>>,
     #[serde(default)]
-    pub losses: Option<Spanned<super::field_weakening::RawLosses>>,
+    pub losses: Option<Spanned<RawLosses>>,
     #[serde(default)]
-    pub sensorless: Option<Spanned<super::sensorless::RawSensorless>>,
+    pub sensorless: Option<Spanned<RawSensorless>>,
 }
 
 /// `[motor]`.
@@ -317,4 +317,61 @@ pub struct RawInverter {
     pub diode_resistance: Val,
     pub diode_threshold: Val,
     pub recovery_energy: Val,
+}
+
+/// `[field_weakening]`: the field-weakening loop's inputs (thesis B §2.3.3).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawFieldWeakening {
+    /// V'_max/V_max, 0 < x < 1.
+    #[serde(default)]
+    pub voltage_fraction: Option<Val>,
+    /// α_s of a closed speed loop, if the drive has one.
+    #[serde(default)]
+    pub speed_loop_bandwidth: Option<Val>,
+}
+
+/// `[losses]`: the loss model's inputs (thesis B chapter 3).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawLosses {
+    /// R_c of Fig. 2.7.
+    #[serde(default)]
+    pub core_resistance: Option<Val>,
+    /// Include the inverter losses (3.11)–(3.14) of `[inverter]`.
+    #[serde(default)]
+    pub include_inverter: Option<Spanned<bool>>,
+}
+
+/// `[sensorless]`: the sensorless estimator's inputs (thesis B chapter 4).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawSensorless {
+    /// ρ, explicit (exclusive with `max_acceleration`).
+    #[serde(default)]
+    pub bandwidth: Option<Val>,
+    /// Largest shaft acceleration |dω_m/dt| the estimator must track (4.74).
+    #[serde(default)]
+    pub max_acceleration: Option<Val>,
+    /// Allowed transient angle error θ̃_max (4.74), (4.69).
+    #[serde(default)]
+    pub max_angle_error: Option<Val>,
+    /// Carrier ω_e of the signal injection (4.34).
+    #[serde(default)]
+    pub injection_frequency: Option<Val>,
+    /// Carrier amplitude V_e (4.35).
+    #[serde(default)]
+    pub injection_voltage: Option<Val>,
+    /// High-pass ω_hp of the demodulation (Table 4.1).
+    #[serde(default)]
+    pub highpass: Option<Val>,
+    /// Low-pass ω_lp of the demodulation (Table 4.1).
+    #[serde(default)]
+    pub lowpass: Option<Val>,
+    /// R̃_s/R_s assumed for ω_min2 (4.69).
+    #[serde(default)]
+    pub resistance_error: Option<Val>,
+    /// Allowed speed-estimate noise ω_ν at base current for (4.24).
+    #[serde(default)]
+    pub speed_noise: Option<Val>,
 }

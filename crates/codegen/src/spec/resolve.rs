@@ -1,9 +1,9 @@
 //! The second pass: raw TOML values → SI [`Param`]s with provenance, collecting every
 //! problem as a located [`Diagnostic`] instead of stopping at the first.
 //!
-//! This module holds the resolver state and the value parsers every section uses
-//! (quantities with units, plain numbers, whole numbers); each section's own rules live in
-//! the module named after it.
+//! This module holds the pass's state ([`ResolveContext`]) and the value parsers every
+//! section uses (quantities with units, plain numbers, whole numbers); each section's own
+//! rules live in the module named after it.
 
 use std::ops::Range;
 
@@ -12,9 +12,11 @@ use super::{Param, Provenance, Spec, plausible};
 use crate::diagnostic::{Diagnostic, Source};
 use crate::units::{self, Kind};
 
-/// The second pass; collects every problem instead of stopping at the first. Its value
-/// readers (`quantity`, `number`, `integer`) also read board files (`crate::board`).
-pub(crate) struct Resolver_<'a> {
+/// The state of the second pass over one file: its text and every problem found so far
+/// (the pass collects them instead of stopping at the first). Each section is resolved by
+/// a method on it in the module named after the section; its value readers (`quantity`,
+/// `number`, `integer`) also read board files (`crate::board`).
+pub(crate) struct ResolveContext<'a> {
     pub(crate) src: Source<'a>,
     pub(crate) errors: Vec<Diagnostic>,
 }
@@ -23,10 +25,10 @@ fn kind_example(kind: Kind) -> &'static str {
     kind.accepted()
 }
 
-impl<'a> Resolver_<'a> {
+impl<'a> ResolveContext<'a> {
     /// A resolver with no problems found yet.
     pub(crate) fn new(src: Source<'a>) -> Self {
-        Resolver_ {
+        ResolveContext {
             src,
             errors: Vec::new(),
         }

@@ -2,7 +2,7 @@
 //! `motor.identified.resolver_offset` overrides.
 
 use super::raw::{RawSpec, Val};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 
 /// The resolved resolver.
@@ -14,7 +14,7 @@ pub struct Resolver {
     pub offset: Option<Param>,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn resolver(&mut self, raw: &RawSpec) -> Option<Resolver> {
         let r = raw.resolver.get_ref();
         let pole_pairs = self.integer(

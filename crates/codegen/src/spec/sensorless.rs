@@ -3,10 +3,8 @@
 //! only for a spec that has it (a drive with a resolver or encoder has no estimator).
 //! Every key is optional or has a documented default taken from the thesis.
 
-use serde::Deserialize;
-
 use super::raw::{RawSpec, Val};
-use super::{Param, Provenance, Resolver_};
+use super::{Param, Provenance, ResolveContext};
 use crate::units::Kind;
 
 /// Allowed transient angle error θ̃ when `sensorless.max_angle_error` is not given:
@@ -15,39 +13,6 @@ pub const DEFAULT_ANGLE_ERROR_DEG: f64 = 10.0;
 /// R̃_s/R_s for ω_min2 (4.69) when `sensorless.resistance_error` is not given: thesis B
 /// §4.4.2 assumes R̃_s = 2R_s.
 pub const DEFAULT_RESISTANCE_ERROR: f64 = 2.0;
-
-/// `[sensorless]`.
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct RawSensorless {
-    /// ρ, explicit (exclusive with `max_acceleration`).
-    #[serde(default)]
-    pub bandwidth: Option<Val>,
-    /// Largest shaft acceleration |dω_m/dt| the estimator must track (4.74).
-    #[serde(default)]
-    pub max_acceleration: Option<Val>,
-    /// Allowed transient angle error θ̃_max (4.74), (4.69).
-    #[serde(default)]
-    pub max_angle_error: Option<Val>,
-    /// Carrier ω_e of the signal injection (4.34).
-    #[serde(default)]
-    pub injection_frequency: Option<Val>,
-    /// Carrier amplitude V_e (4.35).
-    #[serde(default)]
-    pub injection_voltage: Option<Val>,
-    /// High-pass ω_hp of the demodulation (Table 4.1).
-    #[serde(default)]
-    pub highpass: Option<Val>,
-    /// Low-pass ω_lp of the demodulation (Table 4.1).
-    #[serde(default)]
-    pub lowpass: Option<Val>,
-    /// R̃_s/R_s assumed for ω_min2 (4.69).
-    #[serde(default)]
-    pub resistance_error: Option<Val>,
-    /// Allowed speed-estimate noise ω_ν at base current for (4.24).
-    #[serde(default)]
-    pub speed_noise: Option<Val>,
-}
 
 /// The resolved `[sensorless]` inputs (all SI; angles in rad, speeds electrical where
 /// the design says so).
@@ -75,7 +40,7 @@ pub struct SensorlessSpec {
     pub speed_noise: Option<Param>,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     /// `Some(None)` without the section, `None` when a key is bad.
     pub(super) fn sensorless(&mut self, raw: &RawSpec) -> Option<Option<SensorlessSpec>> {
         let Some(section) = raw.sensorless.as_ref() else {

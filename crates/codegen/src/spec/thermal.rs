@@ -1,7 +1,7 @@
 //! `[thermal]`: the winding temperatures of the copper-resistance rule (thesis B 2.24).
 
 use super::raw::RawThermal;
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -14,7 +14,7 @@ pub struct ThermalSpec {
     pub max_winding_temperature: Param,
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     pub(super) fn thermal(&mut self, t: &RawThermal) -> Option<ThermalSpec> {
         let reference_temperature = match &t.reference_temperature {
             Some(v) => self.quantity(

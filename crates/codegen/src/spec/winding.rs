@@ -13,13 +13,13 @@
 //! quotes (for a salient motor, each axis measured at its aligned position).
 
 use super::raw::{Connection, RawMotor, RawParams, Val};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::{self, Kind};
 
 const FORMS: &str = "a quoted phase value such as \"0.304 Ω\", or { value = \"0.608 Ω\", measured = \"line_to_line\" } (measured: \"line_to_line\", \"phase\", or \"winding\" with [motor] connection)";
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     /// A phase resistance or inductance in either form, as the star-equivalent phase value.
     pub(super) fn phase_value(
         &mut self,

@@ -17,7 +17,7 @@
 //! skipped; the test requires enough accepted and refused points to mean something.
 
 use codegen::design::Design;
-use codegen::design::discrete_loop;
+use codegen::design::current_loop;
 use codegen::{Source, design, spec};
 use motor_verify::{Setup, scenarios::current_step};
 
@@ -145,27 +145,20 @@ fn check_verdict_matches_the_simulated_step() {
                         let zeta = s.current_loop.damping.as_ref().map_or(0.0, |z| z.value);
                         let ts = 1.0 / fs;
                         let r = m.phase_resistance.value;
+                        let request = |axis, l| current_loop::Request {
+                            method: s.current_loop.method,
+                            axis,
+                            resistance_ohm: r,
+                            inductance_h: l,
+                            bandwidth_rad_s: alpha,
+                            damping: zeta,
+                            sample_period_s: ts,
+                            loop_delay_s: current_loop::FIRMWARE_LOOP_DELAY_PERIODS * ts,
+                            compensate_delay: compensate,
+                        };
                         let (Ok(gd), Ok(gq)) = (
-                            discrete_loop::axis(
-                                s.current_loop.method,
-                                'd',
-                                r,
-                                m.d_inductance.value,
-                                alpha,
-                                zeta,
-                                ts,
-                                compensate,
-                            ),
-                            discrete_loop::axis(
-                                s.current_loop.method,
-                                'q',
-                                r,
-                                m.q_inductance.value,
-                                alpha,
-                                zeta,
-                                ts,
-                                compensate,
-                            ),
+                            current_loop::design(&request(current_loop::Axis::D, m.d_inductance.value)),
+                            current_loop::design(&request(current_loop::Axis::Q, m.q_inductance.value)),
                         ) else {
                             continue;
                         };

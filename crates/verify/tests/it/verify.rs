@@ -97,7 +97,7 @@ fn doubled_pi_gains_fail_the_rise_time() {
 
 /// chalmers-hev50 with `compensate_delay = false`: α_c·T_s = 0.147, and the sampled loop's
 /// dominant root of z² − z + α_c·T_s (IMC with the delay, hand calculation in
-/// `design::discrete_loop`) is 0.821 ↔ 1973 rad/s, so the step rises in about 1.1 ms, not
+/// `design::current_loop::discrete`) is 0.821 ↔ 1973 rad/s, so the step rises in about 1.1 ms, not
 /// ln 9/1470 = 1.495 ms, and the design warns about it. Without the key (the default
 /// compensation) the step rises in 1.495 ms ± 10 %.
 #[test]

@@ -2,9 +2,7 @@
 
 use std::fmt;
 
-use super::search::{MAX_ATTENUATION_DB, MAX_KAISER_DB};
-use super::validate::MIN_PASS_EDGE_NORMALISED;
-use super::{FMAC_MAX_TAPS, FMAC_MEMORY_WORDS, MIN_ORDER};
+use super::{FMAC_MAX_TAPS, FMAC_MEMORY_WORDS, MAX_ATTENUATION_DB, MAX_KAISER_DB, MIN_ORDER, MIN_PASS_EDGE_NORMALISED};
 
 /// Why no filter was designed; [`FirError::key`] names the spec key to point at.
 ///

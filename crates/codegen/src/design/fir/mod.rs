@@ -49,6 +49,13 @@
 //! 2N + 1 of the 256 words of local memory, so N ≤ 127 ([`FMAC_MAX_TAPS`]).
 //! The bit-level model this module designs for is the firmware's own,
 //! [`motor_control::fir::output`] (the filter checks in the tests run on it).
+//!
+//! # Modules
+//!
+//! In the order they use each other: `error` (why no filter was designed; the limits it
+//! names are the constants of this module), `validate` (the request normalised to
+//! cycles/sample), `response` and `quantise` (measuring and rounding taps), `remez` (the
+//! exchange), `search` (the weight and order searches over the other four).
 
 mod error;
 mod quantise;
@@ -63,7 +70,6 @@ use serde::Serialize;
 
 pub use error::FirError;
 pub use response::magnitude;
-pub use search::{MAX_ATTENUATION_DB, MAX_KAISER_DB};
 
 /// Words of FMAC local memory (RM0440 §17.3.8) [16-bit words].
 pub const FMAC_MEMORY_WORDS: usize = 256;
@@ -77,6 +83,21 @@ pub const Q15_ONE: i32 = 1 << 15;
 pub const GRID_POINTS_PER_TAP: usize = 64;
 /// Upper bound on the Remez runs of the stop-weight search at a given order \[runs\].
 pub const MAX_WEIGHT_EVALUATIONS: usize = 24;
+/// Lowest pass_edge/f_s accepted [cycles/sample]. Below it the pass band (0.01·f_p, f_p)
+/// of the Parks–McClellan exchange is so narrow (its weight (1 − cos ω) ≈ 2π²f² < 2e−11)
+/// that one exchange iteration's extrema search stalls: measured on the thesis-A request
+/// (f_s = 20 kHz, stop_edge 2 kHz, order 20), pass_edge/f_s = 2.5e−7 designs in 0.6 s
+/// (debug build) and 1e−7 runs past 15 s (issue 18). 1e−6 keeps a factor 4 from the
+/// last good point; at it, orders up to 70 and the 60 dB minimum-order search design in
+/// under a second.
+pub const MIN_PASS_EDGE_NORMALISED: f64 = 1e-6;
+/// Kaiser's −10·log10(δ_p·δ_s) \[dB\] above which an order is refused: the equiripple design
+/// would need ripples near 1e−7 and below, where the f64 Remez exchange stalls (seen at
+/// δ_s ≈ 5e−9); Q1.15 rounding caps the attenuation near 90 dB long before.
+pub const MAX_KAISER_DB: f64 = 120.0;
+/// Largest stop-band attenuation accepted in minimum-order mode \[dB\]; Q1.15 rounding
+/// (±2^−16 per tap) leaves a floor near −90 dB.
+pub const MAX_ATTENUATION_DB: f64 = 100.0;
 
 /// How the filter length is chosen.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -6,7 +6,7 @@ use super::quantise::quantise;
 use super::remez::remez_taps;
 use super::response::{Grid, pass_deviation, q15_to_f64, stop_attenuation_db};
 use super::validate::Spec;
-use super::{FMAC_MAX_TAPS, FirDesign, MAX_WEIGHT_EVALUATIONS, MIN_ORDER};
+use super::{FMAC_MAX_TAPS, FirDesign, MAX_ATTENUATION_DB, MAX_KAISER_DB, MAX_WEIGHT_EVALUATIONS, MIN_ORDER};
 
 /// One design at a fixed order and stop weight, quantised, with its quantised pass deviation.
 struct Trial {
@@ -54,13 +54,6 @@ pub(super) fn kaiser_db(spec: &Spec, order: f64) -> f64 {
     14.6 * (spec.fst - spec.fp) * order + 13.0
 }
 
-/// Kaiser's −10·log10(δ_p·δ_s) \[dB\] above which an order is refused: the equiripple design
-/// would need ripples near 1e−7 and below, where the f64 Remez exchange stalls (seen at
-/// δ_s ≈ 5e−9); Q1.15 rounding caps the attenuation near 90 dB long before.
-pub const MAX_KAISER_DB: f64 = 120.0;
-/// Largest stop-band attenuation accepted in minimum-order mode \[dB\]; Q1.15 rounding
-/// (±2^−16 per tap) leaves a floor near −90 dB.
-pub const MAX_ATTENUATION_DB: f64 = 100.0;
 /// Smallest ripple (pass or stop) the weight search lets the exact design aim for [linear].
 const MIN_DESIGN_RIPPLE: f64 = 1e-6;
 

@@ -1,16 +1,7 @@
 //! The request checked and normalised to cycles/sample.
 
 use super::error::FirError;
-use super::{FMAC_MAX_TAPS, FirLength, FirRequest, MIN_ORDER};
-
-/// Lowest pass_edge/f_s accepted [cycles/sample]. Below it the pass band (0.01·f_p, f_p)
-/// of the Parks–McClellan exchange is so narrow (its weight (1 − cos ω) ≈ 2π²f² < 2e−11)
-/// that one exchange iteration's extrema search stalls: measured on the thesis-A request
-/// (f_s = 20 kHz, stop_edge 2 kHz, order 20), pass_edge/f_s = 2.5e−7 designs in 0.6 s
-/// (debug build) and 1e−7 runs past 15 s (issue 18). 1e−6 keeps a factor 4 from the
-/// last good point; at it, orders up to 70 and the 60 dB minimum-order search design in
-/// under a second.
-pub const MIN_PASS_EDGE_NORMALISED: f64 = 1e-6;
+use super::{FMAC_MAX_TAPS, FirLength, FirRequest, MIN_ORDER, MIN_PASS_EDGE_NORMALISED};
 
 /// Validated request in normalised frequency (cycles/sample).
 #[derive(Debug, Clone, Copy)]

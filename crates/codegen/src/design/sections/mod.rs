@@ -1,11 +1,15 @@
-//! The steps of [`super::design`], one per concern: each reads the resolved spec, checks
-//! the design rules of its concern (reporting a violation at the key that caused it) and
-//! returns its section of the [`super::Design`].
+//! The sections of the [`super::Design`], one module each, named after the section it
+//! returns (its key in the JSON form): each reads the resolved spec through [`Context`],
+//! calls the computation modules of `design` (each computing one thing and citing its
+//! equations), checks the design rules of its section (reporting a violation at the key
+//! that caused it) and returns the section.
 //!
-//! The steps run in a fixed order, so diagnostics and warnings keep a stable order.
+//! [`super::design`] runs them in a fixed order, so diagnostics and warnings keep a
+//! stable order; `board` runs last, on the motor's finished design ([`super::on_board`]).
 
 pub(super) mod adc;
 pub(super) mod angle_observer;
+pub(super) mod board;
 pub(super) mod current_loop;
 pub(super) mod drive;
 pub(super) mod field_weakening;
@@ -18,7 +22,7 @@ pub(super) mod sensorless;
 use crate::diagnostic::{Diagnostic, Source};
 use crate::spec::Spec;
 
-/// What every step reads and where it reports.
+/// What every section reads and where it reports.
 pub(super) struct Context<'a> {
     /// The resolved spec.
     pub spec: &'a Spec,

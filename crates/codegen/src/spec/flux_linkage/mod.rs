@@ -2,13 +2,16 @@
 //! speed constant k_n (its reciprocal) or the torque constant K_t (thesis A 2.34), in the
 //! conventions the datasheet states (rms, peak or block commutation; line to line, phase
 //! or winding). Every form the spec gives is kept, so the design can cross-check them.
+//! The conversions themselves, with their derivations, are in [`conversion`].
+
+mod conversion;
 
 use std::ops::Range;
 
 use serde::Serialize;
 
 use super::raw::{Amplitude, Between, Connection, RawMotor, RawParams, SpeedAxis, Val};
-use super::resolve::Resolver_;
+use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
 
@@ -77,7 +80,7 @@ fn voltage_name(a: Amplitude, line_to_line: bool) -> String {
     }
 }
 
-impl Resolver_<'_> {
+impl ResolveContext<'_> {
     /// ψ_M: given, or derived from K_e (preferred: it is ψ_M by definition, 6.11), k_n, or
     /// K_t (2.34); and every source the spec gives, for the design's cross-check.
     pub(super) fn flux(&mut self, m: &RawMotor, np: u32) -> (Option<Param>, Vec<FluxSource>) {
@@ -126,13 +129,7 @@ impl Resolver_<'_> {
                 ),
                 self.line_to_line(&f.key, *k.voltage.get_ref(), k.measured.as_ref(), connection, &f.span),
             ) {
-                let psi = crate::design::flux_linkage::from_back_emf_constant(
-                    v.value,
-                    *k.voltage.get_ref(),
-                    ll,
-                    *k.speed.get_ref(),
-                    np,
-                );
+                let psi = conversion::from_back_emf_constant(v.value, *k.voltage.get_ref(), ll, *k.speed.get_ref(), np);
                 let written = format!(
                     "K_e = {} {} per {} rad/s",
                     text(&k.value),
@@ -156,13 +153,7 @@ impl Resolver_<'_> {
                 self.quantity(&format!("{}.value", f.key), &k.value, Kind::SpeedConstant, f.prov, true),
                 self.line_to_line(&f.key, *k.voltage.get_ref(), k.measured.as_ref(), connection, &f.span),
             ) {
-                let psi = crate::design::flux_linkage::from_back_emf_constant(
-                    1.0 / v.value,
-                    *k.voltage.get_ref(),
-                    ll,
-                    speed,
-                    np,
-                );
+                let psi = conversion::from_back_emf_constant(1.0 / v.value, *k.voltage.get_ref(), ll, speed, np);
                 let written = format!(
                     "k_n = {} per {} volt, K_e = 1/k_n",
                     text(&k.value),
@@ -187,7 +178,7 @@ impl Resolver_<'_> {
                 f.prov,
                 true,
             ) {
-                let psi = crate::design::flux_linkage::from_torque_constant(v.value, *k.current.get_ref(), np);
+                let psi = conversion::from_torque_constant(v.value, *k.current.get_ref(), np);
                 let written = format!(
                     "K_t = {} per {} ampere",
                     text(&k.value),

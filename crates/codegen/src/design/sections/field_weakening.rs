@@ -109,26 +109,17 @@ pub(in crate::design) fn field_weakening(
     let acc_e = f64::from(m.pole_pairs) * acc;
     let allowed = 0.5 * (inp.voltage_max - out.voltage_limit_v);
     let onset = field_weakening::onset_speed(&inp.model, out.voltage_limit_v);
-    let delta = field_weakening::voltage_overshoot(
-        &inp.model,
-        out.voltage_limit_v,
-        onset,
-        out.base_speed_rad_s,
-        acc_e,
-        alpha_fw,
-        lag,
-    );
+    let op = field_weakening::OperatingPoint {
+        voltage_limit_v: out.voltage_limit_v,
+        onset_speed_rad_s: onset,
+        base_speed_rad_s: out.base_speed_rad_s,
+        acceleration_rad_s2: acc_e,
+        current_lag_s: lag,
+    };
+    let delta = field_weakening::voltage_overshoot(&inp.model, &op, alpha_fw);
     out.voltage_overshoot_at_max_acceleration_v = Some(delta);
     if delta > allowed {
-        let need = field_weakening::min_bandwidth_for_overshoot(
-            &inp.model,
-            out.voltage_limit_v,
-            onset,
-            out.base_speed_rad_s,
-            acc_e,
-            lag,
-            allowed,
-        );
+        let need = field_weakening::min_bandwidth_for_overshoot(&inp.model, &op, allowed);
         let a_max = acc * allowed / delta;
         let (span, key, how) = match (rule, &f.speed_loop_bandwidth, mech) {
             (BandwidthRule::SpeedLoop, Some(p), _) => (

@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use super::Context;
+use crate::board::sampling::{settling_multiple, settling_time_constants};
 use crate::design::adc;
 
 /// The ADC settling rule.
@@ -47,8 +48,8 @@ pub(in crate::design) fn adc(cx: &mut Context<'_>) -> AdcOut {
     };
     AdcOut {
         resolution_bits: bits,
-        settling_time_constants: adc::settling_time_constants(bits),
-        settling_multiple: adc::settling_multiple(bits),
+        settling_time_constants: settling_time_constants(bits),
+        settling_multiple: settling_multiple(bits),
         sample_time,
     }
 }

@@ -1,17 +1,20 @@
-//! The current-loop section: both axes' gains, judged on the sampled loop with its 1.5·T_s
-//! delay (poles, margins, overshoot: `design::sampled_loop`; a breach of its floors is an
-//! error at `current_loop.bandwidth` naming the largest bandwidth that meets them), the
-//! bandwidth guidelines of thesis A §5.4.1 (warnings), the hot-winding variant
-//! (thesis B 2.24) and the feed-forward constants (5.3), (2.34).
+//! The current-loop section: both axes through the pipeline of `design::current_loop`,
+//! judged on the sampled loop with its 1.5·T_s delay (poles, margins, overshoot:
+//! `current_loop::analysis`; a breach of its floors is an error at
+//! `current_loop.bandwidth` naming the largest bandwidth that meets them,
+//! `current_loop::bandwidth`), the bandwidth guidelines of thesis A §5.4.1 (warnings), the
+//! hot-winding variant (thesis B 2.24) and the feed-forward constants (5.3), (2.34).
 
 use std::f64::consts::PI;
 
 use serde::Serialize;
 
 use super::Context;
-use crate::design::current_loop::{self, AxisGains, CurrentLoopError};
-use crate::design::discrete_loop::{self, Request};
-use crate::design::sampled_loop::{MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
+use crate::design::current_loop::analysis::{
+    AxisGains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE,
+};
+use crate::design::current_loop::continuous::{self, CurrentLoopError, Promise};
+use crate::design::current_loop::{self, Axis, FIRMWARE_LOOP_DELAY_PERIODS, Request, axis_letter, bandwidth, discrete};
 use crate::design::thermal;
 use crate::diagnostic::{Diagnostic, Source};
 use crate::spec::{Method, Spec};
@@ -46,20 +49,20 @@ pub struct CurrentLoopOut {
     /// (thesis A §5.4.1; a warning, the sampled-loop floors decide).
     pub bandwidth_limit_rad_s: f64,
     /// Designed 10–90 % rise time \[s\]: ln 9/α for first-order loops, the second-order
-    /// step's with ω_n, ζ for pole placement (`design::designed_response`).
+    /// step's with ω_n, ζ for pole placement (`current_loop::continuous`).
     pub rise_time_s: Option<f64>,
     /// 10–90 % rise time \[s\] of the sampled d- and q-axis loops with the 1.5·T_s delay
-    /// (`discrete_loop`).
+    /// (`current_loop::discrete`).
     pub sampled_rise_time_s: Option<[f64; 2]>,
-    /// Each axis designed so that the sampled loop delivers α (`discrete_loop`): on unless
+    /// Each axis designed so that the sampled loop delivers α (`current_loop::discrete`): on unless
     /// the spec sets `compensate_delay = false`.
     pub compensate_delay: bool,
     /// Designed step overshoot (with prefilter for pole placement), fraction.
     pub overshoot: f64,
-    /// The floors every axis's sampled loop meets (`design::sampled_loop`).
+    /// The floors every axis's sampled loop meets (`current_loop::analysis`).
     pub floors: Floors,
     /// Lag of the sampled loop behind a reference ramp \[s\], the larger axis
-    /// (`discrete_loop::ramp_lag`): a current reference moving at di/dt is followed
+    /// (`current_loop::discrete::ramp_lag`): a current reference moving at di/dt is followed
     /// τ_v·di/dt behind.
     pub ramp_lag_s: f64,
     /// d-axis gains.
@@ -74,7 +77,7 @@ pub struct CurrentLoopOut {
     pub feedforward: FeedForward,
 }
 
-/// The sampled-loop floors of `design::sampled_loop`, as applied to this design.
+/// The sampled-loop floors of `current_loop::analysis`, as applied to this design.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Floors {
     /// Smallest phase margin [°].
@@ -116,7 +119,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     let c = &spec.current_loop;
     let fs = cx.switching_frequency();
     let ts = 1.0 / fs;
-    let limit = current_loop::bandwidth_limit(c.method, fs);
+    let limit = continuous::bandwidth_limit(c.method, fs);
     if c.bandwidth.value >= limit {
         let pct = if c.method == Method::PolePlacement { 17 } else { 30 };
         cx.warnings.push(format!(
@@ -126,25 +129,24 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         ));
     }
     let r = m.phase_resistance.value;
-    let gains = axes(spec, r, ts)
+    let requests = requests(spec, r, ts);
+    let gains = axes(&requests)
         .map_err(|e| cx.errors.push(loop_error(&cx.src, spec, e)))
         .ok();
-    let zeta = c.damping.as_ref().map_or(0.0, |d| d.value);
-    let promise = discrete_loop::promise(c.method, c.bandwidth.value, zeta, c.compensate_delay);
+    let promise = Promise::of(&requests[0]);
     let designed_os = promise.overshoot_pct;
     if let Some((gd, gq)) = &gains
         && let Some((axis, breach)) = [('d', gd), ('q', gq)]
             .iter()
             .find_map(|(a, g)| g.sampled.breach(&promise).map(|b| (*a, b)))
     {
-        let req = request(spec, r, ts);
-        let best = discrete_loop::largest_bandwidth(&req, c.bandwidth.value).map(round_down_3);
+        let best = bandwidth::largest_bandwidth(&requests).map(round_down_3);
         let b = &c.bandwidth;
         cx.errors.push(cx.src.error(
             b.span.clone(),
             &b.key,
             format!(
-                "the sampled {axis}-axis loop at α = {:.1} rad/s (f_s = {fs} Hz, 1.5·T_s delay{}) is {breach}; the floors are phase margin ≥ {MIN_PHASE_MARGIN_DEG}°, gain margin ≥ {MIN_GAIN_MARGIN_DB} dB (Åström & Murray §10.3), overshoot ≤ {:.1} % (designed {designed_os:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %){}",
+                "the sampled {axis}-axis loop at α = {:.1} rad/s (f_s = {fs} Hz, {FIRMWARE_LOOP_DELAY_PERIODS}·T_s delay{}) is {breach}; the floors are phase margin ≥ {MIN_PHASE_MARGIN_DEG}°, gain margin ≥ {MIN_GAIN_MARGIN_DB} dB (Åström & Murray §10.3), overshoot ≤ {:.1} % (designed {designed_os:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %){}",
                 b.value,
                 if c.compensate_delay { ", delay-compensated" } else { "" },
                 designed_os + OVERSHOOT_ALLOWANCE_PCT,
@@ -170,7 +172,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         let worst = t[0].min(t[1]);
         if (worst / want - 1.0).abs() > 0.10 {
             cx.warnings.push(format!(
-                "current loop: sampled at f_s = {fs} Hz with the 1.5·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
+                "current loop: sampled at f_s = {fs} Hz with the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
                 worst * 1e3,
                 want * 1e3,
                 if c.compensate_delay {
@@ -185,9 +187,9 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     }
     let hot = hot_variant(cx, r, ts);
     let (d, q) = gains?;
-    let ramp_lag = [(&d, m.d_inductance.value), (&q, m.q_inductance.value)]
+    let ramp_lag = [(&d, &requests[0]), (&q, &requests[1])]
         .iter()
-        .map(|(g, l)| discrete_loop::ramp_lag(&g.loop_gains(), r, *l, ts, g.bandwidth_rad_s))
+        .map(|(g, req)| discrete::ramp_lag(&g.loop_gains(), &discrete::plant(req), g.bandwidth_rad_s))
         .fold(0.0, f64::max);
     let psi = m.flux_linkage.as_ref().map(|p| p.value);
     let kt = psi.map(|p| 1.5 * f64::from(m.pole_pairs) * p);
@@ -198,12 +200,11 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         natural_frequency_rad_s: c
             .damping
             .as_ref()
-            .map(|z| current_loop::natural_frequency(c.bandwidth.value, z.value)),
+            .map(|z| continuous::natural_frequency(c.bandwidth.value, z.value)),
         bandwidth_limit_rad_s: limit,
-        rise_time_s: Some(crate::design::designed_response::designed_rise_time(
+        rise_time_s: Some(continuous::designed_rise_time(
             c.bandwidth.value,
-            (c.method == Method::PolePlacement)
-                .then(|| (current_loop::natural_frequency(c.bandwidth.value, zeta), zeta)),
+            continuous::second_order(&requests[0]),
         )),
         sampled_rise_time_s: sampled_rise,
         compensate_delay: c.compensate_delay,
@@ -229,17 +230,22 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     })
 }
 
-/// The spec's current-loop request with resistance `r` [Ω] at sample period `ts` [s].
-fn request(spec: &Spec, r: f64, ts: f64) -> Request {
+/// The spec's current-loop requests for the d and q axes with resistance `r` \[Ω\] at
+/// sample period `ts` \[s\], with the firmware's loop delay.
+fn requests(spec: &Spec, r: f64, ts: f64) -> [Request; 2] {
     let c = &spec.current_loop;
-    Request {
+    let m = &spec.motor;
+    [(Axis::D, m.d_inductance.value), (Axis::Q, m.q_inductance.value)].map(|(axis, l)| Request {
         method: c.method,
-        r,
-        l: [spec.motor.d_inductance.value, spec.motor.q_inductance.value],
-        zeta: c.damping.as_ref().map_or(0.0, |d| d.value),
-        ts,
-        compensate: c.compensate_delay,
-    }
+        axis,
+        resistance_ohm: r,
+        inductance_h: l,
+        bandwidth_rad_s: c.bandwidth.value,
+        damping: c.damping.as_ref().map_or(0.0, |d| d.value),
+        sample_period_s: ts,
+        loop_delay_s: FIRMWARE_LOOP_DELAY_PERIODS * ts,
+        compensate_delay: c.compensate_delay,
+    })
 }
 
 /// The same gains for R_s at the maximum winding temperature (2.24), if `[thermal]` is given;
@@ -247,11 +253,10 @@ fn request(spec: &Spec, r: f64, ts: f64) -> Request {
 fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
     let t = cx.spec.thermal.as_ref()?;
     let r_hot = thermal::resistance_at(r, t.reference_temperature.value, t.max_winding_temperature.value);
-    match axes(cx.spec, r_hot, ts) {
+    let requests = requests(cx.spec, r_hot, ts);
+    match axes(&requests) {
         Ok((d, q)) => {
-            let c = &cx.spec.current_loop;
-            let zeta = c.damping.as_ref().map_or(0.0, |z| z.value);
-            let promise = discrete_loop::promise(c.method, c.bandwidth.value, zeta, c.compensate_delay);
+            let promise = Promise::of(&requests[0]);
             for (axis, g) in [('d', &d), ('q', &q)] {
                 if let Some(b) = g.sampled.breach(&promise) {
                     cx.warnings.push(format!(
@@ -276,12 +281,9 @@ fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
     }
 }
 
-/// Both axes' gains for resistance `r` [Ω] and sample period `ts` [s].
-fn axes(spec: &Spec, r: f64, ts: f64) -> Result<(AxisGains, AxisGains), CurrentLoopError> {
-    let req = request(spec, r, ts);
-    let alpha = spec.current_loop.bandwidth.value;
-    let axis = |name: char, l: f64| discrete_loop::axis(req.method, name, r, l, alpha, req.zeta, ts, req.compensate);
-    Ok((axis('d', req.l[0])?, axis('q', req.l[1])?))
+/// Both axes through the pipeline (d first).
+fn axes([d, q]: &[Request; 2]) -> Result<(AxisGains, AxisGains), CurrentLoopError> {
+    Ok((current_loop::design(d)?, current_loop::design(q)?))
 }
 
 fn loop_error(src: &Source<'_>, spec: &Spec, e: CurrentLoopError) -> Diagnostic {
@@ -290,13 +292,13 @@ fn loop_error(src: &Source<'_>, spec: &Spec, e: CurrentLoopError) -> Diagnostic 
         CurrentLoopError::RhpZero { axis, min_bandwidth_rad_s } => src.error(
             b.span.clone(),
             &b.key,
-            format!("pole placement at α = {:.4} rad/s puts a right-half-plane zero in the {axis}-axis loop (ω_n·ζ < R/(2L), thesis A §5.4.1)", b.value),
+            format!("pole placement at α = {:.4} rad/s puts a right-half-plane zero in the {}-axis loop (ω_n·ζ < R/(2L), thesis A §5.4.1)", b.value, axis_letter(axis)),
             format!("a bandwidth above {:.1} rad/s, a larger damping, or method = \"imc\"", min_bandwidth_rad_s),
         ),
         CurrentLoopError::NegativeActiveDamping { axis, min_bandwidth_rad_s } => src.error(
             b.span.clone(),
             &b.key,
-            format!("α_c·L < R on the {axis} axis: the active damping R_a = α_c·L − R (thesis B 2.43) would be negative"),
+            format!("α_c·L < R on the {} axis: the active damping R_a = α_c·L − R (thesis B 2.43) would be negative", axis_letter(axis)),
             format!("a bandwidth above R/L = {:.1} rad/s, or method = \"imc\"", min_bandwidth_rad_s),
         ),
     }

@@ -1,8 +1,11 @@
-//! A board with a motor: the ADC-to-SI constants from the board's sensing, the dead
-//! time, trips and bus timing in the units the firmware needs, and the checks that can
-//! only be made with both — a board whose current range is below the motor's peak
-//! current, a DC link above what the divider measures, trips below the motor's
-//! ratings, conversions that take too much of the control period.
+//! The board section (`design.board`), a motor on an inverter board: the ADC-to-SI
+//! constants from the board's sensing (the 16-bit left-aligned codes of thesis A (4.16),
+//! Table 4.1; the sequences' timing of RM0440 §21.4.12), the dead time, trips and bus
+//! timing in the units the firmware needs, and the checks that can only be made with
+//! both — a board whose current range is below the motor's peak current, a DC link above
+//! what the divider measures, trips below the motor's ratings, conversions that take too
+//! much of the control period. It runs on the motor's finished design
+//! ([`crate::design::on_board`]).
 //!
 //! Those are warnings at the board key, not errors: an engineer may well run a large
 //! motor on a small board at reduced current (the firmware trips at the board's levels
@@ -12,7 +15,10 @@
 
 use serde::Serialize;
 
-use super::{Board, Boot0Handling, Polarity, SampleInstant, Signal};
+use crate::board::{
+    ADC_CLOCK_HZ, Board, PinUse, Signal, break_active_high, checks_option_bytes, samples_at_carrier_maximum,
+    sequence_time, warning_at,
+};
 use crate::design::Design;
 
 /// Left-aligned 16-bit ADC codes per volt at the pin, over V_REF+: the firmware shifts
@@ -50,7 +56,7 @@ pub struct BoardOut {
     pub io_afs: [u8; 4],
     /// Injected channels of ADC1 and ADC2, rank order.
     pub adc_channels: [Vec<u8>; 2],
-    /// The signal of each rank ([`signal_code`]).
+    /// The signal of each rank ([`Signal::adc_code`]).
     pub adc_signals: [Vec<u8>; 2],
     /// ADC_SMPR code of each rank.
     pub adc_smp: [Vec<u8>; 2],
@@ -71,21 +77,10 @@ pub struct BoardOut {
     pub warnings: Vec<String>,
 }
 
-/// Worst trigger-to-end time of a converter's sequence: latency 3 ADC cycles (DS12288
-/// Table 66, t_LATRINJ ≤ 3.125 cycles with CKMODE = 0b11) plus, per rank, sampling +
-/// 12.5 conversion cycles (RM0440 §21.4.12: T_CONV = sampling + 12.5 cycles at 12 bits).
-pub fn sequence_time(board: &Board, adc_hz: f64) -> f64 {
-    board
-        .adc
-        .iter()
-        .map(|q| (3.125 + q.iter().map(|s| s.sampling.cycles + 12.5).sum::<f64>()) / adc_hz)
-        .fold(0.0, f64::max)
-}
-
 /// The board with the motor of `d`, and the warnings (each located at its board key).
-pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<String>) {
+pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<String>) {
     let mut warnings = Vec::new();
-    let mut warn = |key: &str, problem: String| warnings.push(super::warning_at(board, board_text, key, &problem));
+    let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
     let i_fs = board.current_full_scale_a();
     let u_fs = board.dc_link_full_scale_v();
     let peak = d.motor.peak_current_a;
@@ -137,7 +132,7 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
             ),
         );
     }
-    let t_conv = sequence_time(board, super::ADC_CLOCK_HZ);
+    let t_conv = sequence_time(board, ADC_CLOCK_HZ);
     let ts = d.drive.sample_period_s;
     if t_conv > 0.25 * ts {
         warn(
@@ -184,7 +179,7 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
         adc_signals: board
             .adc
             .clone()
-            .map(|q| q.iter().map(|x| signal_code(x.signal)).collect()),
+            .map(|q| q.iter().map(|x| x.signal.adc_code()).collect()),
         adc_smp: board
             .adc
             .clone()
@@ -205,37 +200,9 @@ pub fn design(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<Str
 }
 
 fn pin_code(board: &Board, s: Signal) -> u8 {
-    board.pin(s).map_or(u8::MAX, super::PinUse::code)
+    board.pin(s).map_or(u8::MAX, PinUse::code)
 }
 
 fn pin_af(board: &Board, s: Signal) -> u8 {
     board.pin(s).and_then(|p| p.af).unwrap_or(u8::MAX)
-}
-
-/// Codes of the analog signals in the generated ADC sequences (`board::ADCx_SIGNALS`).
-pub fn signal_code(s: Signal) -> u8 {
-    match s {
-        Signal::CurrentU => 0,
-        Signal::CurrentV => 1,
-        Signal::CurrentW => 2,
-        Signal::DcLink => 3,
-        Signal::ResolverSin => 4,
-        Signal::ResolverCos => 5,
-        _ => u8::MAX,
-    }
-}
-
-/// Whether the image must check the BOOT0 option bytes at start-up.
-pub fn checks_option_bytes(board: &Board) -> bool {
-    board.boot0 == Some(Boot0Handling::OptionBytes)
-}
-
-/// The break input's polarity as TIM1_BDTR.BKP (1 = active high, RM0440 §29.6.20).
-pub fn break_active_high(board: &Board) -> bool {
-    board.break_polarity == Polarity::ActiveHigh
-}
-
-/// Whether the currents are sampled at the carrier maximum (low-side pulse centre).
-pub fn samples_at_carrier_maximum(board: &Board) -> bool {
-    board.sample_instant == SampleInstant::LowSideCentre
 }

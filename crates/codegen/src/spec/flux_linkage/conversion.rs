@@ -1,4 +1,5 @@
-//! PM flux linkage ψ_M from datasheet motor constants.
+//! PM flux linkage ψ_M from datasheet motor constants: the unit conversions the spec
+//! applies when it derives ψ_M (below the design, which reads the derived value).
 //!
 //! Thesis A (2.34): T_e = 3/2·n_p·ψ_M·i_q with i_q the peak phase current of the
 //! amplitude-invariant transform, so K_t = 3/2·n_p·ψ_M per peak ampere. Thesis A

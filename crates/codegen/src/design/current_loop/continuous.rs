@@ -1,4 +1,5 @@
-//! Current-loop PI design per axis for the plant M(s) = 1/(Ls + R) (thesis A 5.5).
+//! Stage 1 of the current-loop pipeline ([`super`]): the continuous design rules per
+//! axis for the plant M(s) = 1/(Ls + R) (thesis A 5.5), and what they promise.
 //!
 //! * `imc` — first-order IMC, thesis A (5.8), (5.9): K_a = L·α, K_b = R/L.
 //! * `pole_placement` — thesis A (5.14), (5.15): K_i = L·ω_n², K_p = 2ζω_n·L − R,
@@ -7,10 +8,15 @@
 //!   R_a = α_c·L − R, k_i = α_c·(R + R_a).
 //!
 //! Parallel (K_p, K_i) and series (K_a, K_b) forms are related by (5.7).
+//!
+//! The designed closed-loop step of each method ([`designed_step`]) is the response the
+//! user asks for: the sampled loop is judged against it ([`Promise`], [`super::analysis`])
+//! and the simulation compared with it (`motor-verify`).
 
+use motor_control::commissioning::Axis;
 use serde::Serialize;
 
-use super::sampled_loop::{self, LoopGains, SampledLoop};
+use super::Request;
 use crate::spec::Method;
 
 /// Guideline of thesis A §5.4.1: first-order loops below 30 % of f_s.
@@ -29,56 +35,8 @@ pub struct Prefilter {
     pub discrete_coefficient: f64,
 }
 
-/// PI gains for one axis.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct AxisGains {
-    /// Parallel proportional gain K_p [V/A] (5.6a).
-    pub kp: f64,
-    /// Parallel integral gain K_i [V/(A·s)] (5.6a).
-    pub ki: f64,
-    /// Series gain K_a = K_p [V/A] (5.7).
-    pub ka: f64,
-    /// Series zero K_b = K_i/K_p [rad/s] (5.7).
-    pub kb: f64,
-    /// Active damping (virtual resistance) R_a \[Ω\], thesis B (2.43); 0 for the other methods.
-    pub active_damping_ohm: f64,
-    /// Back-calculation anti-windup gain 1/k_p [A/(V·s)·s] of thesis B (2.49).
-    pub anti_windup_gain: f64,
-    /// Discrete integral gain K_i·T_s [V/A] for the forward-difference integrator (4.17b).
-    pub ki_ts: f64,
-    /// Reference prefilter (pole placement only).
-    pub prefilter: Option<Prefilter>,
-    /// Coefficient a of the reference filter y += a·(x − y) the controller runs: the
-    /// prefilter's (5.16), or 1 (the reference passes unfiltered) without one.
-    pub reference_filter: f64,
-    /// Designed closed-loop poles, real and imaginary parts [rad/s].
-    pub designed_poles: Vec<[f64; 2]>,
-    /// The bandwidth α these gains were designed for [rad/s]: the spec's, or the lower
-    /// delay-compensated one of the first-order methods (`design::discrete_loop`).
-    pub bandwidth_rad_s: f64,
-    /// The sampled loop with these gains: poles, margins, overshoot
-    /// ([`sampled_loop`], 1.5·T_s delay).
-    #[serde(flatten)]
-    pub sampled: SampledLoop,
-}
-
-impl AxisGains {
-    /// The gains as the sampled loop sees them.
-    pub fn loop_gains(&self) -> LoopGains {
-        loop_gains(self.kp, self.ki, self.active_damping_ohm, self.prefilter.as_ref())
-    }
-}
-
-fn loop_gains(kp: f64, ki: f64, active_damping: f64, prefilter: Option<&Prefilter>) -> LoopGains {
-    LoopGains {
-        kp,
-        ki,
-        active_damping,
-        prefilter: prefilter.map_or(1.0, |p| p.discrete_coefficient),
-    }
-}
-
-/// One axis's PI before the sampled-loop analysis (what the design methods produce).
+/// One axis's PI before the sampled-loop analysis: what the design rules of this stage
+/// and of [`super::discrete`] produce, completed by [`super::analysis::finish`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Pi {
     /// K_p [V/A].
@@ -95,47 +53,20 @@ pub struct Pi {
     pub bandwidth_rad_s: f64,
 }
 
-impl Pi {
-    /// The gains as the sampled loop sees them.
-    pub fn loop_gains(&self) -> LoopGains {
-        loop_gains(self.kp, self.ki, self.active_damping_ohm, self.prefilter.as_ref())
-    }
-
-    /// Series form, anti-windup, K_i·T_s and the sampled-loop figures for the plant
-    /// `r` \[Ω\], `l` \[H\] at `ts` \[s\].
-    pub fn finish(self, r: f64, l: f64, ts: f64) -> AxisGains {
-        let sampled = sampled_loop::analyse(&self.loop_gains(), r, l, ts);
-        AxisGains {
-            kp: self.kp,
-            ki: self.ki,
-            ka: self.kp,
-            kb: self.ki / self.kp,
-            active_damping_ohm: self.active_damping_ohm,
-            anti_windup_gain: 1.0 / self.kp,
-            ki_ts: self.ki * ts,
-            reference_filter: self.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient),
-            prefilter: self.prefilter,
-            designed_poles: self.designed_poles,
-            bandwidth_rad_s: self.bandwidth_rad_s,
-            sampled,
-        }
-    }
-}
-
 /// Why a current-loop design is refused.
 #[derive(Debug, Clone, PartialEq)]
 pub enum CurrentLoopError {
     /// ω_n·ζ < R/(2L): the closed loop gets a right-half-plane zero (thesis A §5.4.1).
     RhpZero {
         /// Which axis.
-        axis: char,
+        axis: Axis,
         /// Smallest bandwidth α [rad/s] that avoids it.
         min_bandwidth_rad_s: f64,
     },
     /// α_c·L < R: the active damping (2.43) would be negative.
     NegativeActiveDamping {
         /// Which axis.
-        axis: char,
+        axis: Axis,
         /// Smallest bandwidth α_c = R/L [rad/s] that avoids it.
         min_bandwidth_rad_s: f64,
     },
@@ -156,32 +87,18 @@ pub fn overshoot(zeta: f64) -> f64 {
     }
 }
 
-/// Designs one axis with resistance `r` \[Ω\], inductance `l` \[H\], bandwidth `alpha` [rad/s],
-/// damping `zeta` (pole placement), sample period `ts` \[s\], by the continuous rules of the
-/// module documentation, and analyses it on the sampled loop.
-pub fn design_axis(
-    method: Method,
-    axis: char,
-    r: f64,
-    l: f64,
-    alpha: f64,
-    zeta: f64,
-    ts: f64,
-) -> Result<AxisGains, CurrentLoopError> {
-    continuous(method, axis, r, l, alpha, zeta, ts).map(|pi| pi.finish(r, l, ts))
-}
-
-/// The continuous design rules of the module documentation (no sampled-loop analysis).
-pub fn continuous(
-    method: Method,
-    axis: char,
-    r: f64,
-    l: f64,
-    alpha: f64,
-    zeta: f64,
-    ts: f64,
-) -> Result<Pi, CurrentLoopError> {
-    let (kp, ki, ra, prefilter, poles) = match method {
+/// The continuous design rules of the module documentation for `req` (its method, axis,
+/// R, L, α, ζ; T_s for the prefilter's discrete coefficient).
+pub fn design(req: &Request) -> Result<Pi, CurrentLoopError> {
+    let (axis, r, l, alpha, zeta, ts) = (
+        req.axis,
+        req.resistance_ohm,
+        req.inductance_h,
+        req.bandwidth_rad_s,
+        req.damping,
+        req.sample_period_s,
+    );
+    let (kp, ki, ra, prefilter, poles) = match req.method {
         Method::Imc => {
             let ka = l * alpha; // (5.9)
             let kb = r / l;
@@ -253,9 +170,92 @@ pub fn bandwidth_limit(method: Method, fs: f64) -> f64 {
     2.0 * std::f64::consts::PI * fraction * fs
 }
 
+/// The method's designed step overshoot [%]: 0 for the first-order methods (thesis A
+/// (5.8), thesis B (2.41)), e^(−πζ/√(1−ζ²)) for pole placement (thesis A §5.4.1).
+pub fn designed_overshoot_pct(method: Method, zeta: f64) -> f64 {
+    match method {
+        Method::PolePlacement => 100.0 * overshoot(zeta),
+        _ => 0.0,
+    }
+}
+
+/// (ω_n of (5.15), ζ) of `req`'s designed step for pole placement; `None` for the
+/// first-order methods.
+pub fn second_order(req: &Request) -> Option<(f64, f64)> {
+    (req.method == Method::PolePlacement).then(|| (natural_frequency(req.bandwidth_rad_s, req.damping), req.damping))
+}
+
+/// What the method designs the step to do: the reference of the overshoot and rise floors
+/// of [`super::analysis`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Promise {
+    /// Designed overshoot [%].
+    pub overshoot_pct: f64,
+    /// Designed 10–90 % rise time \[s\], when the design promises it (delay compensation).
+    pub rise_time_s: Option<f64>,
+}
+
+impl Promise {
+    /// What `req`'s method designs at its bandwidth (damping ζ for pole placement): its
+    /// overshoot, and with `compensate_delay` its rise time, ln 9/α (thesis A (5.8)) or the
+    /// second-order step's with ω_n of (5.15) ([`designed_rise_time`]).
+    pub fn of(req: &Request) -> Promise {
+        Promise {
+            overshoot_pct: designed_overshoot_pct(req.method, req.damping),
+            rise_time_s: req
+                .compensate_delay
+                .then(|| designed_rise_time(req.bandwidth_rad_s, second_order(req))),
+        }
+    }
+}
+
+/// Unit step response of the designed closed loop at `t` \[s\]: first order
+/// `1 − e^(−αt)` (thesis A (5.8), thesis B (2.41)) when `zeta` is `None`, else the
+/// second-order system of thesis A (4.14) with ω_n, ζ (the prefilter (5.16) having
+/// cancelled the zero).
+pub fn designed_step(t: f64, alpha: f64, second_order: Option<(f64, f64)>) -> f64 {
+    match second_order {
+        None => 1.0 - (-alpha * t).exp(),
+        Some((wn, zeta)) if zeta < 1.0 => {
+            let wd = wn * (1.0 - zeta * zeta).sqrt();
+            1.0 - (-zeta * wn * t).exp() * ((wd * t).cos() + zeta / (1.0 - zeta * zeta).sqrt() * (wd * t).sin())
+        }
+        Some((wn, 1.0)) => 1.0 - (-wn * t).exp() * (1.0 + wn * t),
+        Some((wn, zeta)) => {
+            let r = (zeta * zeta - 1.0).sqrt();
+            let (p1, p2) = (wn * (zeta - r), wn * (zeta + r));
+            1.0 - (p2 * (-p1 * t).exp() - p1 * (-p2 * t).exp()) / (p2 - p1)
+        }
+    }
+}
+
+/// 10–90 % rise time of [`designed_step`] \[s\], found on a grid of 1/(2000·α).
+pub fn designed_rise_time(alpha: f64, second_order: Option<(f64, f64)>) -> f64 {
+    let dt = 1.0 / (2000.0 * alpha);
+    let y: Vec<f64> = (0..40_000)
+        .map(|k| designed_step(k as f64 * dt, alpha, second_order))
+        .collect();
+    rise_time(&y, dt).unwrap_or(f64::NAN)
+}
+
+/// First time [s] at which `y` (sampled every `dt`) reaches `level`, linearly interpolated.
+fn crossing(y: &[f64], dt: f64, level: f64) -> Option<f64> {
+    y.windows(2)
+        .enumerate()
+        .find_map(|(k, w)| (w[0] < level && w[1] >= level).then(|| (k as f64 + (level - w[0]) / (w[1] - w[0])) * dt))
+}
+
+/// 10–90 % rise time \[s\] of a unit step response sampled every `dt`; `None` if it never
+/// reaches 90 %.
+pub fn rise_time(y: &[f64], dt: f64) -> Option<f64> {
+    Some(crossing(y, dt, 0.9)? - crossing(y, dt, 0.1)?)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::design::current_loop::analysis::AxisGains;
+    use crate::design::current_loop::{design as pipeline, test_request};
     use nalgebra::{Complex, Matrix2};
     use proptest::prelude::*;
 
@@ -281,7 +281,7 @@ mod tests {
     /// K_i = K_a·K_b = 0.65·100 = 65 V/(A·s).
     #[test]
     fn unimotor_imc_d_axis() {
-        let g = design_axis(Method::Imc, 'd', 0.65, 5.4e-3, 100.0, 0.0, 5e-5).unwrap();
+        let g = pipeline(&test_request(Method::Imc, 0.65, 5.4e-3, 100.0, 0.0, 5e-5)).unwrap();
         assert!((g.ka - 0.54).abs() < 1e-12);
         assert!((g.kb - 120.370_370).abs() < 1e-5);
         assert!((g.ki - 65.0).abs() < 1e-9);
@@ -293,7 +293,11 @@ mod tests {
     fn unimotor_pole_placement_q_axis() {
         let z = std::f64::consts::FRAC_1_SQRT_2;
         assert!((natural_frequency(100.0, z) - 100.0).abs() < 1e-9);
-        let g = design_axis(Method::PolePlacement, 'q', 0.65, 7.6e-3, 100.0, z, 5e-5).unwrap();
+        let g = pipeline(&Request {
+            axis: Axis::Q,
+            ..test_request(Method::PolePlacement, 0.65, 7.6e-3, 100.0, z, 5e-5)
+        })
+        .unwrap();
         assert!((g.ki - 76.0).abs() < 1e-9);
         assert!((g.kp - 0.424_802_5).abs() < 1e-6, "{}", g.kp);
         let pre = g.prefilter.unwrap();
@@ -307,13 +311,13 @@ mod tests {
     #[test]
     fn fischer_pole_placement_at_100_rad_s_has_rhp_zero() {
         let z = std::f64::consts::FRAC_1_SQRT_2;
-        match design_axis(Method::PolePlacement, 'd', 0.126, 0.393e-3, 100.0, z, 5e-5) {
+        match pipeline(&test_request(Method::PolePlacement, 0.126, 0.393e-3, 100.0, z, 5e-5)) {
             Err(CurrentLoopError::RhpZero {
                 min_bandwidth_rad_s, ..
             }) => assert!((min_bandwidth_rad_s - 226.7).abs() < 0.1, "{min_bandwidth_rad_s}"),
             other => panic!("expected RHP zero, got {other:?}"),
         }
-        assert!(design_axis(Method::PolePlacement, 'd', 0.126, 0.393e-3, 226.8, z, 5e-5).is_ok());
+        assert!(pipeline(&test_request(Method::PolePlacement, 0.126, 0.393e-3, 226.8, z, 5e-5)).is_ok());
     }
 
     /// Thesis B: α_c = 1.17 pu ⇔ rise time 1.5 ms with ω_base = 2π·200 Hz: ln 9/(1.17·1256.64) = 1.494 ms.
@@ -322,7 +326,15 @@ mod tests {
     fn thesis_b_active_damping() {
         let alpha = 1.17 * 2.0 * std::f64::consts::PI * 200.0;
         assert!((9f64.ln() / alpha - 1.5e-3).abs() < 0.01e-3);
-        let g = design_axis(Method::ImcActiveDamping, 'd', 7.9e-3, 0.23e-3, alpha, 0.0, 1e-4).unwrap();
+        let g = pipeline(&test_request(
+            Method::ImcActiveDamping,
+            7.9e-3,
+            0.23e-3,
+            alpha,
+            0.0,
+            1e-4,
+        ))
+        .unwrap();
         assert!((g.active_damping_ohm - (alpha * 0.23e-3 - 7.9e-3)).abs() < 1e-12);
         assert!((g.ki - alpha * alpha * 0.23e-3).abs() < 1e-9); // α(R + αL − R) = α²L
     }
@@ -343,12 +355,35 @@ mod tests {
             let alpha = alpha_over_rl * r / l; // above R/L so every method is feasible
             let alpha = alpha.max(2.0 * r / l / zeta);
             for m in [Method::Imc, Method::ImcActiveDamping, Method::PolePlacement] {
-                let g = design_axis(m, 'd', r, l, alpha, zeta, 1e-4).unwrap();
+                let g = pipeline(&test_request(m, r, l, alpha, zeta, 1e-4)).unwrap();
                 let got = closed_loop_poles(r, l, &g);
                 // Double poles (active damping) are ill-conditioned: tolerance ~sqrt(eps).
                 let tol = if m == Method::ImcActiveDamping { 1e-6 } else { 1e-9 };
                 prop_assert!(same_poles(got.clone(), &g.designed_poles, tol), "{m:?}: {got:?} vs {:?}", g.designed_poles);
             }
         }
+    }
+
+    /// ln 9/α for a first-order loop (thesis A (5.8)): α = 100 rad/s → 21.97 ms.
+    #[test]
+    fn first_order_rise_time_is_ln9_over_alpha() {
+        let t = designed_rise_time(100.0, None);
+        assert!((t - 9f64.ln() / 100.0).abs() < 1e-5, "{t}");
+    }
+
+    /// ζ = 1/√2: the 10–90 % rise time from the usual empirical fit
+    /// ω_n·t_r ≈ 1 − 0.4167·ζ + 2.917·ζ² = 1 − 0.2947 + 1.4585 = 2.164 (good to about
+    /// 1 % for 0.3 < ζ < 0.8), and the peak e^(−π) = 4.32 % above 1 (thesis A §5.4.1).
+    #[test]
+    fn second_order_figures() {
+        let z = std::f64::consts::FRAC_1_SQRT_2;
+        let t = designed_rise_time(1.0, Some((1.0, z)));
+        assert!((t - 2.164).abs() < 0.03, "{t}");
+        let dt = 1e-3;
+        let y: Vec<f64> = (0..20_000)
+            .map(|k| designed_step(k as f64 * dt, 1.0, Some((1.0, z))))
+            .collect();
+        let peak = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+        assert!((peak - 1.0 - (-std::f64::consts::PI).exp()).abs() < 1e-5, "{peak}");
     }
 }

@@ -1,7 +1,8 @@
-//! Stability figures of one current-loop axis as the firmware samples it: closed-loop
-//! poles, gain and phase margin, step overshoot and rise time of the discrete model that
-//! [`super::discrete_loop`] documents (ZOH plant, one period of computation delay,
-//! forward-difference PI, active damping, prefilter).
+//! Stage 3 of the current-loop pipeline ([`super`]): the figures of one axis as the
+//! firmware samples it — closed-loop poles, gain and phase margin, step overshoot and rise
+//! time of the discrete model that [`super::discrete`] documents (ZOH plant, one period of
+//! computation delay, forward-difference PI, active damping, prefilter) — and the floors
+//! they must meet. [`finish`] turns a stage-2 design into the axis's [`AxisGains`].
 //!
 //! # The loop
 //!
@@ -28,7 +29,7 @@
 //! found as the eigenvalues of the companion matrix (nalgebra). The reference reaches
 //! the current through `T(z) = F(z)·P(z)·C(z)/(1 + L(z))` with the prefilter
 //! `F(z) = c·z/(z − (1 − c))` (5.16); the overshoot and rise time are read off its
-//! simulated step ([`super::discrete_loop::step_response`]).
+//! simulated step ([`super::discrete::step_response`]).
 //!
 //! # Margins
 //!
@@ -64,6 +65,10 @@ use std::f64::consts::PI;
 use nalgebra::{Complex, Matrix3};
 use serde::Serialize;
 
+use super::Request;
+use super::continuous::{Pi, Prefilter, Promise, rise_time};
+use super::discrete::{LoopGains, MODELLED_DELAY_PERIODS, SampledPlant, step_response};
+
 /// Smallest accepted phase margin [°] (Åström & Murray §10.3: 30°–60° typical).
 pub const MIN_PHASE_MARGIN_DEG: f64 = 45.0;
 /// Smallest accepted gain margin \[dB\]: a factor 2 (Åström & Murray §10.3: 2–5 typical).
@@ -73,51 +78,6 @@ pub const OVERSHOOT_ALLOWANCE_PCT: f64 = 2.0;
 /// Largest accepted relative deviation of the sampled rise time from the designed one
 /// (with `compensate_delay`).
 pub const RISE_TOLERANCE: f64 = 0.10;
-
-/// What the method designs the step to do: the reference of the overshoot and rise floors.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Promise {
-    /// Designed overshoot [%].
-    pub overshoot_pct: f64,
-    /// Designed 10–90 % rise time \[s\], when the design promises it (delay compensation).
-    pub rise_time_s: Option<f64>,
-}
-
-/// The gains of one axis as the sampled loop sees them.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct LoopGains {
-    /// k_p [V/A].
-    pub kp: f64,
-    /// k_i [V/(A·s)].
-    pub ki: f64,
-    /// R_a \[Ω\] (0 without active damping).
-    pub active_damping: f64,
-    /// Prefilter coefficient c of r_f += c·(r − r_f) (1: no prefilter).
-    pub prefilter: f64,
-}
-
-/// The plant 1/(Ls + R) sampled with a ZOH at T_s.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct SampledPlant {
-    /// a = e^(−R·T_s/L).
-    pub a: f64,
-    /// b = (1 − a)/R [A/V].
-    pub b: f64,
-    /// T_s \[s\].
-    pub ts: f64,
-}
-
-impl SampledPlant {
-    /// The ZOH equivalent of 1/(Ls + R) at sample period `ts`.
-    pub fn new(r: f64, l: f64, ts: f64) -> Self {
-        let x = -r * ts / l;
-        Self {
-            a: x.exp(),
-            b: -x.exp_m1() / r,
-            ts,
-        }
-    }
-}
 
 /// The sampled loop's figures for one axis (all with the 1.5·T_s delay).
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -210,7 +170,7 @@ impl SampledLoop {
     pub fn describe(&self) -> String {
         let opt = |x: Option<f64>, unit: &str, none: &str| x.map_or(none.to_string(), |v| format!("{v:.1}{unit}"));
         format!(
-            "sampled loop (1.5·T_s delay): phase margin {}, gain margin {}, step overshoot {}, poles |z| ≤ {:.3}",
+            "sampled loop ({MODELLED_DELAY_PERIODS}·T_s delay): phase margin {}, gain margin {}, step overshoot {}, poles |z| ≤ {:.3}",
             opt(self.phase_margin_deg, "°", "∞"),
             opt(self.gain_margin_db, " dB", "∞"),
             opt(self.overshoot_pct, " %", "— (unstable)"),
@@ -364,20 +324,16 @@ fn step_length(radius: f64) -> usize {
     ((1e-4f64).ln() / radius.ln()).ceil().clamp(200.0, 400_000.0) as usize
 }
 
-/// The figures of one axis with gains `g`, resistance `r` \[Ω\], inductance `l` \[H\],
-/// sample period `ts` \[s\].
-pub fn analyse(g: &LoopGains, r: f64, l: f64, ts: f64) -> SampledLoop {
-    let p = SampledPlant::new(r, l, ts);
-    let poles = cubic_roots(characteristic(g, &p));
+/// The figures of one axis with gains `g` on plant `p`.
+pub fn analyse(g: &LoopGains, p: &SampledPlant) -> SampledLoop {
+    let ts = p.ts;
+    let poles = cubic_roots(characteristic(g, p));
     let radius = poles.iter().map(|z| z.norm()).fold(0.0, f64::max);
-    let (gm, pm) = margins(g, &p);
+    let (gm, pm) = margins(g, p);
     let (overshoot, rise) = if radius < 1.0 {
-        let y = super::discrete_loop::step_response(g, r, l, ts, step_length(radius));
+        let y = step_response(g, p, step_length(radius));
         let peak = y.iter().copied().fold(f64::NEG_INFINITY, f64::max);
-        (
-            Some(100.0 * (peak - 1.0).max(0.0)),
-            super::discrete_loop::rise_time(&y, ts),
-        )
+        (Some(100.0 * (peak - 1.0).max(0.0)), rise_time(&y, ts))
     } else {
         (None, None)
     };
@@ -397,6 +353,72 @@ pub fn analyse(g: &LoopGains, r: f64, l: f64, ts: f64) -> SampledLoop {
     }
 }
 
+/// PI gains for one axis.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct AxisGains {
+    /// Parallel proportional gain K_p [V/A] (5.6a).
+    pub kp: f64,
+    /// Parallel integral gain K_i [V/(A·s)] (5.6a).
+    pub ki: f64,
+    /// Series gain K_a = K_p [V/A] (5.7).
+    pub ka: f64,
+    /// Series zero K_b = K_i/K_p [rad/s] (5.7).
+    pub kb: f64,
+    /// Active damping (virtual resistance) R_a \[Ω\], thesis B (2.43); 0 for the other methods.
+    pub active_damping_ohm: f64,
+    /// Back-calculation anti-windup gain 1/k_p [A/(V·s)·s] of thesis B (2.49).
+    pub anti_windup_gain: f64,
+    /// Discrete integral gain K_i·T_s [V/A] for the forward-difference integrator (4.17b).
+    pub ki_ts: f64,
+    /// Reference prefilter (pole placement only).
+    pub prefilter: Option<Prefilter>,
+    /// Coefficient a of the reference filter y += a·(x − y) the controller runs: the
+    /// prefilter's (5.16), or 1 (the reference passes unfiltered) without one.
+    pub reference_filter: f64,
+    /// Designed closed-loop poles, real and imaginary parts [rad/s].
+    pub designed_poles: Vec<[f64; 2]>,
+    /// The bandwidth α these gains were designed for [rad/s]: the spec's, or the lower
+    /// delay-compensated one of the first-order methods ([`super::discrete`]).
+    pub bandwidth_rad_s: f64,
+    /// The sampled loop with these gains: poles, margins, overshoot ([`analyse`], 1.5·T_s
+    /// delay).
+    #[serde(flatten)]
+    pub sampled: SampledLoop,
+}
+
+impl AxisGains {
+    /// The gains as the sampled loop sees them.
+    pub fn loop_gains(&self) -> LoopGains {
+        LoopGains {
+            kp: self.kp,
+            ki: self.ki,
+            active_damping: self.active_damping_ohm,
+            prefilter: self.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient),
+        }
+    }
+}
+
+/// `req`'s axis with the stage-2 gains `pi`: the series form (5.7), the anti-windup gain
+/// (thesis B (2.49)), K_i·T_s (4.17b) and the sampled loop's figures ([`analyse`]).
+pub fn finish(pi: Pi, req: &Request) -> AxisGains {
+    let ts = req.sample_period_s;
+    let sampled = analyse(&LoopGains::of(&pi), &super::discrete::plant(req));
+    AxisGains {
+        kp: pi.kp,
+        ki: pi.ki,
+        ka: pi.kp,
+        kb: pi.ki / pi.kp,
+        active_damping_ohm: pi.active_damping_ohm,
+        anti_windup_gain: 1.0 / pi.kp,
+        ki_ts: pi.ki * ts,
+        reference_filter: pi.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient),
+        prefilter: pi.prefilter,
+        designed_poles: pi.designed_poles,
+        bandwidth_rad_s: pi.bandwidth_rad_s,
+        sampled,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -408,7 +430,7 @@ mod tests {
     };
 
     /// Gains whose PI zero 1 − k_i·T_s/k_p sits exactly on the plant pole a: then
-    /// L(z) = K/(z(z − 1)) with K = b·k_p (the IMC loop of `discrete_loop` with perfect
+    /// L(z) = K/(z(z − 1)) with K = b·k_p (the IMC loop of `discrete` with perfect
     /// cancellation).
     fn cancelling(r: f64, l: f64, ts: f64, k: f64) -> LoopGains {
         let p = SampledPlant::new(r, l, ts);
@@ -435,7 +457,7 @@ mod tests {
         let (r, l, ts) = (0.126, 0.393e-3, 5e-5); // Fischer, 20 kHz
         for k in [0.05, 0.2, 0.35, 0.5, 0.9] {
             let g = cancelling(r, l, ts, k);
-            let s = analyse(&g, r, l, ts);
+            let s = analyse(&g, &SampledPlant::new(r, l, ts));
             let gm = -20.0 * f64::log10(k);
             let pm = 90.0 - 3.0 * (k / 2.0).asin().to_degrees();
             assert!(
@@ -454,7 +476,7 @@ mod tests {
             assert!((s.gain_crossover_rad_s.unwrap() / wc - 1.0).abs() < 1e-9);
         }
         let g = cancelling(r, l, ts, 0.2);
-        let s = analyse(&g, r, l, ts);
+        let s = analyse(&g, &SampledPlant::new(r, l, ts));
         let a = (-r * ts / l).exp();
         let want = [0.5 + 0.2f64.sqrt() / 2.0 * 1.0, a, 0.5 - 0.2f64.sqrt() / 2.0];
         let mut got: Vec<f64> = s.poles.iter().map(|p| p[0]).collect();
@@ -472,14 +494,14 @@ mod tests {
     #[test]
     fn stability_boundary_at_k_equal_one() {
         let (r, l, ts) = (0.126, 0.393e-3, 5e-5);
-        let s = analyse(&cancelling(r, l, ts, 0.999), r, l, ts);
+        let s = analyse(&cancelling(r, l, ts, 0.999), &SampledPlant::new(r, l, ts));
         assert!(
             s.spectral_radius < 1.0 && s.spectral_radius > 0.999,
             "{}",
             s.spectral_radius
         );
         assert!(s.gain_margin_db.unwrap() > 0.0);
-        let s = analyse(&cancelling(r, l, ts, 1.05), r, l, ts);
+        let s = analyse(&cancelling(r, l, ts, 1.05), &SampledPlant::new(r, l, ts));
         assert!(s.spectral_radius > 1.0);
         assert!(s.gain_margin_db.unwrap() < 0.0);
         assert_eq!(s.overshoot_pct, None);
@@ -492,12 +514,12 @@ mod tests {
     #[test]
     fn overshoot_of_the_cancelled_loop_by_hand() {
         let (r, l, ts) = (0.126, 0.393e-3, 5e-5);
-        let s = analyse(&cancelling(r, l, ts, 0.5), r, l, ts);
+        let s = analyse(&cancelling(r, l, ts, 0.5), &SampledPlant::new(r, l, ts));
         // The plant pole is cancelled to rounding only; the residue is below 1e-6.
         assert!((s.overshoot_pct.unwrap() - 25.0).abs() < 1e-3, "{:?}", s.overshoot_pct);
         assert!(matches!(s.breach(&FIRST_ORDER), Some(FloorBreach::Overshoot { .. })));
         // K = 0.25: double root 1/2, monotonic step.
-        let s = analyse(&cancelling(r, l, ts, 0.25), r, l, ts);
+        let s = analyse(&cancelling(r, l, ts, 0.25), &SampledPlant::new(r, l, ts));
         assert!(s.overshoot_pct.unwrap() < 1e-6, "{:?}", s.overshoot_pct);
         assert_eq!(s.breach(&FIRST_ORDER), None);
     }
@@ -506,7 +528,7 @@ mod tests {
     #[test]
     fn s_plane_equivalents_invert_the_z_map() {
         let (r, l, ts) = (0.126, 0.393e-3, 5e-5);
-        let s = analyse(&cancelling(r, l, ts, 0.2), r, l, ts);
+        let s = analyse(&cancelling(r, l, ts, 0.2), &SampledPlant::new(r, l, ts));
         for (z, sp) in s.poles.iter().zip(&s.poles_s_rad_s) {
             let sp = sp.unwrap();
             let back = Complex::new(sp[0] * ts, sp[1] * ts).exp();
