@@ -92,7 +92,7 @@ impl<'a> OnBoard<'a> {
             formula: Lit("f_ADC the sampling codes are chosen for: HCLK/4"),
             equation: Lit("RM0440 §21.4.3"),
             inputs: Lit("the firmware's clock tree"),
-            json: Json::At("/board/adc_clock_hz"),
+            json: Json::None,
         },
         Decl {
             name: "CURRENT_OFFSET_CODE",
