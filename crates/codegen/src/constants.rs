@@ -385,6 +385,8 @@ fn fs_input(d: &Design) -> String {
 
 #[cfg(test)]
 mod tests {
+    use std::collections::HashSet;
+
     use super::*;
 
     #[test]
@@ -412,5 +414,70 @@ mod tests {
         assert_eq!(q31v(1 << 30).c_expr, "INT32_C(1073741824)");
         assert_eq!(intv(12, "u8", "uint8_t").c_expr, "UINT8_C(12)");
         assert_eq!(i16_array(&[1, -2]).c_len, Some(2));
+    }
+
+    /// The number(s) of a JSON value, null read as 0 (as the constants document).
+    fn numbers(v: &serde_json::Value) -> Vec<f64> {
+        match v {
+            serde_json::Value::Array(a) => a.iter().flat_map(numbers).collect(),
+            serde_json::Value::Null => vec![0.0],
+            x => vec![x.as_f64().unwrap_or_else(|| panic!("{x} is not a number"))],
+        }
+    }
+
+    /// Every declared constant of every motor, alone and on every board, has a
+    /// SCREAMING_SNAKE_CASE name unique in its group and a JSON pointer to the same value in
+    /// the JSON design; only the firmware's fixed choices, which the design does not compute
+    /// — the CAN protocol, the commissioning routines' parameters, the ADC clock — have
+    /// none. (The golden tests check the motors without a board, in the generated code.)
+    #[test]
+    fn every_constant_is_named_once_and_is_its_json_value() {
+        for (stem, rel, text) in motor_test_support::motors() {
+            let mut designs = vec![("no board".to_string(), crate::design_source(&rel, &text).unwrap())];
+            for board in motor_test_support::board_stems() {
+                let file = format!("boards/{board}.toml");
+                let d = crate::design_with_board(&rel, &text, &file, &motor_test_support::read(&file)).unwrap();
+                designs.push((board, d));
+            }
+            for (board, d) in designs {
+                let json = serde_json::to_value(&d).unwrap();
+                for g in constants(&d) {
+                    let mut names = HashSet::new();
+                    for k in &g.constants {
+                        let at = format!("{stem} ({board}): {}::{}", g.name, k.name);
+                        assert!(
+                            !k.name.is_empty()
+                                && !k.name.starts_with(|c: char| c.is_ascii_digit())
+                                && k.name
+                                    .chars()
+                                    .all(|c| c.is_ascii_uppercase() || c.is_ascii_digit() || c == '_'),
+                            "{at}: not SCREAMING_SNAKE_CASE"
+                        );
+                        assert!(names.insert(k.name.as_str()), "{at} declared twice");
+                        if k.json_path.is_empty() {
+                            let fixed = matches!(
+                                (g.name, k.name.as_str()),
+                                ("can" | "commissioning", _) | ("board", "ADC_CLOCK_HZ")
+                            );
+                            assert!(fixed, "{at} has no JSON pointer");
+                            continue;
+                        }
+                        let want = json
+                            .pointer(&k.json_path)
+                            .unwrap_or_else(|| panic!("{at}: no {} in the JSON design", k.json_path));
+                        let (got, want) = (numbers(&k.value.number), numbers(want));
+                        assert_eq!(got.len(), want.len(), "{at}: {got:?} but {} is {want:?}", k.json_path);
+                        for (g, w) in got.iter().zip(&want) {
+                            if k.value.c_type == "float" {
+                                // The f32 constant is the JSON f64 rounded to the nearest f32.
+                                assert_eq!(g.to_bits(), f64::from(*w as f32).to_bits(), "{at}: {g}, JSON {w}");
+                            } else {
+                                assert_eq!(g, w, "{at}");
+                            }
+                        }
+                    }
+                }
+            }
+        }
     }
 }
