@@ -61,7 +61,8 @@ pub struct Constant {
     pub equation: String,
     /// Inputs with their provenance, e.g. `L_d = 0.393 mH (datasheet)`.
     pub inputs: String,
-    /// JSON pointer of the same value in `motorgen design --format json` (null there reads as 0).
+    /// JSON pointer of the same value in `motorgen design --format json` (null there reads as 0);
+    /// empty for a fixed choice of the firmware, which the design does not compute.
     pub json_path: String,
 }
 
@@ -128,6 +129,10 @@ enum Json<C> {
 
 /// One constant, declared as data: its name, and how each of its parts comes from the
 /// context `C` its table is read against.
+///
+/// A group's tables are `const`s; where the context borrows the design they are
+/// associated consts of the context (`Axis::DECLS`), as a free `const` cannot be generic
+/// over that borrow.
 struct Decl<C> {
     /// Identifier within its group (after the prefix of a repeated table),
     /// SCREAMING_SNAKE_CASE.
@@ -145,6 +150,7 @@ struct Decl<C> {
 }
 
 impl<C> Text<C> {
+    /// The text for `ctx`.
     fn text(&self, ctx: &C) -> String {
         match self {
             Text::Lit(s) => (*s).to_string(),
