@@ -3,12 +3,21 @@
 //! capture and fault-report frames (only for a design on a board: the identifiers follow the board's
 //! `can.setpoint_id`). The byte layouts are `motor_control::can_protocol`'s (firmware
 //! and host share them); `templates/motor.dbc.j2` renders this group as a DBC file.
+//! The signal scalings are the per-unit ones of thesis A (4.16), (4.20), Table 4.1.
+//!
+//! With it, the `commissioning` group: the fixed parameters of the thesis A chapter 6
+//! routines the CAN command starts — step response (6.4), (6.7), rotor alignment §6.3,
+//! (6.9), resolver rotation §6.4, (6.2), flux-linkage measurement §6.5, (6.10) — and the
+//! capture buffer's size (DS12288 §3.5).
 
 use std::collections::BTreeMap;
 
 use motor_control::can_protocol as p;
 
-use super::{Constant, Group, c, f32v, intv, phys};
+use super::Source::{Custom, F32};
+use super::Text::{Lit, Of};
+use super::{Decl, Group, Json, Value, declare, intv, phys};
+use crate::board::Board;
 use crate::design::Design;
 
 /// Standard identifier of the fault report, a choice of the firmware: low (high
@@ -21,137 +30,398 @@ pub const FAULT_CURRENT_PER_LSB: f64 = 0.1;
 /// Data length of the setpoint frame (a little-endian i16 torque, `can_frame`).
 pub const SETPOINT_LEN: u8 = 2;
 
+/// The equation column of the entries the protocol defines.
+const PROTOCOL: &str = "motor_control::can_protocol";
+
+/// What the CAN interface's entries read.
+struct Can<'a> {
+    d: &'a Design,
+    b: &'a Board,
+}
+
+impl<'a> Can<'a> {
+    /// The entries: identifiers, data lengths, signal scalings.
+    const DECLS: &'a [Decl<Self>] = &[
+        Decl {
+            name: "STATUS_ID",
+            value: Custom(|c| c.id(1)),
+            formula: Lit("setpoint_id + 1: standard identifier of the status frame (drive → bus, every status period)"),
+            equation: Lit(PROTOCOL),
+            inputs: Of(|c| c.setpoint_id()),
+            json: Json::None,
+        },
+        Decl {
+            name: "COMMAND_ID",
+            value: Custom(|c| c.id(2)),
+            formula: Lit("setpoint_id + 2: standard identifier of the commissioning command (bus → drive)"),
+            equation: Lit(PROTOCOL),
+            inputs: Of(|c| c.setpoint_id()),
+            json: Json::None,
+        },
+        Decl {
+            name: "CAPTURE_HEADER_ID",
+            value: Custom(|c| c.id(3)),
+            formula: Lit("setpoint_id + 3: standard identifier of the capture header (drive → bus)"),
+            equation: Lit(PROTOCOL),
+            inputs: Of(|c| c.setpoint_id()),
+            json: Json::None,
+        },
+        Decl {
+            name: "CAPTURE_DATA_ID",
+            value: Custom(|c| c.id(4)),
+            formula: Lit(
+                "setpoint_id + 4: standard identifier of the capture data, one sample per frame (drive → bus)",
+            ),
+            equation: Lit(PROTOCOL),
+            inputs: Of(|c| c.setpoint_id()),
+            json: Json::None,
+        },
+        Decl {
+            name: "CAPTURE_END_ID",
+            value: Custom(|c| c.id(5)),
+            formula: Lit("setpoint_id + 5: standard identifier of the capture end with the CRC-32 (drive → bus)"),
+            equation: Lit(PROTOCOL),
+            inputs: Of(|c| c.setpoint_id()),
+            json: Json::None,
+        },
+        Decl {
+            name: "FAULT_REPORT_ID",
+            value: Custom(|_| identifier(FAULT_REPORT_ID)),
+            formula: Lit(
+                "fixed: standard identifier of the fault report (drive → bus, once after a boot that found a fault record)",
+            ),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's choice, outside setpoint_id … setpoint_id + 5 (checked when the image builds)"),
+            json: Json::None,
+        },
+        Decl {
+            name: "SETPOINT_LEN",
+            value: Custom(|_| length(SETPOINT_LEN)),
+            formula: Lit("data length code of the setpoint: bytes 0–1 torque (i16)"),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's frame layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "STATUS_LEN",
+            value: Custom(|_| length(p::STATUS_LEN)),
+            formula: Lit("data length code of the status: state, reason, routine, faults"),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's frame layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "COMMAND_LEN",
+            value: Custom(|_| length(p::COMMAND_LEN)),
+            formula: Lit("data length code of the command: routine, axis, voltage, current trip, decimation"),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's frame layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "CAPTURE_HEADER_LEN",
+            value: Custom(|_| length(p::HEADER_LEN)),
+            formula: Lit("data length code of the header: routine/axis/tripped, decimation, T_s, count, trip level"),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's frame layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "CAPTURE_DATA_LEN",
+            value: Custom(|_| length(p::DATA_LEN)),
+            formula: Lit("data length code of the data: routine (multiplexor), sequence, channels A and B"),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's frame layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "CAPTURE_END_LEN",
+            value: Custom(|_| length(p::END_LEN)),
+            formula: Lit("data length code of the end: CRC-32, trip sample, trip current"),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's frame layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "FAULT_REPORT_LEN",
+            value: Custom(|_| length(p::FAULT_REPORT_LEN)),
+            formula: Lit("data length code of the fault report: cause, flags, PC, i_q"),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the firmware's frame layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "CURRENT_PER_LSB",
+            value: F32(|c| c.d.scaling.phase_current.full_scale / 32768.0, "A"),
+            formula: Lit("A/2^15: a 16-bit signal is the phase current in Q1.15 of its full scale"),
+            equation: Lit("thesis A (4.16), Table 4.1"),
+            inputs: Of(|c| full_scale(c.d.scaling.phase_current.full_scale, "A")),
+            json: Json::None,
+        },
+        Decl {
+            name: "VOLTAGE_PER_LSB",
+            value: F32(|c| c.d.scaling.phase_voltage.full_scale / 32768.0, "V"),
+            formula: Lit("A/2^15: a 16-bit signal is the phase voltage in Q1.15 of its full scale"),
+            equation: Lit("thesis A (4.16), Table 4.1"),
+            inputs: Of(|c| full_scale(c.d.scaling.phase_voltage.full_scale, "V")),
+            json: Json::None,
+        },
+        Decl {
+            name: "SPEED_PER_LSB",
+            value: F32(|c| c.d.scaling.speed.full_scale / 32768.0, "rad/s"),
+            formula: Lit("A/2^15: a 16-bit signal is the electrical speed in Q1.15 of its full scale"),
+            equation: Lit("thesis A (4.16), Table 4.1"),
+            inputs: Of(|c| full_scale(c.d.scaling.speed.full_scale, "rad/s")),
+            json: Json::None,
+        },
+        Decl {
+            name: "FAULT_CURRENT_PER_LSB",
+            value: F32(|_| FAULT_CURRENT_PER_LSB, "A"),
+            formula: Lit(
+                "fixed: the fault report's i_q unit, ±3276.7 A in an i16 (beyond any phase-current full scale, so a trip's current is never cut)",
+            ),
+            equation: Lit(PROTOCOL),
+            inputs: Lit("the fault report's layout"),
+            json: Json::None,
+        },
+        Decl {
+            name: "ANGLE_PER_LSB",
+            value: F32(|_| f64::from(p::ANGLE_PER_LSB), "rad"),
+            formula: Lit("π/2^15: the top 16 bits of the π-scaled Q1.31 angle"),
+            equation: Lit("thesis A (4.20)"),
+            inputs: Lit("the angle format"),
+            json: Json::None,
+        },
+        Decl {
+            name: "SAMPLE_PERIOD_UNITS",
+            value: Custom(|c| {
+                let ts = c.d.drive.sample_period_s;
+                let units = (ts * p::SAMPLE_PERIOD_UNITS_PER_S)
+                    .round()
+                    .clamp(1.0, f64::from(u16::MAX));
+                (
+                    intv(units as i64, "u16", "uint16_t"),
+                    format!("{} (T_s = {})", units, phys(ts, "s")),
+                )
+            }),
+            formula: Lit("T_s/100 ns, rounded: the capture header's sample period"),
+            equation: Lit("thesis A §6.2"),
+            inputs: Lit("drive.switching_frequency (spec)"),
+            json: Json::None,
+        },
+        Decl {
+            name: "STATUS_PERIOD_S",
+            value: F32(|c| c.b.setpoint_period_s, "s"),
+            formula: Lit("the status frame is sent at the setpoint period"),
+            equation: Lit("—"),
+            inputs: Of(|c| format!("can.setpoint_period ({})", c.b.file)),
+            json: Json::At("/board/board/setpoint_period_s"),
+        },
+    ];
+
+    /// The identifier `k` after the setpoint's.
+    fn id(&self, k: u16) -> (Value, String) {
+        identifier(self.b.setpoint_id + k)
+    }
+
+    /// The board's setpoint identifier as an input.
+    fn setpoint_id(&self) -> String {
+        format!("can.setpoint_id = {:#05x} ({})", self.b.setpoint_id, self.b.file)
+    }
+}
+
+/// A standard identifier and its hexadecimal spelling.
+fn identifier(id: u16) -> (Value, String) {
+    (intv(id.into(), "u16", "uint16_t"), format!("{id:#05x}"))
+}
+
+/// A data length code in bytes.
+fn length(len: u8) -> (Value, String) {
+    (intv(len.into(), "u8", "uint8_t"), format!("{len} bytes"))
+}
+
+/// A scaling's full scale as an input.
+fn full_scale(x: f64, unit: &str) -> String {
+    format!("A = {} (scaling)", phys(x, unit))
+}
+
 /// The group, `None` for a motor designed without a board.
 pub fn group(d: &Design) -> Option<Group> {
     let o = d.board.as_ref()?;
-    let b = &o.board;
-    let file = &b.file;
-    let base = b.setpoint_id;
-    let proto = "motor_control::can_protocol";
-    let mut v: Vec<Constant> = Vec::new();
-    for (k, name, what) in [
-        (1u16, "STATUS_ID", "status frame (drive → bus, every status period)"),
-        (2, "COMMAND_ID", "commissioning command (bus → drive)"),
-        (3, "CAPTURE_HEADER_ID", "capture header (drive → bus)"),
-        (4, "CAPTURE_DATA_ID", "capture data, one sample per frame (drive → bus)"),
-        (5, "CAPTURE_END_ID", "capture end with the CRC-32 (drive → bus)"),
-    ] {
-        let id = base + k;
-        v.push(c(
-            name,
-            intv(i64::from(id), "u16", "uint16_t"),
-            format!("{id:#05x}"),
-            &format!("setpoint_id + {k}: standard identifier of the {what}"),
-            proto,
-            format!("can.setpoint_id = {base:#05x} ({file})"),
-        ));
-    }
-    v.push(c(
-        "FAULT_REPORT_ID",
-        intv(i64::from(FAULT_REPORT_ID), "u16", "uint16_t"),
-        format!("{FAULT_REPORT_ID:#05x}"),
-        "fixed: standard identifier of the fault report (drive → bus, once after a boot that found a fault record)",
-        proto,
-        "the firmware's choice, outside setpoint_id … setpoint_id + 5 (checked when the image builds)".into(),
-    ));
-    for (name, len, what) in [
-        ("SETPOINT_LEN", SETPOINT_LEN, "setpoint: bytes 0–1 torque (i16)"),
-        ("STATUS_LEN", p::STATUS_LEN, "status: state, reason, routine, faults"),
-        (
-            "COMMAND_LEN",
-            p::COMMAND_LEN,
-            "command: routine, axis, voltage, current trip, decimation",
-        ),
-        (
-            "CAPTURE_HEADER_LEN",
-            p::HEADER_LEN,
-            "header: routine/axis/tripped, decimation, T_s, count, trip level",
-        ),
-        (
-            "CAPTURE_DATA_LEN",
-            p::DATA_LEN,
-            "data: routine (multiplexor), sequence, channels A and B",
-        ),
-        ("CAPTURE_END_LEN", p::END_LEN, "end: CRC-32, trip sample, trip current"),
-        (
-            "FAULT_REPORT_LEN",
-            p::FAULT_REPORT_LEN,
-            "fault report: cause, flags, PC, i_q",
-        ),
-    ] {
-        v.push(c(
-            name,
-            intv(i64::from(len), "u8", "uint8_t"),
-            format!("{len} bytes"),
-            &format!("data length code of the {what}"),
-            proto,
-            "the firmware's frame layout".into(),
-        ));
-    }
-    let s = &d.scaling;
-    for (name, sc, unit, what) in [
-        ("CURRENT_PER_LSB", &s.phase_current, "A", "phase current"),
-        ("VOLTAGE_PER_LSB", &s.phase_voltage, "V", "phase voltage"),
-        ("SPEED_PER_LSB", &s.speed, "rad/s", "electrical speed"),
-    ] {
-        let x = sc.full_scale / 32768.0;
-        v.push(c(
-            name,
-            f32v(x),
-            phys(x, unit),
-            &format!("A/2^15: a 16-bit signal is the {what} in Q1.15 of its full scale"),
-            "thesis A (4.16), Table 4.1",
-            format!("A = {} (scaling)", phys(sc.full_scale, unit)),
-        ));
-    }
-    v.push(c(
-        "FAULT_CURRENT_PER_LSB",
-        f32v(FAULT_CURRENT_PER_LSB),
-        phys(FAULT_CURRENT_PER_LSB, "A"),
-        "fixed: the fault report's i_q unit, ±3276.7 A in an i16 (beyond any phase-current full scale, so a trip's current is never cut)",
-        proto,
-        "the fault report's layout".into(),
-    ));
-    v.push(c(
-        "ANGLE_PER_LSB",
-        f32v(f64::from(p::ANGLE_PER_LSB)),
-        phys(f64::from(p::ANGLE_PER_LSB), "rad"),
-        "π/2^15: the top 16 bits of the π-scaled Q1.31 angle",
-        "thesis A (4.20)",
-        "the angle format".into(),
-    ));
-    let units = (d.drive.sample_period_s * p::SAMPLE_PERIOD_UNITS_PER_S)
-        .round()
-        .clamp(1.0, f64::from(u16::MAX));
-    v.push(c(
-        "SAMPLE_PERIOD_UNITS",
-        intv(units as i64, "u16", "uint16_t"),
-        format!("{} (T_s = {})", units, phys(d.drive.sample_period_s, "s")),
-        "T_s/100 ns, rounded: the capture header's sample period",
-        "thesis A §6.2",
-        "drive.switching_frequency (spec)".into(),
-    ));
-    v.push(
-        c(
-            "STATUS_PERIOD_S",
-            f32v(b.setpoint_period_s),
-            phys(b.setpoint_period_s, "s"),
-            "the status frame is sent at the setpoint period",
-            "—",
-            format!("can.setpoint_period ({file})"),
-        )
-        .at("/board/board/setpoint_period_s"),
-    );
+    let can = Can { d, b: &o.board };
     Some(Group {
         name: "can",
         title: "CAN interface: identifiers, data lengths and signal scalings (also as the DBC file)",
-        constants: v,
+        constants: declare(Can::DECLS, &can, "").collect(),
     })
 }
 
 /// Captured samples the image has room for: 4096 × 8 bytes (two `f32` channels) =
 /// 32 KiB of the STM32G474's 128 KiB SRAM (DS12288 §3.5).
 pub const CAPTURE_CAPACITY: u32 = 4096;
+
+/// What the commissioning entries read.
+struct Commissioning<'a> {
+    d: &'a Design,
+    /// T_s \[s\].
+    ts: f64,
+    /// τ = max(L_d, L_q)/R \[s\].
+    tau: f64,
+    /// T_s as an input.
+    ts_in: String,
+    /// τ and T_s as inputs.
+    tau_in: String,
+}
+
+impl<'a> Commissioning<'a> {
+    /// The entries.
+    const DECLS: &'a [Decl<Self>] = &[
+        Decl {
+            name: "CAPTURE_CAPACITY",
+            value: Custom(|_| {
+                let n = CAPTURE_CAPACITY;
+                (intv(n.into(), "u32", "uint32_t"), format!("{n} samples"))
+            }),
+            formula: Lit("two f32 channels each: 32 KiB of the 128 KiB SRAM"),
+            equation: Lit("DS12288 §3.5"),
+            inputs: Lit("the firmware's RAM budget"),
+            json: Json::None,
+        },
+        Decl {
+            name: "STEP_PRE_SAMPLES",
+            value: Custom(|c| c.samples(40.0)),
+            formula: Lit("periods at 0 V before the step (baseline)"),
+            equation: Lit("thesis A §6.2"),
+            inputs: Lit("—"),
+            json: Json::None,
+        },
+        Decl {
+            name: "STEP_SAMPLES",
+            value: Custom(|c| c.samples(c.periods(12.0 * c.tau).max(3000.0))),
+            formula: Lit("max(⌈12·τ/T_s⌉, 3000), τ = max(L_d, L_q)/R: the step settles (identify needs 8 τ)"),
+            equation: Lit("thesis A (6.4), (6.7)"),
+            inputs: Of(|c| c.tau_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "ALIGN_RAMP_SAMPLES",
+            value: Custom(|c| c.samples(c.periods(0.05))),
+            formula: Lit("⌈50 ms/T_s⌉: voltage ramp to the alignment level"),
+            equation: Lit("thesis A §6.3"),
+            inputs: Of(|c| c.ts_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "ALIGN_SETTLE_SAMPLES",
+            value: Custom(|c| c.samples(c.periods((30.0 * c.tau).max(0.5)))),
+            formula: Lit(
+                "⌈max(30·τ, 500 ms)/T_s⌉: the rotor comes to rest on the α axis (the rotor's motion and the currents form a mode as slow as τ = max(L_d, L_q)/R)",
+            ),
+            equation: Lit("thesis A §6.3"),
+            inputs: Of(|c| c.tau_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "ALIGN_AVERAGE_SAMPLES",
+            value: Custom(|c| c.samples(c.periods(0.1))),
+            formula: Lit("⌈100 ms/T_s⌉: θ_r averaged"),
+            equation: Lit("thesis A (6.9)"),
+            inputs: Of(|c| c.ts_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "ROTATION_STEP",
+            value: Custom(|c| {
+                // One electrical turn per second: 2^32 LSB of the π-scaled angle per second.
+                let step = (4_294_967_296.0 * c.ts).round().clamp(1.0, f64::from(i32::MAX));
+                (
+                    intv(step as i64, "i32", "int32_t"),
+                    format!("{step} LSB per period (1 electrical turn/s)"),
+                )
+            }),
+            formula: Lit("2^32·T_s: the field turns once a second, slow enough for the rotor to follow"),
+            equation: Lit("thesis A §6.4"),
+            inputs: Of(|c| c.ts_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "ROTATION_TURNS",
+            value: Custom(|c| {
+                let o = &c.d.angle_observer;
+                let turns = 2 * o.motor_pole_pairs / o.resolver_pole_pairs.max(1);
+                (
+                    intv(turns.into(), "u32", "uint32_t"),
+                    format!("{turns} electrical turns"),
+                )
+            }),
+            formula: Lit("2·n_p/n_r: two resolver turns"),
+            equation: Lit("thesis A (6.2)"),
+            inputs: Of(|c| {
+                let o = &c.d.angle_observer;
+                format!("n_p = {}, n_r = {}", o.motor_pole_pairs, o.resolver_pole_pairs)
+            }),
+            json: Json::None,
+        },
+        Decl {
+            name: "ROTATION_SETTLE_SAMPLES",
+            value: Custom(|c| c.samples(c.periods(0.5))),
+            formula: Lit("⌈500 ms/T_s⌉ held at the start and the end angle"),
+            equation: Lit("thesis A §6.4"),
+            inputs: Of(|c| c.ts_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "FLUX_SETTLE_SAMPLES",
+            value: Custom(|c| c.samples(c.periods(0.2))),
+            formula: Lit("⌈200 ms/T_s⌉: the current loop settles at i = 0"),
+            equation: Lit("thesis A §6.5"),
+            inputs: Of(|c| c.ts_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "FLUX_AVERAGE_SAMPLES",
+            value: Custom(|c| c.samples(c.periods(0.1))),
+            formula: Lit("⌈100 ms/T_s⌉ averaged (and captured)"),
+            equation: Lit("thesis A (6.10)"),
+            inputs: Of(|c| c.ts_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "FLUX_MIN_SPEED",
+            value: F32(|c| 0.05 * c.d.motor.max_electrical_speed_rad_s, "rad/s"),
+            formula: Lit("5 % of the maximum electrical speed: the back EMF dominates R·i"),
+            equation: Lit("thesis A (6.10)"),
+            inputs: Of(|c| c.max_speed()),
+            json: Json::None,
+        },
+        Decl {
+            name: "STANDSTILL_SPEED",
+            value: F32(|c| 0.01 * c.d.motor.max_electrical_speed_rad_s, "rad/s"),
+            formula: Lit("1 % of the maximum electrical speed: a command is accepted below it"),
+            equation: Lit("—"),
+            inputs: Of(|c| c.max_speed()),
+            json: Json::None,
+        },
+    ];
+
+    /// Whole control periods lasting at least `t` seconds (at least one).
+    fn periods(&self, t: f64) -> f64 {
+        (t / self.ts).ceil().clamp(1.0, f64::from(u32::MAX))
+    }
+
+    /// `periods` control periods as a `u32` constant, with their duration.
+    fn samples(&self, periods: f64) -> (Value, String) {
+        (
+            intv(periods as i64, "u32", "uint32_t"),
+            format!("{periods} periods ({})", phys(periods * self.ts, "s")),
+        )
+    }
+
+    /// ω_e,max as an input.
+    fn max_speed(&self) -> String {
+        format!("ω_e,max = {}", phys(self.d.motor.max_electrical_speed_rad_s, "rad/s"))
+    }
+}
 
 /// The `commissioning` group: the fixed parameters of the chapter-6 routines the CAN
 /// command starts (the command gives voltage, trip and decimation), emitted with the
@@ -160,125 +430,19 @@ pub fn commissioning_group(d: &Design) -> Option<Group> {
     d.board.as_ref()?;
     let m = &d.motor;
     let ts = d.drive.sample_period_s;
-    let periods = |t: f64| (t / ts).ceil().clamp(1.0, f64::from(u32::MAX));
     let tau = m.d_inductance_h.max(m.q_inductance_h) / m.phase_resistance_ohm;
     let ts_in = format!("T_s = {} (drive.switching_frequency)", phys(ts, "s"));
-    let u32c = |name: &str, x: f64, formula: &str, eq: &str, inputs: String| {
-        c(
-            name,
-            intv(x as i64, "u32", "uint32_t"),
-            format!("{x} periods ({})", phys(x * ts, "s")),
-            formula,
-            eq,
-            inputs,
-        )
+    let commissioning = Commissioning {
+        d,
+        ts,
+        tau,
+        tau_in: format!("τ = {}, {ts_in}", phys(tau, "s")),
+        ts_in,
     };
-    let np = d.angle_observer.motor_pole_pairs;
-    let nr = d.angle_observer.resolver_pole_pairs;
-    // One electrical turn per second: 2^32 LSB of the π-scaled angle per second.
-    let rotation_step = (4_294_967_296.0 * ts).round().clamp(1.0, f64::from(i32::MAX));
-    let v = vec![
-        c(
-            "CAPTURE_CAPACITY",
-            intv(i64::from(CAPTURE_CAPACITY), "u32", "uint32_t"),
-            format!("{CAPTURE_CAPACITY} samples"),
-            "two f32 channels each: 32 KiB of the 128 KiB SRAM",
-            "DS12288 §3.5",
-            "the firmware's RAM budget".into(),
-        ),
-        u32c(
-            "STEP_PRE_SAMPLES",
-            40.0,
-            "periods at 0 V before the step (baseline)",
-            "thesis A §6.2",
-            "—".into(),
-        ),
-        u32c(
-            "STEP_SAMPLES",
-            periods(12.0 * tau).max(3000.0),
-            "max(⌈12·τ/T_s⌉, 3000), τ = max(L_d, L_q)/R: the step settles (identify needs 8 τ)",
-            "thesis A (6.4), (6.7)",
-            format!("τ = {}, {ts_in}", phys(tau, "s")),
-        ),
-        u32c(
-            "ALIGN_RAMP_SAMPLES",
-            periods(0.05),
-            "⌈50 ms/T_s⌉: voltage ramp to the alignment level",
-            "thesis A §6.3",
-            ts_in.clone(),
-        ),
-        u32c(
-            "ALIGN_SETTLE_SAMPLES",
-            periods((30.0 * tau).max(0.5)),
-            "⌈max(30·τ, 500 ms)/T_s⌉: the rotor comes to rest on the α axis (the rotor's motion and the currents form a mode as slow as τ = max(L_d, L_q)/R)",
-            "thesis A §6.3",
-            format!("τ = {}, {ts_in}", phys(tau, "s")),
-        ),
-        u32c(
-            "ALIGN_AVERAGE_SAMPLES",
-            periods(0.1),
-            "⌈100 ms/T_s⌉: θ_r averaged",
-            "thesis A (6.9)",
-            ts_in.clone(),
-        ),
-        c(
-            "ROTATION_STEP",
-            intv(rotation_step as i64, "i32", "int32_t"),
-            format!("{rotation_step} LSB per period (1 electrical turn/s)"),
-            "2^32·T_s: the field turns once a second, slow enough for the rotor to follow",
-            "thesis A §6.4",
-            ts_in.clone(),
-        ),
-        c(
-            "ROTATION_TURNS",
-            intv(i64::from(2 * np / nr.max(1)), "u32", "uint32_t"),
-            format!("{} electrical turns", 2 * np / nr.max(1)),
-            "2·n_p/n_r: two resolver turns",
-            "thesis A (6.2)",
-            format!("n_p = {np}, n_r = {nr}"),
-        ),
-        u32c(
-            "ROTATION_SETTLE_SAMPLES",
-            periods(0.5),
-            "⌈500 ms/T_s⌉ held at the start and the end angle",
-            "thesis A §6.4",
-            ts_in.clone(),
-        ),
-        u32c(
-            "FLUX_SETTLE_SAMPLES",
-            periods(0.2),
-            "⌈200 ms/T_s⌉: the current loop settles at i = 0",
-            "thesis A §6.5",
-            ts_in.clone(),
-        ),
-        u32c(
-            "FLUX_AVERAGE_SAMPLES",
-            periods(0.1),
-            "⌈100 ms/T_s⌉ averaged (and captured)",
-            "thesis A (6.10)",
-            ts_in,
-        ),
-        c(
-            "FLUX_MIN_SPEED",
-            f32v(0.05 * m.max_electrical_speed_rad_s),
-            phys(0.05 * m.max_electrical_speed_rad_s, "rad/s"),
-            "5 % of the maximum electrical speed: the back EMF dominates R·i",
-            "thesis A (6.10)",
-            format!("ω_e,max = {}", phys(m.max_electrical_speed_rad_s, "rad/s")),
-        ),
-        c(
-            "STANDSTILL_SPEED",
-            f32v(0.01 * m.max_electrical_speed_rad_s),
-            phys(0.01 * m.max_electrical_speed_rad_s, "rad/s"),
-            "1 % of the maximum electrical speed: a command is accepted below it",
-            "—",
-            format!("ω_e,max = {}", phys(m.max_electrical_speed_rad_s, "rad/s")),
-        ),
-    ];
     Some(Group {
         name: "commissioning",
         title: "Commissioning routines started over CAN (thesis A chapter 6)",
-        constants: v,
+        constants: declare(Commissioning::DECLS, &commissioning, "").collect(),
     })
 }
 
