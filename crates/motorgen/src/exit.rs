@@ -108,6 +108,22 @@ impl From<Diagnostics> for Failure {
     }
 }
 
+/// The library's failures, each with its exit code: bad input 1, an unreadable input
+/// 74, the CAN interface 69, the drive's refusal or abort 6, no capture in time 75.
+impl From<motor_commission::Error> for Failure {
+    fn from(e: motor_commission::Error) -> Self {
+        use motor_commission::Error as E;
+        let exit = match &e {
+            E::Input(_) | E::Option(_) => Exit::BadInput,
+            E::Unreadable(_) => Exit::Io,
+            E::BusUnavailable(_) => Exit::CanUnavailable,
+            E::Refused { .. } | E::Aborted { .. } => Exit::Refused,
+            E::Timeout { .. } => Exit::Timeout,
+        };
+        Failure::new(exit, e.to_string())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
