@@ -409,8 +409,7 @@ impl Plan {
             .map_err(|e| session_error(e, &o.iface, &o.timeout))?;
         // From here on, the candump path.
         let name = format!("{} (live)", o.iface);
-        let captures: Vec<LoggedCapture> =
-            identify::captures_from_frames(&name, rec.text, &rec.frames, &self.layout)?;
+        let captures: Vec<LoggedCapture> = identify::captures_from_frames(&name, rec.text, &rec.frames, &self.layout)?;
         let header_time = |c: &candump::Capture| {
             rec.frames
                 .iter()
@@ -427,11 +426,7 @@ impl Plan {
                     (Routine::Step, false) => "-d",
                     _ => "",
                 };
-                let file = format!(
-                    "{}-{kind}{axis}-{}.csv",
-                    self.spec_stem,
-                    stamp(header_time(&c.capture))
-                );
+                let file = format!("{}-{kind}{axis}-{}.csv", self.spec_stem, stamp(header_time(&c.capture)));
                 (file, c.csv.clone())
             })
             .collect();

@@ -543,8 +543,10 @@ impl Request {
         date: &str,
         out: &mut dyn fmt::Write,
     ) -> Result<Update, Error> {
-        let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) =
-            self.all_recordings(csv, spec, RecordingKind::Step, ts)?.into_iter().unzip();
+        let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) = self
+            .all_recordings(csv, spec, RecordingKind::Step, ts)?
+            .into_iter()
+            .unzip();
         let name = match axis {
             Axis::D => "d",
             Axis::Q => "q",
@@ -656,8 +658,10 @@ impl Request {
         date: &str,
         out: &mut dyn fmt::Write,
     ) -> Result<Update, Error> {
-        let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) =
-            self.all_recordings(csv, spec, RecordingKind::Flux, ts)?.into_iter().unzip();
+        let (recs, origins): (Vec<Recording>, Vec<RecordingOrigin>) = self
+            .all_recordings(csv, spec, RecordingKind::Flux, ts)?
+            .into_iter()
+            .unzip();
         let setup = flux::FluxSetup {
             resistance_ohm: design.motor.phase_resistance_ohm,
             d_inductance_h: design.motor.d_inductance_h,
@@ -689,7 +693,12 @@ impl Request {
         let Some(s) = Spread::of(&values) else {
             return Err(plain_error(spec.file, "no recordings".into(), "--csv FILE…").into());
         };
-        say!(out, "  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)", s.mean, s.relative_percent());
+        say!(
+            out,
+            "  mean: ψ_M = {:.5} Wb ± {:.2} % (1σ)",
+            s.mean,
+            s.relative_percent()
+        );
         let files = self.names(csv);
         let entries = [Entry {
             key: "flux_linkage",
@@ -782,7 +791,10 @@ impl Request {
             return Err(Diagnostics(errors).into());
         }
         if !ratios.is_empty() {
-            say!(out, "  pole-pair ratio agrees with the spec ({np}/{nr}); directions agree");
+            say!(
+                out,
+                "  pole-pair ratio agrees with the spec ({np}/{nr}); directions agree"
+            );
         }
         if offset.is_empty() && can_offset.is_empty() {
             return Ok(None);

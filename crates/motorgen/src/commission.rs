@@ -246,7 +246,10 @@ mod tests {
         assert!(csv.starts_with("# motorgen recording: step\n"), "{csv}");
         let text = b.spec_text();
         assert_ne!(text, before);
-        assert!(text.contains("d_inductance = ") && text.contains("sim0 (live)"), "{text}");
+        assert!(
+            text.contains("d_inductance = ") && text.contains("sim0 (live)"),
+            "{text}"
+        );
     }
 
     /// `--dry-run`: the CSV is written, the spec is not.

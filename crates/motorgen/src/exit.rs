@@ -151,4 +151,51 @@ mod tests {
             assert!(HELP.contains(&row), "{e:?}");
         }
     }
+
+    /// Each of the library's failures has the exit code the README documents, and its
+    /// message unchanged.
+    #[test]
+    fn library_failures_have_their_exit_codes() {
+        use motor_commission::{Error, Problem};
+        use motor_control::can_protocol::Reason;
+        let located = Diagnostics(vec![codegen::Diagnostic {
+            file: "m.toml".into(),
+            line: 3,
+            column: 1,
+            key: String::new(),
+            problem: "bad".into(),
+            accepted: "good".into(),
+            excerpt: String::new(),
+        }]);
+        let problem = Problem::new("--trip", "bad", "good");
+        let iface = || "can0".to_string();
+        for (e, exit) in [
+            (Error::Input(located.clone()), Exit::BadInput),
+            (Error::Option(problem.clone()), Exit::BadInput),
+            (Error::Unreadable(located), Exit::Io),
+            (Error::BusUnavailable(problem), Exit::CanUnavailable),
+            (
+                Error::Refused {
+                    iface: iface(),
+                    reason: Reason::Busy,
+                },
+                Exit::Refused,
+            ),
+            (Error::Aborted { iface: iface() }, Exit::Refused),
+            (
+                Error::Timeout {
+                    iface: iface(),
+                    waited: std::time::Duration::from_secs(2),
+                    last_status: None,
+                    capture_frames: 0,
+                    limit: "2 s".into(),
+                },
+                Exit::Timeout,
+            ),
+        ] {
+            let message = e.to_string();
+            let f = Failure::from(e);
+            assert_eq!((f.exit, f.message), (exit, message));
+        }
+    }
 }

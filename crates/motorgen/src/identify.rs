@@ -215,11 +215,14 @@ pub fn identify(spec: &Path, dry_run: bool, request: &Request) -> Result<(), Fai
             crate::read_spec(spec)?;
         }
         let mut lock = LockedSpec::open(spec)?;
-        let text = crate::spec_text(spec, std::mem::take(&mut lock.bytes)).map_err(codegen::Diagnostics::from)?;
+        let text = crate::spec_text(spec, std::mem::take(&mut lock.bytes))?;
         (Some(lock), text)
     };
     let file = spec.display().to_string();
-    let source = Source { file: &file, text: &text };
+    let source = Source {
+        file: &file,
+        text: &text,
+    };
     let Some(update) = request.identify(&source, &date, &mut Stdout)? else {
         return Ok(());
     };

@@ -206,7 +206,7 @@ fn read_spec(path: &Path) -> Result<String, Failure> {
 fn read_input(path: &Path) -> Input {
     let file = path.display().to_string();
     let text = match std::fs::read(path) {
-        Ok(bytes) => spec_text(path, bytes).map_err(|d| motor_commission::Error::Input(d.into())),
+        Ok(bytes) => spec_text(path, bytes).map_err(motor_commission::Error::Input),
         Err(e) => {
             let d = codegen::Diagnostic {
                 file: file.clone(),
@@ -224,7 +224,7 @@ fn read_input(path: &Path) -> Input {
 }
 
 /// A spec's bytes as UTF-8 text, or bad input located at the first invalid byte.
-fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, codegen::Diagnostic> {
+fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, codegen::Diagnostics> {
     let file = path.display().to_string();
     String::from_utf8(bytes).map_err(|e| {
         let at = e.utf8_error().valid_up_to();
@@ -239,6 +239,7 @@ fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, codegen::Diagnostic>
             format!("the file is not valid UTF-8 (byte {at})"),
             "a UTF-8 text file; save the spec as UTF-8",
         )
+        .into()
     })
 }
 

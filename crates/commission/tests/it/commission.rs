@@ -265,7 +265,14 @@ fn silence_is_a_timeout() {
     o.timeout = "2 s".into();
     let e = b.plan(&o).unwrap().run(&mut Silent(Duration::ZERO)).unwrap_err();
     assert!(
-        matches!(&e, Error::Timeout { last_status: None, capture_frames: 0, .. }),
+        matches!(
+            &e,
+            Error::Timeout {
+                last_status: None,
+                capture_frames: 0,
+                ..
+            }
+        ),
         "{e:?}"
     );
     let m = e.to_string();

@@ -43,7 +43,10 @@ fn step_recordings_update_the_spec() {
     let req = request(What::Step { axis: Axis::Q, csv });
     let date = req.check("2000-01-01").unwrap();
     let mut table = String::new();
-    let spec = Source { file: SPEC, text: &text };
+    let spec = Source {
+        file: SPEC,
+        text: &text,
+    };
     let update = req.identify(&spec, &date, &mut table).unwrap().unwrap();
     assert!(table.starts_with("q axis, 3 recording(s)"), "{table}");
     for k in 1..=3 {
@@ -51,12 +54,20 @@ fn step_recordings_update_the_spec() {
     }
     assert_eq!(update.keys, ["phase_resistance", "q_inductance"]);
     let value = |key: &str, kind: Kind| {
-        let line = update.text.lines().find(|x| x.starts_with(&format!("{key} = "))).unwrap();
+        let line = update
+            .text
+            .lines()
+            .find(|x| x.starts_with(&format!("{key} = ")))
+            .unwrap();
         units::parse(kind, line.split('"').nth(1).unwrap()).unwrap()
     };
     assert!((value("phase_resistance", Kind::Resistance) / r - 1.0).abs() < 0.02);
     assert!((value("q_inductance", Kind::Inductance) / l - 1.0).abs() < 0.02);
-    assert!(update.text.contains("2025-03-14") && update.text.contains("q1.csv"), "{}", update.text);
+    assert!(
+        update.text.contains("2025-03-14") && update.text.contains("q1.csv"),
+        "{}",
+        update.text
+    );
     assert!(
         update.provenance.contains(&"phase_resistance: identified".to_string()),
         "{:?}",
@@ -71,9 +82,15 @@ fn step_recordings_update_the_spec() {
 #[test]
 fn recording_problems_are_reported_together() {
     let (text, _) = fischer();
-    let spec = Source { file: SPEC, text: &text };
+    let spec = Source {
+        file: SPEC,
+        text: &text,
+    };
     let gone = Input::unreadable("gone.csv", "cannot read the recording: gone".into(), "a readable CSV");
-    let bad = Input::new("bad.csv", "# motorgen recording: step\nsample,voltage_v,current_a\n0,1,x\n");
+    let bad = Input::new(
+        "bad.csv",
+        "# motorgen recording: step\nsample,voltage_v,current_a\n0,1,x\n",
+    );
     let req = request(What::Step {
         axis: Axis::D,
         csv: vec![bad.clone(), gone],
@@ -127,12 +144,22 @@ fn an_update_that_breaks_the_design_is_refused() {
     let csv = vec![Input::new("q.csv", step_recording(&d, "q", 2.0 * 1470.0 * l, l, 3))];
     let req = request(What::Step { axis: Axis::Q, csv });
     let spec = Source { file, text: &text };
-    let line = text.lines().position(|x| x.starts_with("bandwidth = \"1470 rad/s\"")).unwrap() + 1;
+    let line = text
+        .lines()
+        .position(|x| x.starts_with("bandwidth = \"1470 rad/s\""))
+        .unwrap()
+        + 1;
     match req.identify(&spec, "2025-03-14", &mut String::new()) {
         Err(Error::Input(e)) => {
-            assert_eq!((e.0[0].line, e.0[0].key.as_str()), (line, "current_loop.bandwidth"), "{e}");
+            assert_eq!(
+                (e.0[0].line, e.0[0].key.as_str()),
+                (line, "current_loop.bandwidth"),
+                "{e}"
+            );
             assert!(
-                e.0[0].problem.starts_with("with the identified phase_resistance, q_inductance written"),
+                e.0[0]
+                    .problem
+                    .starts_with("with the identified phase_resistance, q_inductance written"),
                 "{e}"
             );
         }

@@ -39,7 +39,12 @@ fn commission(spec: &str, can: &str, out: &str, routine: &[&str]) -> std::proces
 fn missing_interface_exits_69() {
     let (dir, spec, out) = setup("missing");
     let before = std::fs::read_to_string(&spec).unwrap();
-    let o = commission(&spec, "mgnone0", &out, &["step", "--axis", "d", "--voltage", "1 V", "--trip", "10 A"]);
+    let o = commission(
+        &spec,
+        "mgnone0",
+        &out,
+        &["step", "--axis", "d", "--voltage", "1 V", "--trip", "10 A"],
+    );
     assert_eq!(o.status.code(), Some(69), "{}", text_of(&o));
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("mgnone0") && err.contains("accepted:"), "{err}");
@@ -53,7 +58,10 @@ fn missing_interface_exits_69() {
 fn bad_options_exit_1() {
     let (dir, spec, out) = setup("options");
     for (routine, option) in [
-        (&["step", "--axis", "q", "--voltage", "2 V", "--trip", "10 V"][..], "--trip"),
+        (
+            &["step", "--axis", "q", "--voltage", "2 V", "--trip", "10 V"][..],
+            "--trip",
+        ),
         (&["resolver-offset", "--voltage", "0 V"][..], "--voltage"),
     ] {
         let o = commission(&spec, "mgnone0", &out, routine);
@@ -75,6 +83,10 @@ fn bad_options_exit_1() {
         "flux",
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", text_of(&o));
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--decimation"), "{}", text_of(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--decimation"),
+        "{}",
+        text_of(&o)
+    );
     assert!(!dir.join("out").exists());
 }
