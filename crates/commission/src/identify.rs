@@ -60,6 +60,28 @@ impl Input {
         }
     }
 
+    /// A text file read as `bytes`: its text, or bad input located at the first byte
+    /// that is not UTF-8.
+    pub fn from_bytes(name: impl Into<String>, bytes: Vec<u8>) -> Self {
+        let name = name.into();
+        let text = String::from_utf8(bytes).map_err(|e| {
+            let at = e.utf8_error().valid_up_to();
+            let text = String::from_utf8_lossy(e.as_bytes());
+            Source {
+                file: &name,
+                text: &text,
+            }
+            .error(
+                at..at,
+                "",
+                format!("the file is not valid UTF-8 (byte {at})"),
+                "a UTF-8 text file; save the spec as UTF-8",
+            )
+            .into()
+        });
+        Input { name, text }
+    }
+
     /// A file that could not be read: `problem` (e.g. `cannot read the log: <why>`) at
     /// the file, `accepted` what would be.
     pub fn unreadable(name: impl Into<String>, problem: String, accepted: &str) -> Self {

@@ -215,7 +215,7 @@ pub fn identify(spec: &Path, dry_run: bool, request: &Request) -> Result<(), Fai
             crate::read_spec(spec)?;
         }
         let mut lock = LockedSpec::open(spec)?;
-        let text = crate::spec_text(spec, std::mem::take(&mut lock.bytes))?;
+        let text = Input::from_bytes(spec.display().to_string(), std::mem::take(&mut lock.bytes)).text?;
         (Some(lock), text)
     };
     let file = spec.display().to_string();

@@ -204,43 +204,15 @@ fn read_spec(path: &Path) -> Result<String, Failure> {
 /// A spec or board file as the library crates take it: its text, or why it could not be
 /// read (an unreadable file, or bad input located at its first invalid UTF-8 byte).
 fn read_input(path: &Path) -> Input {
-    let file = path.display().to_string();
-    let text = match std::fs::read(path) {
-        Ok(bytes) => spec_text(path, bytes).map_err(motor_commission::Error::Input),
-        Err(e) => {
-            let d = codegen::Diagnostic {
-                file: file.clone(),
-                line: 1,
-                column: 1,
-                key: String::new(),
-                problem: format!("cannot read the file: {e}"),
-                accepted: "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)".into(),
-                excerpt: String::new(),
-            };
-            Err(motor_commission::Error::Unreadable(d.into()))
-        }
-    };
-    Input { name: file, text }
-}
-
-/// A spec's bytes as UTF-8 text, or bad input located at the first invalid byte.
-fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, codegen::Diagnostics> {
-    let file = path.display().to_string();
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let text = String::from_utf8_lossy(e.as_bytes());
-        codegen::Source {
-            file: &file,
-            text: &text,
-        }
-        .error(
-            at..at,
-            "",
-            format!("the file is not valid UTF-8 (byte {at})"),
-            "a UTF-8 text file; save the spec as UTF-8",
-        )
-        .into()
-    })
+    let name = path.display().to_string();
+    match std::fs::read(path) {
+        Ok(bytes) => Input::from_bytes(name, bytes),
+        Err(e) => Input::unreadable(
+            name,
+            format!("cannot read the file: {e}"),
+            "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)",
+        ),
+    }
 }
 
 fn design(path: &Path) -> Result<codegen::Design, Failure> {

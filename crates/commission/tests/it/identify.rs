@@ -189,3 +189,30 @@ fn capture_files_refuse_bad_logs() {
     let no_can = Input::new("b.toml", "");
     assert!(capture_files(&spec, &no_can, &[]).is_err());
 }
+
+/// A file that is not UTF-8 is bad input at its first invalid byte; one that could not
+/// be read carries the front end's reason as an unreadable input.
+#[test]
+fn inputs_carry_why_they_cannot_be_read() {
+    let bad = Input::from_bytes("m.toml", b"a = 1\nb = \"\xff\"\n".to_vec());
+    match bad.text() {
+        Err(Error::Input(d)) => {
+            assert_eq!(
+                (d.0[0].file.as_str(), d.0[0].line, d.0[0].column),
+                ("m.toml", 2, 6),
+                "{d}"
+            );
+            assert!(d.0[0].problem.contains("not valid UTF-8 (byte 11)"), "{d}");
+        }
+        other => panic!("{other:?}"),
+    }
+    assert_eq!(Input::from_bytes("m.toml", b"a = 1\n".to_vec()).text(), Ok("a = 1\n"));
+    let gone = Input::unreadable("m.toml", "cannot read the file: gone".into(), "a file");
+    assert!(matches!(gone.text(), Err(Error::Unreadable(_))));
+    assert!(
+        gone.text()
+            .unwrap_err()
+            .to_string()
+            .starts_with("error: m.toml:1:1: cannot read the file: gone\n")
+    );
+}
