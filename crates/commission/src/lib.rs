@@ -1,5 +1,7 @@
 //! Identified motor values from recorded commissioning data (thesis A chapter 6), and
-//! their write-back into the motor spec's `[motor.identified]` section.
+//! their write-back into the motor spec's `[motor.identified]` section: the logic of
+//! `motorgen identify`, `capture` and `commission`, which only read the files, lock and
+//! write the spec, open the bus and print.
 //!
 //! * [`recording`]: the CSV format of the firmware's captures, parsed with located
 //!   errors, and the writer for a `VoltageStep` capture buffer.
@@ -10,29 +12,45 @@
 //!   ratio n_p/n_r with the direction check (§6.4).
 //! * [`candump`]: captures sent over CAN (`candump -l` logs or a live socket),
 //!   reassembled, checked and turned into recordings.
-//! * [`commission`]: a session on a live bus (command, status, the capture's frames
-//!   recorded as a `candump -l` log for [`candump`]).
-//! * [`sim_drive`]: the firmware's commissioning mode on the simulated motor behind the
-//!   same bus trait (the simulated bench of the tests and `commission --sim`).
-//! * [`synthetic`]: synthetic recordings of a blocked-rotor step from R and L (thesis A
-//!   (6.4) with a transport delay, noise and ADC quantisation), for tests and benchmarks.
 //! * [`writeback`]: the new values into the spec text with `toml_edit` (comments and
 //!   layout kept).
+//! * [`identify`]: the whole identification of one routine: a spec's text and its
+//!   recordings' and logs' texts ([`Input`]) → the estimates, their spread and the
+//!   spec's [`identify::Update`] (`motorgen identify`; `capture`'s CSV files).
+//! * [`commission`]: a session on a bus: the options checked into a command
+//!   ([`commission::plan`]), the session (command, status, the capture's frames
+//!   recorded as a `candump -l` log for [`candump`]), and the captures' CSV files and
+//!   identification ([`commission::Plan::run`]) (`motorgen commission`).
+//! * [`socket`]: the live bus, a SocketCAN socket (Linux).
+//! * [`sim_drive`]: the firmware's commissioning mode on the simulated motor behind the
+//!   same bus trait (the simulated bench of the tests).
+//! * [`synthetic`]: synthetic recordings of a blocked-rotor step from R and L (thesis A
+//!   (6.4) with a transport delay, noise and ADC quantisation), for tests and benchmarks.
+//! * [`error`]: why an identification or a session failed ([`Error`]: bad input,
+//!   unreadable input, bus unavailable, refused, aborted, timeout), one variant per exit
+//!   code of `motorgen`.
 //!
-//! Nothing here does file I/O; `motorgen identify` reads the files and writes the spec.
+//! No file I/O: the front end reads the files into [`Input`]s and writes what comes
+//! back; the only I/O here is the CAN socket of [`socket`].
 //!
 //! May depend on `codegen` (the design core), `motor-control` and `motor-sim`; never on
 //! `motor-verify` or `motorgen` (ARCHITECTURE.md).
 
 pub mod candump;
 pub mod commission;
+pub mod error;
 pub mod flux;
+pub mod identify;
 pub mod recording;
 pub mod resolver;
 pub mod sim_drive;
+pub mod socket;
 pub mod step;
 pub mod synthetic;
 pub mod writeback;
+
+pub use error::{Error, Problem};
+pub use identify::Input;
 
 /// Mean and spread of one quantity over several recordings.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -27,7 +27,7 @@ impl Noise {
 
 /// Noise σ in ADC LSB (a realistic 12-bit current channel: a few LSB of noise).
 pub const NOISE_LSB: f64 = 3.0;
-/// Transport delay of the generated recordings [samples].
+/// Transport delay of the generated recordings \[samples\].
 pub const DELAY: f64 = 1.5;
 
 /// A `step` recording of the blocked rotor with resistance `r`, inductance `l`:

@@ -108,6 +108,22 @@ impl From<Diagnostics> for Failure {
     }
 }
 
+/// The library's failures, each with its exit code: bad input 1, an unreadable input
+/// 74, the CAN interface 69, the drive's refusal or abort 6, no capture in time 75.
+impl From<motor_commission::Error> for Failure {
+    fn from(e: motor_commission::Error) -> Self {
+        use motor_commission::Error as E;
+        let exit = match &e {
+            E::Input(_) | E::Option(_) => Exit::BadInput,
+            E::Unreadable(_) => Exit::Io,
+            E::BusUnavailable(_) => Exit::CanUnavailable,
+            E::Refused { .. } | E::Aborted { .. } => Exit::Refused,
+            E::Timeout { .. } => Exit::Timeout,
+        };
+        Failure::new(exit, e.to_string())
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -133,6 +149,53 @@ mod tests {
                 format!("\n  {code} ")
             };
             assert!(HELP.contains(&row), "{e:?}");
+        }
+    }
+
+    /// Each of the library's failures has the exit code the README documents, and its
+    /// message unchanged.
+    #[test]
+    fn library_failures_have_their_exit_codes() {
+        use motor_commission::{Error, Problem};
+        use motor_control::can_protocol::Reason;
+        let located = Diagnostics(vec![codegen::Diagnostic {
+            file: "m.toml".into(),
+            line: 3,
+            column: 1,
+            key: String::new(),
+            problem: "bad".into(),
+            accepted: "good".into(),
+            excerpt: String::new(),
+        }]);
+        let problem = Problem::new("--trip", "bad", "good");
+        let iface = || "can0".to_string();
+        for (e, exit) in [
+            (Error::Input(located.clone()), Exit::BadInput),
+            (Error::Option(problem.clone()), Exit::BadInput),
+            (Error::Unreadable(located), Exit::Io),
+            (Error::BusUnavailable(problem), Exit::CanUnavailable),
+            (
+                Error::Refused {
+                    iface: iface(),
+                    reason: Reason::Busy,
+                },
+                Exit::Refused,
+            ),
+            (Error::Aborted { iface: iface() }, Exit::Refused),
+            (
+                Error::Timeout {
+                    iface: iface(),
+                    waited: std::time::Duration::from_secs(2),
+                    last_status: None,
+                    capture_frames: 0,
+                    limit: "2 s".into(),
+                },
+                Exit::Timeout,
+            ),
+        ] {
+            let message = e.to_string();
+            let f = Failure::from(e);
+            assert_eq!((f.exit, f.message), (exit, message));
         }
     }
 }

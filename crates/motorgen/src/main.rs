@@ -15,6 +15,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand, ValueEnum};
 use codegen::render::{Output, render_with};
 use exit::{Exit, Failure};
+use motor_commission::Input;
 use output::{out, outln};
 
 /// Motor description (TOML) → tuned motor-controller constants.
@@ -194,43 +195,24 @@ fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String
     }
 }
 
-/// Reads a spec as UTF-8 text: an unreadable file is an I/O failure, invalid UTF-8 bad
-/// input; both name the file.
+/// Reads a spec or board file as UTF-8 text: an unreadable file is an I/O failure,
+/// invalid UTF-8 bad input; both name the file.
 fn read_spec(path: &Path) -> Result<String, Failure> {
-    let file = path.display().to_string();
-    let bytes = std::fs::read(path).map_err(|e| {
-        let d = codegen::Diagnostic {
-            file: file.clone(),
-            line: 1,
-            column: 1,
-            key: String::new(),
-            problem: format!("cannot read the file: {e}"),
-            accepted: "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)".into(),
-            excerpt: String::new(),
-        };
-        Failure::new(Exit::Io, codegen::Diagnostics(vec![d]).to_string())
-    })?;
-    spec_text(path, bytes)
+    Ok(read_input(path).text?)
 }
 
-/// A spec's bytes as UTF-8 text, or bad input located at the first invalid byte.
-fn spec_text(path: &Path, bytes: Vec<u8>) -> Result<String, Failure> {
-    let file = path.display().to_string();
-    String::from_utf8(bytes).map_err(|e| {
-        let at = e.utf8_error().valid_up_to();
-        let text = String::from_utf8_lossy(e.as_bytes());
-        let d = codegen::Source {
-            file: &file,
-            text: &text,
-        }
-        .error(
-            at..at,
-            "",
-            format!("the file is not valid UTF-8 (byte {at})"),
-            "a UTF-8 text file; save the spec as UTF-8",
-        );
-        Failure::from(codegen::Diagnostics::from(d))
-    })
+/// A spec or board file as the library crates take it: its text, or why it could not be
+/// read (an unreadable file, or bad input located at its first invalid UTF-8 byte).
+fn read_input(path: &Path) -> Input {
+    let name = path.display().to_string();
+    match std::fs::read(path) {
+        Ok(bytes) => Input::from_bytes(name, bytes),
+        Err(e) => Input::unreadable(
+            name,
+            format!("cannot read the file: {e}"),
+            "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)",
+        ),
+    }
 }
 
 fn design(path: &Path) -> Result<codegen::Design, Failure> {
@@ -418,15 +400,12 @@ fn run(command: Command) -> Result<(), Failure> {
             out,
         } => {
             atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
-            let layout = identify::layout(&spec, &board)?;
-            let mut files = Vec::new();
-            for (k, (file, _, cap, csv)) in identify::read_logs(&candump, &layout)?.into_iter().enumerate() {
-                let stem = Path::new(&file)
-                    .file_stem()
-                    .map_or_else(|| "capture".into(), |s| s.to_string_lossy().into_owned());
-                let kind = motor_commission::candump::kind_of(cap.header.routine).name();
-                files.push((out.join(format!("{stem}-{}-{kind}.csv", k + 1)), csv.into_bytes()));
-            }
+            let (spec, board) = (read_input(&spec), read_input(&board));
+            let logs = identify::read_logs(&candump);
+            let files: Vec<(PathBuf, Vec<u8>)> = motor_commission::identify::capture_files(&spec, &board, &logs)?
+                .into_iter()
+                .map(|(name, csv)| (out.join(name), csv.into_bytes()))
+                .collect();
             let written = atomic::write_set(&out, &files)?;
             for ((path, _), w) in files.iter().zip(written) {
                 outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());

@@ -50,6 +50,17 @@ pub fn warn(args: Arguments<'_>) {
     stderr(format_args!("warning: {args}\n"));
 }
 
+/// Standard output as a [`std::fmt::Write`] (for the library's result tables), with
+/// [`stdout`]'s handling of failures (it never returns an error).
+pub struct Stdout;
+
+impl std::fmt::Write for Stdout {
+    fn write_str(&mut self, s: &str) -> std::fmt::Result {
+        stdout(format_args!("{s}"));
+        Ok(())
+    }
+}
+
 /// `print!` without the panic.
 macro_rules! out {
     ($($t:tt)*) => { $crate::output::stdout(format_args!($($t)*)) };

@@ -3,6 +3,7 @@
 
 mod can_round_trip;
 mod cli;
+mod commission;
 mod common;
 mod firmware_image;
 mod identify;

@@ -1,0 +1,92 @@
+//! `motorgen commission` as a user runs it, as far as it goes without a drive on a bus:
+//! the exit codes of what is checked before and at the bus (bad options 1, no CAN
+//! interface 69) and that nothing is written then. The session against the simulated
+//! drive, its refusal, abort and timeout are tested on the library
+//! (`cargo test -p motor-commission --test it commission`); the files written after a
+//! session in the binary's own tests (`cargo test -p motorgen --bin motorgen commission`).
+
+use crate::common::{motorgen, text_of, tmp};
+
+/// The spec copied into a fresh directory, and the (not yet existing) `--out` there.
+fn setup(name: &str) -> (std::path::PathBuf, String, String) {
+    let dir = tmp("commission", name);
+    let spec = dir.join("fischer-ti085.toml");
+    std::fs::copy(crate::common::repo().join("motors/fischer-ti085.toml"), &spec).unwrap();
+    let out = dir.join("out");
+    (dir, spec.display().to_string(), out.display().to_string())
+}
+
+fn commission(spec: &str, can: &str, out: &str, routine: &[&str]) -> std::process::Output {
+    let mut args = vec![
+        "commission",
+        spec,
+        "--board",
+        "boards/motorgen-reference.toml",
+        "--can",
+        can,
+        "--out",
+        out,
+        "--date",
+        "2025-03-14",
+    ];
+    args.extend(routine);
+    motorgen(&args)
+}
+
+/// No such interface: exit 69 naming it, nothing written (on Linux the socket cannot be
+/// opened, elsewhere SocketCAN is missing).
+#[test]
+fn missing_interface_exits_69() {
+    let (dir, spec, out) = setup("missing");
+    let before = std::fs::read_to_string(&spec).unwrap();
+    let o = commission(
+        &spec,
+        "mgnone0",
+        &out,
+        &["step", "--axis", "d", "--voltage", "1 V", "--trip", "10 A"],
+    );
+    assert_eq!(o.status.code(), Some(69), "{}", text_of(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("mgnone0") && err.contains("accepted:"), "{err}");
+    assert!(!dir.join("out").exists());
+    assert_eq!(std::fs::read_to_string(&spec).unwrap(), before);
+}
+
+/// Options that are wrong before the bus is touched: exit 1 naming the option, nothing
+/// written; the interface is not even opened (a missing one would be exit 69).
+#[test]
+fn bad_options_exit_1() {
+    let (dir, spec, out) = setup("options");
+    for (routine, option) in [
+        (
+            &["step", "--axis", "q", "--voltage", "2 V", "--trip", "10 V"][..],
+            "--trip",
+        ),
+        (&["resolver-offset", "--voltage", "0 V"][..], "--voltage"),
+    ] {
+        let o = commission(&spec, "mgnone0", &out, routine);
+        assert_eq!(o.status.code(), Some(1), "{}", text_of(&o));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.starts_with(&format!("error: {option}: ")), "{err}");
+    }
+    let o = motorgen(&[
+        "commission",
+        &spec,
+        "--board",
+        "boards/motorgen-reference.toml",
+        "--can",
+        "mgnone0",
+        "--out",
+        &out,
+        "--decimation",
+        "0",
+        "flux",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text_of(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--decimation"),
+        "{}",
+        text_of(&o)
+    );
+    assert!(!dir.join("out").exists());
+}
