@@ -12,8 +12,8 @@
 use super::Source::{Custom, F32};
 use super::Text::{Lit, Of};
 use super::{Decl, Group, Json, count, declare, intv, phys, u8_array};
-use crate::board::design::BoardOut;
 use crate::board::{ADC_CLOCK_HZ, AdcSlot, Board};
+use crate::design::BoardOut;
 use crate::design::Design;
 
 /// `port·16 + pin` codes as pin names, `—` for none.

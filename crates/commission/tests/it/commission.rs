@@ -5,12 +5,9 @@
 //! a bench, and each failure as its own `Error` variant (the exit codes are `motorgen`'s,
 //! tested there).
 //!
-//! The bench here is the simulated drive around the firmware's control step configured
-//! from the design through the control core's own mapping
-//! (`ControllerConfig::from_parameters`), with the design's dq motor (no harmonics or
-//! saturation) as the plant: this crate may not depend on `motor-verify`, whose
-//! `Setup::bench` the command line's tests use. Only the plant's R and L_d matter to the
-//! checks.
+//! The bench is `motor_verify::Setup::bench` — the firmware's control step configured
+//! from the design and `verify`'s plant — as in the command line's tests (a
+//! dev-dependency: the library itself does not depend on `motor-verify`).
 
 use std::time::Duration;
 
@@ -19,76 +16,12 @@ use codegen::{Design, Source};
 use motor_commission::commission::{self, BusFrame, Captured, FrameBus, Options, Plan, RoutineOptions};
 use motor_commission::sim_drive::SimulatedDrive;
 use motor_commission::{Error, Input, socket};
-use motor_control::angle::to_radians_f64;
 use motor_control::can_protocol::{Frame, Reason};
 use motor_control::commissioning::Axis;
-use motor_control::modulation::centre_aligned_period;
-use motor_control::pi::PiConfig;
-use motor_control::step::{ControllerConfig, ControllerParameters};
-use motor_sim::bench::Bench as SimBench;
-use motor_sim::plant::{MotorModel, Plant, Shaft, SpeedProfile};
 use motor_test_support::repo;
 
 const SPEC: &str = "motors/fischer-ti085.toml";
 const BOARD: &str = "boards/motorgen-reference.toml";
-
-/// The firmware's control step and a dq plant for design `d` at standstill (see the
-/// module doc): the mapping of `motor_verify::controller::controller_parameters`.
-fn sim_bench(d: &Design) -> SimBench {
-    let cl = &d.current_loop;
-    let o = &d.angle_observer;
-    let s = &d.scaling;
-    let axis = |g: &codegen::design::current_loop::AxisGains| PiConfig {
-        kp: g.kp as f32,
-        ki: g.ki as f32,
-        anti_windup: g.anti_windup_gain as f32,
-        active_damping: g.active_damping_ohm as f32,
-        reference_filter: g.reference_filter as f32,
-    };
-    let cfg = ControllerConfig::from_parameters(&ControllerParameters {
-        sample_period: d.drive.sample_period_s as f32,
-        speed_per_lsb: s.speed.si_per_lsb as f32,
-        current_offset_code: 1 << 15,
-        current_per_lsb: s.phase_current.si_per_lsb as f32,
-        current_phases: 3,
-        dc_link_per_lsb: s.dc_link_voltage.si_per_lsb as f32,
-        observer_kp_q31: o.gains.kp_q31,
-        observer_ki_q31: o.gains.ki_q31,
-        observer_error_form: o.error_form,
-        motor_pole_pairs: o.motor_pole_pairs,
-        resolver_pole_pairs: o.resolver_pole_pairs,
-        resolver_offset_q31: o.resolver_offset_q31.unwrap_or(0),
-        lead_q16: o.lead_q16,
-        d: axis(&cl.d),
-        q: axis(&cl.q),
-        ld: cl.feedforward.d_inductance_h as f32,
-        lq: cl.feedforward.q_inductance_h as f32,
-        psi_m: cl.feedforward.flux_linkage_wb.unwrap_or(0.0) as f32,
-        dc_link_min: d.drive.dc_link_voltage_min_v as f32,
-        // TIM1 at 170 MHz, centre-aligned (the firmware's hw::TIMER_CLOCK_HZ).
-        pwm_period: centre_aligned_period(170_000_000, d.drive.switching_frequency_hz as f32).unwrap_or(u16::MAX),
-    });
-    let motor = MotorModel {
-        pole_pairs: d.motor.pole_pairs,
-        resistance: d.motor.phase_resistance_ohm,
-        ld: d.motor.d_inductance_h,
-        lq: d.motor.q_inductance_h,
-        psi: d.motor.flux_linkage_wb.unwrap_or(0.0),
-        l6: 0.0,
-        psi_d: [0.0; 2],
-        psi_q: [0.0; 2],
-        q_saturation: Vec::new(),
-    };
-    let mut plant = Plant::new(
-        motor,
-        Shaft::Imposed(SpeedProfile::constant(0.0)),
-        d.drive.sample_period_s,
-        d.drive.dc_link_voltage_v,
-    );
-    plant.resolver_pole_pairs = o.resolver_pole_pairs;
-    plant.resolver_offset = to_radians_f64(o.resolver_offset_q31.unwrap_or(0));
-    SimBench::new(cfg, plant)
-}
 
 /// The Fischer spec and the reference board as read, the design, and the plant's R and
 /// L_d.
@@ -119,7 +52,10 @@ fn bench() -> Bench {
 impl Bench {
     /// The drive on the simulated motor at standstill.
     fn drive(&self) -> SimulatedDrive {
-        SimulatedDrive::new(&self.design, sim_bench(&self.design), 0.0).unwrap()
+        let text = self.spec.text().unwrap();
+        let spec = codegen::spec::parse(Source { file: SPEC, text }).unwrap();
+        let setup = motor_verify::Setup::new(&spec, &self.design);
+        SimulatedDrive::new(&self.design, setup.bench(0.0), 0.0).unwrap()
     }
 
     /// A d-axis step to 30 % of the current limit, tripping at 80 %, on `sim0`.
