@@ -16,6 +16,9 @@
 //! [`crate::design::on_board`].
 
 pub mod chip;
+pub mod current;
+pub mod gates;
+pub mod parts;
 mod raw;
 pub mod sampling;
 mod sequence;
@@ -28,7 +31,11 @@ use crate::diagnostic::{Diagnostics, Source};
 use crate::spec::{Param, Provenance, ResolveContext};
 use crate::units::Kind;
 use chip::Chip;
-pub use raw::{Boot0Handling, Polarity, SampleInstant};
+pub use current::CurrentSensing;
+pub use gates::{GateDriver, GateInput};
+pub use raw::{
+    Boot0Handling, ComparatorOutput, Direction, InputLogic, InputPull, Placement, Polarity, SampleInstant, SensorKind,
+};
 use raw::{PinName, RawBoard, RawPins};
 pub use sequence::{AdcSlot, Converter};
 
@@ -243,12 +250,16 @@ pub struct Board {
     pub boot0: Option<Boot0Handling>,
     /// Break-input polarity.
     pub break_polarity: Polarity,
+    /// The over-current comparator's output stage, if the board states it.
+    pub break_output: Option<ComparatorOutput>,
+    /// The gate driver's inputs.
+    pub gate_driver: GateDriver,
+    /// The phase-current sensing, with its signed gain at the ADC pin.
+    pub current: CurrentSensing,
+    /// HSE crystal frequency \[Hz\], if the board has one (`[clock] hse`).
+    pub hse_hz: Option<f64>,
     /// V_REF+ of the ADC \[V\].
     pub adc_reference_v: f64,
-    /// Current-sensor gain at the ADC pin \[V/A\].
-    pub current_gain_v_per_a: f64,
-    /// ADC-pin voltage at zero current \[V\].
-    pub current_offset_v: f64,
     /// DC-link divider ratio V_pin/U_dc.
     pub dc_link_divider: f64,
     /// When the currents are sampled.
@@ -277,6 +288,9 @@ pub struct Board {
     pub torque_resolution_nm: f64,
     /// Independent-watchdog timeout \[s\].
     pub watchdog_timeout_s: f64,
+    /// What the board states that contradicts its parts' datasheets, located at the key
+    /// (also printed by `motorgen check`).
+    pub warnings: Vec<String>,
     /// Key → span of every value, for design checks located at the board key.
     #[serde(skip)]
     pub spans: Vec<(String, Range<usize>)>,
@@ -299,7 +313,7 @@ impl Board {
     /// Full scale of the current measurement \[A\]: the smaller of the two distances from
     /// the zero-current level to the ADC's rails, divided by the gain.
     pub fn current_full_scale_a(&self) -> f64 {
-        self.current_offset_v.min(self.adc_reference_v - self.current_offset_v) / self.current_gain_v_per_a
+        self.current.offset_v.min(self.adc_reference_v - self.current.offset_v) / self.current.gain_v_per_a.abs()
     }
 
     /// Full scale of the DC-link measurement \[V\]: V_REF+/ratio.
@@ -329,6 +343,29 @@ pub fn break_active_high(board: &Board) -> bool {
     board.break_polarity == Polarity::ActiveHigh
 }
 
+/// TIM1_CCER's polarity bits for the board's gate driver ([`gates::ccer_polarity`]).
+pub fn tim1_ccer_polarity(board: &Board) -> u32 {
+    gates::ccer_polarity(&board.gate_driver)
+}
+
+/// TIM1_CR2's idle levels OISx/OISxN for the board's gate driver ([`gates::cr2_idle`]).
+pub fn tim1_cr2_idle(board: &Board) -> u32 {
+    gates::cr2_idle(&board.gate_driver)
+}
+
+/// GPIOx_PUPDR code for the break pin (RM0440 GPIOx_PUPDR: 00 none, 01 pull-up, 10
+/// pull-down): with a push-pull comparator none; otherwise (open drain, or an output
+/// stage the board does not state) a pull to the inactive level, so that the line is
+/// never left floating into TIM1_BKIN — up for an active-low break, down for an
+/// active-high one.
+pub fn break_pull(board: &Board) -> u8 {
+    match (board.break_output, board.break_polarity) {
+        (Some(ComparatorOutput::PushPull), _) => 0b00,
+        (_, Polarity::ActiveLow) => 0b01,
+        (_, Polarity::ActiveHigh) => 0b10,
+    }
+}
+
 /// Whether the currents are sampled at the carrier maximum (low-side pulse centre).
 pub fn samples_at_carrier_maximum(board: &Board) -> bool {
     board.sample_instant == SampleInstant::LowSideCentre
@@ -345,7 +382,7 @@ pub fn parse(source: Source<'_>) -> Result<Board, Diagnostics> {
                 0..0,
                 "",
                 "the file is empty",
-                format!("a board file with `name`, `chip`, [pins], [break_input], [sensing], [pwm], [protection], [can] and [watchdog] (see {EXAMPLE})"),
+                format!("a board file with `name`, `chip`, [pins], [break_input], [gate_driver], [current_sensing], [sensing], [pwm], [protection], [can] and [watchdog] (see {EXAMPLE})"),
             )
             .into());
     }
@@ -442,26 +479,51 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
             "the ADC reference the board supplies, 2 V to 3.6 V (DS12288 Table 66), e.g. \"3.3 V\"",
         );
     }
-    let gain = q(
-        cx,
-        &mut spans,
-        "sensing.current_gain",
-        &s.current_gain,
-        Kind::Transresistance,
-    );
-    spans.push(("sensing.current_offset".into(), s.current_offset.span()));
-    let offset = cx.quantity(
-        "sensing.current_offset",
-        &s.current_offset,
-        Kind::Voltage,
-        Provenance::Datasheet,
-        false,
-    );
-    if let (Some(o), Some(v)) = (&offset, &vref)
-        && !(o.value > 0.0 && o.value < v.value)
-    {
-        cx.err(o.span.clone(), "sensing.current_offset", format!("the zero-current level {} V is not inside the ADC range 0 … {} V: one current direction could not be measured", o.value, v.value), "the sensor output at 0 A, between 0 V and the ADC reference (bipolar phase currents), e.g. half the reference");
+    for (moved, key, to) in [
+        (&s.current_gain, "sensing.current_gain", "[current_sensing]: kind, placement, shunt and amplifier_gain (or a Hall sensor's sensitivity and direction), from which the signed gain is derived"),
+        (&s.current_offset, "sensing.current_offset", "[current_sensing] offset = \"1.65 V\""),
+    ] {
+        if let Some(v) = moved {
+            cx.err(
+                v.span(),
+                key,
+                format!("`{key}` is no longer a board fact: the current sensing is described by its parts, whose sign the board's gain alone cannot give (a low-side shunt inverts it)"),
+                to,
+            );
+        }
     }
+    let current = current::resolve(cx, &raw.current_sensing, vref.as_ref(), &s.sample_instant, &mut spans);
+    let mut part_warnings = Vec::new();
+    let gate_driver = gates::resolve(cx, &raw.gate_driver, &mut spans, &mut part_warnings);
+    let b = raw.break_input.get_ref();
+    let break_polarity = *b.polarity.get_ref();
+    spans.push(("break_input.polarity".into(), b.polarity.span()));
+    let break_output = b.output.as_ref().map(|o| {
+        spans.push(("break_input.output".into(), o.span()));
+        if *o.get_ref() == ComparatorOutput::OpenDrain && break_polarity == Polarity::ActiveHigh {
+            cx.err(
+                o.span(),
+                "break_input.output",
+                "an open-drain output can only pull the line low, so it cannot signal an active-high break",
+                "polarity = \"active_low\" with an open-drain comparator, or output = \"push_pull\"",
+            );
+        }
+        *o.get_ref()
+    });
+    let hse = raw.clock.as_ref().and_then(|c| c.get_ref().hse.as_ref()).and_then(|v| {
+        spans.push(("clock.hse".into(), v.span()));
+        let f = cx.quantity("clock.hse", v, Kind::Frequency, Provenance::Datasheet, true)?;
+        if !(4e6..=48e6).contains(&f.value) {
+            cx.err(
+                f.span.clone(),
+                "clock.hse",
+                format!("{} MHz is outside the HSE oscillator's range", f.value / 1e6),
+                "a crystal between 4 MHz and 48 MHz (DS12288 features: 4 to 48 MHz crystal oscillator), e.g. \"24 MHz\"",
+            );
+            return None;
+        }
+        Some(f.value)
+    });
     spans.push(("sensing.dc_link_divider".into(), s.dc_link_divider.span()));
     let divider = cx.number(
         "sensing.dc_link_divider",
@@ -542,10 +604,10 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         Kind::Voltage,
     );
     let os = q(cx, &mut spans, "protection.over_speed", &pr.over_speed, Kind::Speed);
-    if let (Some(oc), Some(o), Some(v), Some(g)) = (&oc, &offset, &vref, &gain) {
-        let fs = o.value.min(v.value - o.value) / g.value;
+    if let (Some(oc), Some(c), Some(v)) = (&oc, &current, &vref) {
+        let fs = c.offset_v.min(v.value - c.offset_v) / c.gain_v_per_a.abs();
         if oc.value > fs {
-            cx.err(oc.span.clone(), "protection.over_current", format!("{} A is beyond what the board measures, ±{fs:.2} A ({} V reference, {} V at 0 A, {} V/A): the trip could never see it", oc.value, v.value, o.value, g.value), format!("a trip level up to {fs:.2} A, or a sensor with a lower gain"));
+            cx.err(oc.span.clone(), "protection.over_current", format!("{} A is beyond what the board measures, ±{fs:.2} A ({} V reference, {} V at 0 A, {} V/A): the trip could never see it", oc.value, v.value, c.offset_v, c.gain_v_per_a), format!("a trip level up to {fs:.2} A, or a sensor with a lower gain"));
         }
     }
     if let (Some(ov), Some(v), Some(d)) = (&ov, &vref, &divider) {
@@ -611,10 +673,12 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         package: chip.package,
         pins: pins?,
         boot0,
-        break_polarity: *raw.break_input.get_ref().polarity.get_ref(),
+        break_polarity,
+        break_output,
+        gate_driver: gate_driver?,
+        current: current?,
+        hse_hz: hse,
         adc_reference_v: vref?.value,
-        current_gain_v_per_a: gain?.value,
-        current_offset_v: offset?.value,
         dc_link_divider: divider?.value,
         sample_instant: *s.sample_instant.get_ref(),
         adc: adc?,
@@ -629,8 +693,18 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         setpoint_ramp_s: ramp?.value,
         torque_resolution_nm: lsb?.value,
         watchdog_timeout_s: wd?.value,
+        warnings: part_warnings
+            .into_iter()
+            .map(|(span, key, problem)| located(cx.src, span, &key, &problem))
+            .collect(),
         spans,
     })
+}
+
+/// `file:line:column: `key`: problem` for a warning at `span`.
+fn located(src: Source<'_>, span: Range<usize>, key: &str, problem: &str) -> String {
+    let d = src.error(span, key, problem, "");
+    format!("{}:{}:{}: `{key}`: {problem}", d.file, d.line, d.column)
 }
 
 /// Every signal's pin: exists, carries the function, used once.
@@ -760,8 +834,7 @@ pub fn warning_at(board: &Board, text: &str, key: &str, problem: &str) -> String
         file: &board.file,
         text,
     };
-    let d = src.error(board.span(key), key, problem, "");
-    format!("{}:{}:{}: `{key}`: {problem}", d.file, d.line, d.column)
+    located(src, board.span(key), key, problem)
 }
 
 /// A resolved value's provenance for the constants (board files are datasheet-like).
@@ -825,7 +898,11 @@ mod tests {
     /// The NUCLEO-G474RE + X-NUCLEO-IHM08M1: low-side shunts at the low-side centre,
     /// ±min(1.71, 1.59) V/51.8 mV/A = ±30.69 A, 3.3 V/0.05221 = 63.2 V (ST's MC SDK
     /// figure for the board); the divider's 8.82 kΩ on the fast PA1 needs the 12 kΩ row
-    /// (4125 ns) → 247.5 cycles at 42.5 MHz (5.82 µs).
+    /// (4125 ns) → 247.5 cycles at 42.5 MHz (5.82 µs). The parts: L6398 (LIN inverted:
+    /// CC1NP..CC3NP, OIS1N..OIS3N, low-side pins high when off), a low-side shunt behind a
+    /// non-inverting 5.18 stage (−10 mΩ·5.18 = −51.8 mV/A), the 24 MHz HSE; the currents'
+    /// 1 kΩ bound needs DS12288 Table 67's 1.5 kΩ (fast) / 1.2 kΩ (slow) rows, 408.33 ns
+    /// → 24.5 cycles at 42.5 MHz (576 ns) on PA0 (fast IN1) and PC1, PC0 (slow IN7, IN6).
     #[test]
     fn nucleo_ihm08m1_board() {
         let b = board(
@@ -836,9 +913,41 @@ mod tests {
         assert_eq!(b.sample_instant, SampleInstant::LowSideCentre);
         assert_eq!(b.pin(Signal::GateULow).map(|p| (p.pin, p.af)), Some(("PA7", Some(6))));
         assert_eq!(b.pin(Signal::BreakInput).map(|p| (p.pin, p.af)), Some(("PA6", Some(6))));
+        assert!((b.current.gain_v_per_a + 0.0518).abs() < 1e-12);
         assert!((b.current_full_scale_a() - (3.3 - 1.71) / 0.0518).abs() < 1e-9);
         assert!((b.dc_link_full_scale_v() - 63.206).abs() < 1e-3);
         let dc = b.adc.iter().flatten().find(|s| s.signal == Signal::DcLink).unwrap();
         assert_eq!((dc.pin, dc.sampling.fast, dc.sampling.cycles), ("PA1", true, 247.5));
+        for (signal, pin, fast) in [
+            (Signal::CurrentU, "PA0", true),
+            (Signal::CurrentV, "PC1", false),
+            (Signal::CurrentW, "PC0", false),
+        ] {
+            let s = b.adc.iter().flatten().find(|s| s.signal == signal).unwrap();
+            assert_eq!((s.pin, s.sampling.fast, s.sampling.cycles), (pin, fast, 24.5), "{signal:?}");
+        }
+        assert_eq!(b.gate_driver.part.as_deref(), Some("L6398"));
+        assert_eq!(tim1_ccer_polarity(&b), 0x0888);
+        assert_eq!(tim1_cr2_idle(&b), 0x2A00);
+        assert_eq!(gates::off_levels(&b.gate_driver), [0, 0, 0, 1, 1, 1]);
+        assert_eq!(break_pull(&b), 0b01);
+        assert_eq!(b.hse_hz, Some(24e6));
+        assert!(b.warnings.is_empty(), "{:?}", b.warnings);
+    }
+
+    /// The reference board keeps the facts the firmware assumed: in-phase isolated
+    /// drivers (no polarity or idle bit), Hall sensors reading +15 mV/A, no HSE.
+    #[test]
+    fn reference_board_parts() {
+        let b = board(
+            "boards/motorgen-reference.toml",
+            include_str!("../../../../boards/motorgen-reference.toml"),
+        )
+        .unwrap();
+        assert_eq!((tim1_ccer_polarity(&b), tim1_cr2_idle(&b)), (0, 0));
+        assert_eq!(gates::off_levels(&b.gate_driver), [0; 6]);
+        assert!((b.current.gain_v_per_a - 0.015).abs() < 1e-12);
+        assert_eq!(b.hse_hz, None);
+        assert!(!b.gate_driver.interlock && b.gate_driver.dead_time_s.is_none());
     }
 }

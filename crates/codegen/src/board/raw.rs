@@ -22,11 +22,15 @@ pub struct RawBoard {
     #[serde(default)]
     pub boot0: Option<Spanned<RawBoot0>>,
     pub break_input: Spanned<RawBreak>,
+    pub gate_driver: Spanned<RawGateDriver>,
+    pub current_sensing: Spanned<RawCurrentSensing>,
     pub sensing: Spanned<RawSensing>,
     pub pwm: Spanned<RawPwm>,
     pub protection: Spanned<RawProtection>,
     pub can: Spanned<RawCan>,
     pub watchdog: Spanned<RawWatchdog>,
+    #[serde(default)]
+    pub clock: Option<Spanned<RawClock>>,
 }
 
 /// `[pins]`: one pin per signal (optional here so that a missing one is reported with
@@ -80,11 +84,126 @@ pub enum Polarity {
     ActiveHigh,
 }
 
+/// The over-current comparator's output stage.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ComparatorOutput {
+    /// Drives both levels (e.g. an op-amp section used as a comparator).
+    PushPull,
+    /// Only pulls low; the line needs a pull-up to its inactive level.
+    OpenDrain,
+}
+
 /// `[break_input]`.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct RawBreak {
     pub polarity: Spanned<Polarity>,
+    #[serde(default)]
+    pub output: Option<Spanned<ComparatorOutput>>,
+}
+
+/// How a gate-driver input turns its switch on.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InputLogic {
+    /// A high input turns the switch on (active high).
+    InPhase,
+    /// A low input turns the switch on (active low).
+    Inverted,
+}
+
+/// What holds a gate-driver input while nothing drives it (the driver's internal bias or
+/// the board's resistor).
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum InputPull {
+    /// Pulled to ground.
+    Down,
+    /// Pulled to the logic supply.
+    Up,
+    /// Nothing: the input floats.
+    None,
+}
+
+/// `[gate_driver]`: a part of the parts table, or its facts stated one by one (a
+/// stated fact wins over the part's and is warned about when it contradicts it).
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawGateDriver {
+    #[serde(default)]
+    pub part: Option<Spanned<String>>,
+    #[serde(default)]
+    pub high_side_input: Option<Spanned<InputLogic>>,
+    #[serde(default)]
+    pub low_side_input: Option<Spanned<InputLogic>>,
+    #[serde(default)]
+    pub high_side_pull: Option<Spanned<InputPull>>,
+    #[serde(default)]
+    pub low_side_pull: Option<Spanned<InputPull>>,
+    #[serde(default)]
+    pub interlock: Option<Spanned<bool>>,
+    #[serde(default)]
+    pub dead_time: Option<Val>,
+}
+
+/// What measures the phase currents.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum SensorKind {
+    /// A shunt resistor and an amplifier.
+    Shunt,
+    /// A Hall-effect current sensor (or any sensor with a voltage output per ampere).
+    Hall,
+}
+
+/// Where a shunt sits.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Placement {
+    /// Between each leg's low-side switch and ground: carries the phase current only while
+    /// the low side conducts.
+    LowSide,
+    /// In series with the phase, between the leg and the motor terminal.
+    Inline,
+    /// One shunt in the DC link's return (single-shunt reconstruction).
+    DcLink,
+}
+
+/// How a Hall sensor's positive current direction is mounted.
+#[derive(Debug, Clone, Copy, Deserialize, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Direction {
+    /// Positive for a current out of the inverter leg into the motor terminal.
+    LegToMotor,
+    /// Positive for a current from the motor terminal into the leg.
+    MotorToLeg,
+}
+
+/// `[current_sensing]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawCurrentSensing {
+    pub kind: Spanned<SensorKind>,
+    #[serde(default)]
+    pub placement: Option<Spanned<Placement>>,
+    #[serde(default)]
+    pub shunt: Option<Val>,
+    #[serde(default)]
+    pub amplifier_gain: Option<Val>,
+    #[serde(default)]
+    pub sensitivity: Option<Val>,
+    #[serde(default)]
+    pub direction: Option<Spanned<Direction>>,
+    pub offset: Val,
+}
+
+/// `[clock]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RawClock {
+    #[serde(default)]
+    pub hse: Option<Val>,
 }
 
 /// Where in the PWM period the phase currents are sampled.
@@ -103,8 +222,12 @@ pub enum SampleInstant {
 #[serde(deny_unknown_fields)]
 pub struct RawSensing {
     pub adc_reference: Val,
-    pub current_gain: Val,
-    pub current_offset: Val,
+    /// Moved to `[current_sensing]` (refused with a message saying so).
+    #[serde(default)]
+    pub current_gain: Option<Val>,
+    /// Moved to `[current_sensing] offset` (refused with a message saying so).
+    #[serde(default)]
+    pub current_offset: Option<Val>,
     pub dc_link_divider: Val,
     pub sample_instant: Spanned<SampleInstant>,
     #[serde(default)]

@@ -97,7 +97,7 @@ impl<'a> OnBoard<'a> {
         Decl {
             name: "CURRENT_OFFSET_CODE",
             value: Custom(|c| {
-                let physical = format!("{} V at 0 A", c.b.current_offset_v);
+                let physical = format!("{} V at 0 A", c.b.current.offset_v);
                 (intv(c.o.current_offset_code.into(), "i32", "int32_t"), physical)
             }),
             formula: Lit("V_0/V_REF+·2^16 (16-bit left-aligned code)"),
@@ -108,7 +108,9 @@ impl<'a> OnBoard<'a> {
         Decl {
             name: "CURRENT_PER_LSB",
             value: F32(|c| c.o.amps_per_lsb, "A"),
-            formula: Lit("V_REF+/(G·2^16)"),
+            formula: Lit(
+                "V_REF+/(G·2^16), G the signed gain at the pin (shunt: gain·R, −R for low-side shunts; Hall: ±sensitivity)",
+            ),
             equation: Lit("thesis A (4.16)"),
             inputs: Of(|c| c.current.clone()),
             json: Json::At("/board/amps_per_lsb"),
@@ -179,6 +181,74 @@ impl<'a> OnBoard<'a> {
             equation: Lit("RM0440 §29.6.20"),
             inputs: Of(|c| c.key("break_input.polarity")),
             json: Json::At("/board/break_active_high"),
+        },
+        Decl {
+            name: "BREAK_PULL",
+            value: Custom(|c| {
+                let physical = match c.o.break_pull {
+                    1 => "pull-up",
+                    2 => "pull-down",
+                    _ => "none",
+                };
+                (intv(c.o.break_pull.into(), "u8", "uint8_t"), physical.to_string())
+            }),
+            formula: Lit(
+                "GPIOx_PUPDR of the break pin: none for a push-pull comparator, else a pull to the inactive level",
+            ),
+            equation: Lit("RM0440 GPIOx_PUPDR"),
+            inputs: Of(|c| c.key("break_input.output, break_input.polarity")),
+            json: Json::At("/board/break_pull"),
+        },
+        Decl {
+            name: "TIM1_CCER_POLARITY",
+            value: Custom(|c| {
+                let v = c.o.tim1_ccer_polarity;
+                (intv(v.into(), "u32", "uint32_t"), format!("{v:#06x}"))
+            }),
+            formula: Lit("CCxP (bit 4x−3) for an inverted high-side input, CCxNP (bit 4x−1) for an inverted low-side input, x = 1..3"),
+            equation: Lit("RM0440 TIMx_CCER; gate-driver datasheet (parts table)"),
+            inputs: Of(|c| c.key("gate_driver")),
+            json: Json::At("/board/tim1_ccer_polarity"),
+        },
+        Decl {
+            name: "TIM1_CR2_IDLE",
+            value: Custom(|c| {
+                let v = c.o.tim1_cr2_idle;
+                (intv(v.into(), "u32", "uint32_t"), format!("{v:#06x}"))
+            }),
+            formula: Lit(
+                "OISx (bit 2x+6) / OISxN (bit 2x+7) = the input's off level (1 for an inverted input), x = 1..3; written before BDTR's LOCK",
+            ),
+            equation: Lit("RM0440 TIMx_CR2, TIMx_BDTR LOCK level 1"),
+            inputs: Of(|c| c.key("gate_driver")),
+            json: Json::At("/board/tim1_cr2_idle"),
+        },
+        Decl {
+            name: "GATE_OFF_LEVELS",
+            value: Custom(|c| {
+                let physical = format!("{:?}: u/v/w high, u/v/w low", c.o.gate_off_levels);
+                (u8_array(&c.o.gate_off_levels), physical)
+            }),
+            formula: Lit("pin level that turns each switch off: 0 for an in-phase input, 1 for an inverted one"),
+            equation: Lit("gate-driver datasheet (parts table)"),
+            inputs: Of(|c| c.key("gate_driver")),
+            json: Json::At("/board/gate_off_levels"),
+        },
+        Decl {
+            name: "HSE_HZ",
+            value: Custom(|c| {
+                let f = c.o.hse_hz;
+                let physical = if f == 0 {
+                    "no crystal".to_string()
+                } else {
+                    phys(f64::from(f), "Hz")
+                };
+                (intv(f.into(), "u32", "uint32_t"), physical)
+            }),
+            formula: Lit("HSE crystal frequency on the board, 0 = none"),
+            equation: Lit("DS12288 §5.3.7 (4–48 MHz)"),
+            inputs: Of(|c| c.key("clock.hse")),
+            json: Json::At("/board/hse_hz"),
         },
         Decl {
             name: "BOOT0_OPTION_BYTES",
@@ -367,10 +437,10 @@ pub fn group(d: &Design) -> Option<Group> {
         o,
         b,
         current: format!(
-            "V_REF+ = {} V, G = {} (sensing.current_gain), V_0 = {} V (sensing.current_offset), {file}",
+            "V_REF+ = {} V, G = {} ([current_sensing]), V_0 = {} V (current_sensing.offset), {file}",
             b.adc_reference_v,
-            phys(b.current_gain_v_per_a, "V/A"),
-            b.current_offset_v
+            phys(b.current.gain_v_per_a, "V/A"),
+            b.current.offset_v
         ),
         dc_link: format!(
             "V_REF+ = {} V, ratio {} (sensing.dc_link_divider), {file}",

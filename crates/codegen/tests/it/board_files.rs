@@ -126,6 +126,55 @@ const CORPUS: &[Case] = &[
         &["up to 110.00 A"],
     ),
     (
+        "gate-pull-turns-on.toml",
+        "\"down\"   # wrong",
+        "gate_driver.low_side_pull",
+        &["the low_side input is inverted and held down", "it turns its switch on"],
+        &["low_side_pull = \"up\""],
+    ),
+    (
+        "unknown-gate-driver.toml",
+        "\"L6399\"",
+        "gate_driver.part",
+        &["\"L6399\" is not in the parts table"],
+        &["L6398", "DRV8323", "IR2110", "1EDI20N12AF", "high_side_input"],
+    ),
+    (
+        "dc-link-shunt.toml",
+        "\"dc_link\"",
+        "current_sensing.placement",
+        &["single DC-link shunt", "does not reconstruct"],
+        &["\"low_side\" or \"inline\""],
+    ),
+    (
+        "low-side-shunt-sampled-high.toml",
+        "\"high_side_centre\"",
+        "sensing.sample_instant",
+        &["low-side shunts carry the phase current only while the low-side switch conducts"],
+        &["\"low_side_centre\""],
+    ),
+    (
+        "current-gain-moved.toml",
+        "\"15 mV/A\"   # the old",
+        "sensing.current_gain",
+        &["no longer a board fact", "low-side shunt inverts it"],
+        &["[current_sensing]", "amplifier_gain"],
+    ),
+    (
+        "open-drain-active-high.toml",
+        "\"open_drain\"",
+        "break_input.output",
+        &["open-drain output can only pull the line low"],
+        &["output = \"push_pull\""],
+    ),
+    (
+        "hse-out-of-range.toml",
+        "\"50 MHz\"",
+        "clock.hse",
+        &["50 MHz is outside the HSE oscillator's range"],
+        &["4 MHz and 48 MHz", "DS12288"],
+    ),
+    (
         "bare-number.toml",
         "500 ",
         "pwm.dead_time",
@@ -168,4 +217,50 @@ fn bad_boards_are_refused_at_the_key() {
             "{d}"
         );
     }
+}
+
+/// A board that names its driver and states facts contradicting it: the stated facts are
+/// used (an inverter on the board would explain them) and `check` warns at each key,
+/// citing the datasheet passage. Built from the NUCLEO file with LIN declared in phase
+/// (and pulled down, which an in-phase input needs: an in-phase input with the L6398's
+/// pull-up would turn its switch on at reset, which is refused).
+#[test]
+fn a_stated_fact_contradicting_its_part_is_warned_at_the_key() {
+    let text = std::fs::read_to_string(repo().join("boards/nucleo-g474re-ihm08m1.toml")).unwrap();
+    let stated = text.replace(
+        "part = \"L6398\"",
+        "part = \"L6398\"\nlow_side_input = \"in_phase\"   # contradicts the L6398\nlow_side_pull = \"down\"",
+    );
+    assert_ne!(stated, text);
+    let b = board::parse(Source {
+        file: "nucleo-stated.toml",
+        text: &stated,
+    })
+    .unwrap_or_else(|d| panic!("{d}"));
+    let (line, column) = position(&stated, "\"in_phase\"   # contradicts");
+    assert_eq!(b.warnings.len(), 2, "{:#?}", b.warnings);
+    let w = &b.warnings[0];
+    assert!(
+        w.starts_with(&format!("nucleo-stated.toml:{line}:{column}: `gate_driver.low_side_input`: ")),
+        "{w}"
+    );
+    for needle in ["in_phase", "L6398 has inverted", "truth table", "LIN is active low"] {
+        assert!(w.contains(needle), "{needle:?} not in {w}");
+    }
+    assert!(
+        b.warnings[1].contains("`gate_driver.low_side_pull`") && b.warnings[1].contains("Table 8"),
+        "{}",
+        b.warnings[1]
+    );
+    // The stated fact wins: no CCxNP, no OISxN.
+    assert_eq!(board::tim1_ccer_polarity(&b), 0);
+    assert_eq!(board::tim1_cr2_idle(&b), 0);
+    // The file as shipped: no warning, the L6398's inverted LIN.
+    let shipped = board::parse(Source {
+        file: "nucleo-g474re-ihm08m1.toml",
+        text: &text,
+    })
+    .unwrap();
+    assert!(shipped.warnings.is_empty(), "{:?}", shipped.warnings);
+    assert_eq!(board::tim1_ccer_polarity(&shipped), 0x0888);
 }

@@ -16,8 +16,8 @@
 use serde::Serialize;
 
 use crate::board::{
-    ADC_CLOCK_HZ, Board, PinUse, Signal, break_active_high, checks_option_bytes, samples_at_carrier_maximum,
-    sequence_time, warning_at,
+    ADC_CLOCK_HZ, Board, PinUse, Signal, break_active_high, break_pull, checks_option_bytes, gates,
+    samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle, warning_at,
 };
 use crate::design::Design;
 
@@ -34,7 +34,8 @@ pub struct BoardOut {
     pub board: Board,
     /// ADC code (16-bit left-aligned) at zero current: V_off/V_REF+·2^16.
     pub current_offset_code: i32,
-    /// Amperes per 16-bit code: V_REF+/(G·2^16).
+    /// Amperes per 16-bit code: V_REF+/(G·2^16), with the sign of the sensing's gain G
+    /// (negative for low-side shunts behind a non-inverting stage).
     pub amps_per_lsb: f64,
     /// Measurable current ± \[A\].
     pub current_full_scale_a: f64,
@@ -64,6 +65,17 @@ pub struct BoardOut {
     pub current_phases: u8,
     /// 1: break input active high (TIM1_BDTR.BKP = 1).
     pub break_active_high: u8,
+    /// GPIOx_PUPDR code of the break pin: 0 none, 1 pull-up, 2 pull-down.
+    pub break_pull: u8,
+    /// TIM1_CCER polarity bits CCxP/CCxNP (x = 1..3) for the gate driver's inputs.
+    pub tim1_ccer_polarity: u32,
+    /// TIM1_CR2 idle levels OISx/OISxN (x = 1..3): each input's off level.
+    pub tim1_cr2_idle: u32,
+    /// The level each gate pin (u/v/w high, u/v/w low) is driven to when the outputs are
+    /// off (the fault path's GPIO levels).
+    pub gate_off_levels: [u8; 6],
+    /// HSE crystal frequency \[Hz\], 0 when the board has none.
+    pub hse_hz: u32,
     /// 1: currents sampled at the carrier maximum (low-side centre), 0: at the minimum.
     pub sample_at_carrier_maximum: u8,
     /// 1: the image requires and checks the BOOT0 option bytes.
@@ -79,14 +91,18 @@ pub struct BoardOut {
 
 /// The board with the motor of `d`, and the warnings (each located at its board key).
 pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<String>) {
-    let mut warnings = Vec::new();
+    let mut warnings = board.warnings.clone();
     let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
     let i_fs = board.current_full_scale_a();
     let u_fs = board.dc_link_full_scale_v();
     let peak = d.motor.peak_current_a;
+    let gain_key = match board.current.kind {
+        crate::board::SensorKind::Shunt => "current_sensing.amplifier_gain",
+        crate::board::SensorKind::Hall => "current_sensing.sensitivity",
+    };
     if i_fs < peak {
         warn(
-            "sensing.current_gain",
+            gain_key,
             format!(
                 "the board measures ±{i_fs:.1} A but {} needs its peak current {peak:.1} A (√2·{:.1} A rms): currents above {i_fs:.1} A read as the ADC rail and trip the drive; size the sensing to the motor or lower its peak current",
                 d.name, d.motor.peak_current_a_rms
@@ -163,8 +179,8 @@ pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (
     let dead_s = d.drive.dead_time_s.map_or(board_dead, |spec| spec.max(board_dead));
     let out = BoardOut {
         board: board.clone(),
-        current_offset_code: (board.current_offset_v / board.adc_reference_v * CODES_16).round() as i32,
-        amps_per_lsb: board.adc_reference_v / (board.current_gain_v_per_a * CODES_16),
+        current_offset_code: (board.current.offset_v / board.adc_reference_v * CODES_16).round() as i32,
+        amps_per_lsb: board.adc_reference_v / (board.current.gain_v_per_a * CODES_16),
         current_full_scale_a: i_fs,
         dc_link_volts_per_lsb: board.adc_reference_v / (board.dc_link_divider * CODES_15),
         dc_link_full_scale_v: u_fs,
@@ -186,6 +202,11 @@ pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (
             .map(|q| q.iter().map(|x| x.sampling.smp_code).collect()),
         current_phases: if board.pin(Signal::CurrentW).is_some() { 3 } else { 2 },
         break_active_high: u8::from(break_active_high(board)),
+        break_pull: break_pull(board),
+        tim1_ccer_polarity: tim1_ccer_polarity(board),
+        tim1_cr2_idle: tim1_cr2_idle(board),
+        gate_off_levels: gates::off_levels(&board.gate_driver),
+        hse_hz: board.hse_hz.map_or(0, |f| f.round() as u32),
         sample_at_carrier_maximum: u8::from(samples_at_carrier_maximum(board)),
         boot0_option_bytes: u8::from(checks_option_bytes(board)),
         over_speed_electrical_rad_s: board.over_speed_rad_s * f64::from(d.motor.pole_pairs),
