@@ -1,18 +1,20 @@
 //! The closed loop: `motorgen verify`'s simulated drive ([`motor_sim::plant::Plant`]: the
 //! PMSM dq model with the spec's harmonics and L_q saturation, the ideal inverter, the
-//! resolver) driven by the bridge duties the image programs into TIM1, and read back
-//! through the board's sensing gains at each conversion's instant. The real control
-//! interrupt then runs the real control step against the simulated motor.
+//! resolver) driven by the switches the board's gate driver turns on from the pins the
+//! image drives ([`crate::bridge`]), and read back through the board's own sensing
+//! ([`crate::hardware`]: its sign and gain, not the board file's) at each conversion's
+//! instant. The real control interrupt then runs the real control step against the
+//! simulated motor.
 //!
 //! Time is the emulator's: at every TIM1 update event (and MOE change) the plant is
 //! integrated up to that instant with the duties that were active, then takes the new
 //! ones; a conversion at `t` sees the plant integrated on to `t` (a copy, so the
 //! period's integration stays one piece).
 
-use codegen::board::Signal;
 use motor_sim::plant::{Measured, Plant, SpeedProfile};
 use motor_verify::Setup;
 
+use crate::hardware::{Analog as Signal, Hardware};
 use crate::soc::Analog;
 use crate::wiring::Sensing;
 
@@ -44,15 +46,15 @@ impl Drive {
     /// The drive of `setup` (the same machine model `motorgen verify` builds from the
     /// spec and design, resolver pole pairs and offset from the design) at rest at
     /// θ_m = 0, the shaft following `speed`, the nominal DC link, gates off; sensed
-    /// through the design's board.
-    pub fn new(setup: &Setup<'_>, speed: SpeedProfile) -> Result<Self, String> {
+    /// through the board's hardware `hw`.
+    pub fn new(setup: &Setup<'_>, speed: SpeedProfile, hw: &Hardware) -> Self {
         let d = setup.design;
-        Ok(Self {
+        Self {
             plant: setup.plant(speed),
             max_step_s: d.drive.sample_period_s,
-            sensing: Sensing::new(d)?,
+            sensing: Sensing::new(hw),
             samples: Vec::new(),
-        })
+        }
     }
 
     /// Integrates `plant` from its time to `t` \[s\] with its pending duties, in steps of

@@ -1,5 +1,6 @@
-//! The image: `target/firmware/<motor>.elf` as `motorgen firmware` writes it, built
-//! once per motor for the default board (and reused by every test of that motor).
+//! The image: `target/firmware/[<board>/]<motor>.elf` as `motorgen firmware` writes it,
+//! built once per motor and board file (and reused by every test of that pair, across
+//! runs through a stamp of its inputs).
 //!
 //! ELF reading uses the `object` crate (already in the lock for `motorgen firmware`):
 //! loadable segments by physical address (LMA: `.data`'s initial values live in flash),
@@ -78,27 +79,78 @@ pub fn motors() -> Vec<String> {
     motor_test_support::motor_stems_filtered("EMULATOR_MOTORS")
 }
 
+/// The board file an image is built for: one of `boards/`, or a variant of one (the
+/// tests' boards with one fact changed), written where the build script reads it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct BoardFile {
+    /// Its stem (`BOARD`).
+    pub stem: String,
+    /// Its text.
+    pub text: String,
+    /// A variant: not the file in `boards/`.
+    pub variant: bool,
+}
+
+impl BoardFile {
+    /// `boards/<stem>.toml`.
+    pub fn shipped(stem: &str) -> Result<Self, String> {
+        let (_, text) = crate::wiring::read(&format!("boards/{stem}.toml"))?;
+        Ok(Self {
+            stem: stem.to_string(),
+            text,
+            variant: false,
+        })
+    }
+
+    /// A board file with the text `text`, named `<stem>.toml` (a variant of a shipped one).
+    pub fn variant(stem: &str, text: String) -> Self {
+        Self {
+            stem: stem.to_string(),
+            text,
+            variant: true,
+        }
+    }
+
+    /// The name messages give it: `boards/<stem>.toml`, or `variant-<hash>/<stem>.toml`.
+    pub fn file_name(&self) -> String {
+        if self.variant {
+            format!("variant-{:016x}/{}.toml", fnv(self.text.as_bytes()), self.stem)
+        } else {
+            format!("boards/{}.toml", self.stem)
+        }
+    }
+}
+
+/// FNV-1a, 64 bit.
+fn fnv(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
+    }
+    h
+}
+
 /// One build at a time: the firmware workspace's target directory holds one image.
 static BUILD: Mutex<()> = Mutex::new(());
 
-/// Images built by this process, by motor.
-static IMAGES: Mutex<Vec<(String, Image)>> = Mutex::new(Vec::new());
+/// Images built by this process, by motor and board text.
+static IMAGES: Mutex<Vec<(String, String, Image)>> = Mutex::new(Vec::new());
 
-/// The image of `motor`, built on first use in this process (see [`build`]).
-pub fn image(motor: &str) -> Result<Image, String> {
+/// The image of `motor` on `board`, built on first use in this process (see [`build`]).
+pub fn image(motor: &str, board: &BoardFile) -> Result<Image, String> {
     let mut cache = IMAGES.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
-    if let Some((_, i)) = cache.iter().find(|(m, _)| m == motor) {
+    if let Some((_, _, i)) = cache.iter().find(|(m, b, _)| m == motor && *b == board.text) {
         return Ok(i.clone());
     }
-    let i = build(motor)?;
-    cache.push((motor.to_string(), i.clone()));
+    let i = build(motor, board)?;
+    cache.push((motor.to_string(), board.text.clone(), i.clone()));
     Ok(i)
 }
 
 /// FNV-1a (64 bit) of every input of the image: the firmware sources and build scripts,
-/// the lock files, the motor's spec, the board files, codegen's sources and templates
-/// (the build script runs the design engine), the toolchain file.
-fn inputs_hash(motor: &str) -> u64 {
+/// the lock files, the motor's spec, the board file's text, codegen's sources and
+/// templates (the build script runs the design engine), the toolchain file.
+fn inputs_hash(motor: &str, board: &BoardFile) -> u64 {
     fn walk(dir: &Path, out: &mut Vec<PathBuf>) {
         let Ok(rd) = std::fs::read_dir(dir) else { return };
         for e in rd.flatten() {
@@ -122,7 +174,6 @@ fn inputs_hash(motor: &str) -> u64 {
         "firmware/control",
         "crates/codegen/src",
         "templates",
-        "boards",
     ] {
         walk(&repo.join(d), &mut files);
     }
@@ -136,33 +187,50 @@ fn inputs_hash(motor: &str) -> u64 {
     }
     files.push(repo.join("motors").join(format!("{motor}.toml")));
     files.sort();
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut bytes = Vec::new();
     for f in files {
         let name = f.strip_prefix(&repo).unwrap_or(&f).to_string_lossy().into_owned();
-        for b in name.bytes().chain(std::fs::read(&f).unwrap_or_default()) {
-            h = (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3);
-        }
+        bytes.extend(name.bytes());
+        bytes.extend(std::fs::read(&f).unwrap_or_default());
     }
-    h
+    bytes.extend(board.stem.bytes());
+    bytes.extend(board.text.bytes());
+    fnv(&bytes)
 }
 
-/// `target/firmware/<motor>.elf` for the default board, built as `motorgen firmware`
-/// builds it (`MOTOR=<motor> cargo build --release --target thumbv7em-none-eabihf -p
-/// motor-firmware` in `firmware/`, its own target directory) and copied there with a
-/// stamp of its inputs: an image whose stamp matches is reused without running cargo
-/// (switching `MOTOR` makes cargo rebuild the image, a minute each on 2 cores).
-pub fn build(motor: &str) -> Result<Image, String> {
+/// The image of `motor` on `board`, built as `motorgen firmware` builds it
+/// (`MOTOR=<motor> BOARD=<stem> cargo build --release --target thumbv7em-none-eabihf -p
+/// motor-firmware` in `firmware/`, its own target directory; a variant's text is written
+/// to its own `BOARDS_DIR`) and copied to `target/firmware/[<board>/]<motor>.elf` (where
+/// `motorgen firmware` puts it; variants under `target/firmware/variant-<hash>/`) with a
+/// stamp of its inputs: an image whose stamp matches is reused without running cargo.
+pub fn build(motor: &str, board: &BoardFile) -> Result<Image, String> {
     let _guard = BUILD.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let repo = repo();
-    let dir = repo.join("target").join("firmware");
+    let mut dir = repo.join("target").join("firmware");
+    if board.variant {
+        dir = dir.join(format!("variant-{:016x}", fnv(board.text.as_bytes())));
+    } else if board.stem != codegen::board::DEFAULT_BOARD {
+        dir = dir.join(&board.stem);
+    }
     let elf = dir.join(format!("{motor}.elf"));
     let stamp = dir.join(format!("{motor}.emulator-stamp"));
-    let hash = format!("{:016x}", inputs_hash(motor));
+    let hash = format!("{:016x}", inputs_hash(motor, board));
     if std::fs::read_to_string(&stamp).is_ok_and(|s| s == hash)
         && let Ok(bytes) = std::fs::read(&elf)
     {
         return Image::parse(&bytes);
     }
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let boards_dir = if board.variant {
+        let d = dir.join("boards");
+        std::fs::create_dir_all(&d).map_err(|e| format!("{}: {e}", d.display()))?;
+        let f = d.join(format!("{}.toml", board.stem));
+        std::fs::write(&f, &board.text).map_err(|e| format!("{}: {e}", f.display()))?;
+        d
+    } else {
+        repo.join("boards")
+    };
     let firmware = repo.join("firmware");
     let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
         .args([
@@ -177,19 +245,19 @@ pub fn build(motor: &str) -> Result<Image, String> {
         .current_dir(&firmware)
         .env("CARGO_TARGET_DIR", firmware.join("target"))
         .env("MOTOR", motor)
-        .env("BOARD", codegen::board::DEFAULT_BOARD)
+        .env("BOARD", &board.stem)
+        .env("BOARDS_DIR", &boards_dir)
         .env_remove("MOTORS_DIR")
-        .env_remove("BOARDS_DIR")
         .output()
         .map_err(|e| format!("cargo: {e}"))?;
     if !out.status.success() {
         return Err(format!(
-            "building the {motor} image failed:\n{}",
+            "building the {motor} image on {} failed:\n{}",
+            board.file_name(),
             String::from_utf8_lossy(&out.stderr)
         ));
     }
     let built = firmware.join("target/thumbv7em-none-eabihf/release/motor-firmware");
-    std::fs::create_dir_all(&dir).map_err(|e| e.to_string())?;
     std::fs::copy(&built, &elf).map_err(|e| format!("{}: {e}", built.display()))?;
     std::fs::write(&stamp, &hash).map_err(|e| e.to_string())?;
     let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;

@@ -13,7 +13,9 @@
 //! Licences: this crate's source is the workspace's; its test binaries link Debian's
 //! GPL-2.0 `libunicorn`. It is never a dependency of `codegen`/`motorgen` or of the image.
 
+pub mod bridge;
 pub mod drive;
+pub mod hardware;
 pub mod image;
 pub mod periph;
 pub mod rig;
@@ -25,8 +27,9 @@ use unicorn_engine::unicorn_const::{Arch, Mode, Permission};
 use unicorn_engine::{RegisterARM, Unicorn};
 
 pub use periph::fdcan::Frame;
-pub use soc::{Analog, Note, Patches, Soc, UNITS_PER_S, Wiring};
+pub use soc::{Analog, Note, Patches, Pulse, Soc, UNITS_PER_S, Wiring};
 pub use violation::Violation;
+use violation::Broken;
 
 use image::Image;
 
@@ -109,6 +112,10 @@ pub struct Machine {
     injected: Vec<u32>,
     /// The last fault the emulator raised (Unicorn's error, the PC).
     pub last_fault: Option<String>,
+    /// Since when (bus units) an enabled interrupt has been pending but masked.
+    masked_since: Option<u64>,
+    /// The image's symbols (name, address, size).
+    symbols: Vec<(String, u32, u32)>,
 }
 
 fn uc_err(e: unicorn_engine::unicorn_const::uc_error) -> Stop {
@@ -179,6 +186,8 @@ impl Machine {
             handled: Vec::new(),
             injected: Vec::new(),
             last_fault: None,
+            masked_since: None,
+            symbols: image.symbols.clone(),
         };
         let sp = m.vector(0)?;
         let reset = m.vector(1)?;
@@ -227,6 +236,11 @@ impl Machine {
     /// The chip, to drive its inputs.
     pub fn soc_mut(&mut self) -> &mut Soc {
         self.uc.get_data_mut()
+    }
+
+    /// The address of the image's first symbol whose name contains `part`.
+    pub fn symbol(&self, part: &str) -> Option<u32> {
+        self.symbols.iter().find(|(n, _, _)| n.contains(part)).map(|s| s.1)
     }
 
     /// A word of memory (RAM or flash).
@@ -300,7 +314,9 @@ impl Machine {
         self.reg_w(SP, sp + FRAME_BYTES + ((xpsr >> 9) & 1) * 4)?;
         if let Some((n, ins, at)) = self.active.pop() {
             if n >= 16 {
-                self.uc.get_data_mut().irq_active = false;
+                let soc = self.uc.get_data_mut();
+                soc.irq_active = false;
+                soc.irq_exit();
             }
             let exit = self.uc.get_data().instructions;
             self.handled.push(Handled {
@@ -391,6 +407,14 @@ impl Machine {
             if soc.syscfg.lockup_to_break() {
                 soc.break_asserted = true;
                 soc.update_break();
+            } else if soc.gates_can_switch() {
+                soc.fail(Broken::new(
+                    "core LOCKUP",
+                    "the core locked up (a fault inside the HardFault handler, ARMv7-M B1.5.15) with the bridge still switching and SYSCFG_CFGR2.CLL clear: TIM1 keeps running with the last compare values and no code can clear MOE — CLL routes LOCKUP to TIM1's break (RM0440 §11.3.10)",
+                ));
+                if let Some(v) = soc.violation.clone() {
+                    return Err(Stop::Violation(v));
+                }
             }
             return Err(Stop::Lockup(t));
         }
@@ -399,20 +423,53 @@ impl Machine {
         self.enter(HARD_FAULT)
     }
 
-    /// Takes an injected exception, or a pending enabled interrupt when PRIMASK = 0 and
-    /// no handler is active (the image has one interrupt; ARMv7-M B1.5.4 priorities).
+    /// Takes an injected exception, or a pending enabled interrupt when no handler is
+    /// active and neither PRIMASK nor BASEPRI masks it (the image has one interrupt;
+    /// ARMv7-M B1.5.4: BASEPRI ≠ 0 masks every priority value ≥ BASEPRI; the G474's NVIC
+    /// keeps the upper 4 bits). An interrupt held off for longer than a carrier period
+    /// misses a control period: a strict-mode failure naming the mask.
     fn take_exceptions(&mut self) -> Result<(), Stop> {
+        if let Some(b) = self.uc.get_data_mut().basepri_request.take() {
+            self.reg_w(RegisterARM::BASEPRI, b)?;
+        }
         if let Some(n) = self.injected.pop() {
             if n == HARD_FAULT && self.active.iter().any(|&(a, _, _)| a == HARD_FAULT) {
                 return self.fault();
             }
             return self.enter(n);
         }
-        if !self.active.is_empty() || self.reg(RegisterARM::PRIMASK)? & 1 != 0 {
+        if !self.active.is_empty() {
             return Ok(());
         }
-        if let Some(irq) = self.uc.get_data().scs.active_irq() {
-            self.enter(16 + irq)?;
+        let Some(irq) = self.uc.get_data().scs.active_irq() else {
+            self.masked_since = None;
+            return Ok(());
+        };
+        let primask = self.reg(RegisterARM::PRIMASK)? & 1 != 0;
+        let basepri = self.reg(RegisterARM::BASEPRI)? & 0xF0;
+        let soc = self.uc.get_data_mut();
+        let prio = u32::from(soc.scs.priority(irq));
+        let by_basepri = basepri != 0 && prio >= basepri;
+        if !primask && !by_basepri {
+            self.masked_since = None;
+            return self.enter(16 + irq);
+        }
+        let since = *self.masked_since.get_or_insert(soc.now);
+        let period = soc.tim1.period_ticks() * soc.tim1.tick;
+        if period > 0 && soc.now - since > period {
+            let mask = if by_basepri {
+                format!("BASEPRI = {basepri:#04x} (its priority {prio:#04x} ≥ BASEPRI)")
+            } else {
+                "PRIMASK".to_string()
+            };
+            soc.fail(Broken::new(
+                format!("NVIC IRQ {irq}"),
+                format!(
+                    "the control interrupt has been pending and enabled but masked by {mask} for {:.1} µs, longer than a carrier period ({:.1} µs): the control loop misses its periods (ARMv7-M B1.5.4, exception priorities and BASEPRI)",
+                    (soc.now - since) as f64 / UNITS_PER_S * 1e6,
+                    period as f64 / UNITS_PER_S * 1e6
+                ),
+            ));
         }
         Ok(())
     }

@@ -1,55 +1,115 @@
-//! A test rig: one motor's image on the default board at standstill, with the vehicle
-//! unit's setpoint frames on the CAN bus.
+//! A test rig: one motor's image, built from a board file, on the emulated hardware of a
+//! board (its own description, [`crate::hardware`]), at standstill unless the test gives
+//! another analog source, with the vehicle unit's setpoint frames on the CAN bus.
 
 use codegen::design::Design;
 
-use crate::image;
+use crate::hardware::{self, Hardware};
+use crate::image::{self, BoardFile};
 use crate::periph::fdcan::Frame;
-use crate::soc::{Analog, Patches, Soc};
+use crate::soc::{Analog, OPTR_NSWBOOT0, Patches, Soc, Wiring};
 use crate::wiring::{self, Standstill};
 use crate::{Machine, Stop};
 
+/// FLASH_OPTR as delivered (RM0440 §5.4.1, FLASH_OPTR reset value from the factory
+/// option bytes: 0xFFEF_F8AA, nSWBOOT0 = nBOOT0 = 1).
+pub const OPTR_FACTORY: u32 = 0xFFEF_F8AA;
+
 /// FLASH_OPTR as the image requires it on a board with a signal on PB8 (firmware
-/// README, "Option bytes"): the delivered value 0xFFEF_F8AA (RM0440 §5.4.1, FLASH_OPTR
-/// reset value from the option bytes) with nSWBOOT0 (bit 26) programmed to 0 and nBOOT0
-/// (bit 27) left at 1.
-pub const OPTR_BOOT_FROM_FLASH: u32 = 0xFFEF_F8AA & !(1 << 26);
+/// README, "Option bytes"): the delivered value with nSWBOOT0 (bit 26) programmed to 0 and
+/// nBOOT0 (bit 27) left at 1.
+pub const OPTR_BOOT_FROM_FLASH: u32 = OPTR_FACTORY & !OPTR_NSWBOOT0;
+
+/// What a rig runs: a motor's image built from a board file, on a board's hardware.
+#[derive(Clone, Debug)]
+pub struct Bench {
+    /// The motor (`motors/<motor>.toml`).
+    pub motor: String,
+    /// The board file the image is built from.
+    pub board: BoardFile,
+    /// The hardware it runs on.
+    pub hardware: Hardware,
+    /// Injected defects.
+    pub patches: Patches,
+    /// FLASH_OPTR of the chip.
+    pub optr: u32,
+}
+
+impl Bench {
+    /// `motor` on `boards/<board>.toml` and that board's hardware, option bytes
+    /// programmed, no defect.
+    pub fn new(motor: &str, board: &str) -> Result<Self, String> {
+        let hardware = hardware::for_board(board).ok_or_else(|| format!("no hardware description of {board}"))?;
+        Ok(Self {
+            motor: motor.to_string(),
+            board: BoardFile::shipped(board)?,
+            hardware,
+            patches: Patches::default(),
+            optr: OPTR_BOOT_FROM_FLASH,
+        })
+    }
+
+    /// With `patches`.
+    pub fn patched(self, patches: Patches) -> Self {
+        Self { patches, ..self }
+    }
+
+    /// The image built from `text` (a variant of the board's file) on the same hardware.
+    pub fn board_text(self, text: String) -> Self {
+        let board = BoardFile::variant(&self.board.stem, text);
+        Self { board, ..self }
+    }
+
+    /// `motor/board`, for messages.
+    pub fn name(&self) -> String {
+        if self.board.variant {
+            format!("{} on a variant of {}", self.motor, self.board.stem)
+        } else {
+            format!("{} on {}", self.motor, self.board.stem)
+        }
+    }
+}
 
 /// The rig.
 pub struct Rig {
     /// The emulated chip running the image.
     pub machine: Machine,
-    /// The motor's design on the default board.
+    /// The motor's design on the board file the image was built from.
     pub design: Design,
+    /// The board's hardware.
+    pub hardware: Hardware,
+    /// What runs.
+    pub bench: Bench,
     /// The next setpoint frame is due at this time \[s\].
     next_frame_s: f64,
 }
 
 impl Rig {
-    /// Builds (once per process) and loads `motor`'s image, at reset.
-    pub fn new(motor: &str, patches: Patches) -> Result<Self, String> {
-        Self::with_analog(motor, patches, |d| Ok(Box::new(Standstill::new(d)?)))
+    /// Builds (once per process) and loads the bench's image, at reset, at standstill.
+    pub fn new(bench: Bench) -> Result<Self, String> {
+        Self::with_analog(bench, |d, hw| Ok(Box::new(Standstill::new(d, hw))))
     }
 
-    /// [`Rig::new`] with the analog inputs from `analog` (given the design), e.g. the
-    /// closed loop's [`crate::drive::Drive`].
+    /// [`Rig::new`] with the analog inputs from `analog` (given the design and the
+    /// hardware), e.g. the closed loop's [`crate::drive::Drive`].
     pub fn with_analog(
-        motor: &str,
-        patches: Patches,
-        analog: impl FnOnce(&Design) -> Result<Box<dyn Analog>, String>,
+        bench: Bench,
+        analog: impl FnOnce(&Design, &Hardware) -> Result<Box<dyn Analog>, String>,
     ) -> Result<Self, String> {
-        let design = wiring::design(motor)?;
-        let image = image::image(motor)?;
+        let design = wiring::design(&bench.motor, &bench.board.file_name(), &bench.board.text)?;
+        let image = image::image(&bench.motor, &bench.board)?;
         let soc = Soc::new(
-            wiring::wiring(&design)?,
-            analog(&design)?,
-            OPTR_BOOT_FROM_FLASH,
-            patches,
+            Wiring::new(bench.hardware.clone()),
+            analog(&design, &bench.hardware)?,
+            bench.optr,
+            bench.patches.clone(),
         );
         let machine = Machine::new(&image, soc).map_err(|e| e.to_string())?;
         Ok(Self {
             machine,
             design,
+            hardware: bench.hardware.clone(),
+            bench,
             next_frame_s: 0.0,
         })
     }
@@ -84,11 +144,35 @@ impl Rig {
             .map_err(|e| format!("{e}; {}", self.machine.summary()))?;
         if !reached {
             return Err(format!(
-                "no enabled PWM period within {limit_s} s; {}",
+                "no enabled PWM period within {limit_s} s{}; {}",
+                self.fault_cause().map_or(String::new(), |c| format!(" (fault record: {c})")),
                 self.machine.summary()
             ));
         }
         first_enabled_period(&self.machine).ok_or_else(|| "no enabled period".into())
+    }
+
+    /// The cause the image sealed in its fault record (`MOTOR_FAULT_RECORD` word 1,
+    /// firmware README "Fault record"), if the record is valid.
+    pub fn fault_cause(&self) -> Option<String> {
+        let at = self.machine.symbol("MOTOR_FAULT_RECORD")?;
+        if self.machine.peek(at).ok()? != 0x4D46_5231 {
+            return None;
+        }
+        let cause = self.machine.peek(at + 4).ok()?;
+        let name = match cause {
+            1 => "HardFault",
+            2 => "stack overflow",
+            3 => "break",
+            4 => "trip",
+            5 => "lost conversion",
+            6 => "bring-up",
+            7 => "unhandled interrupt",
+            8 => "panic",
+            9 => "watchdog",
+            _ => "unknown",
+        };
+        Some(format!("{cause} ({name})"))
     }
 
     /// The standstill analog source, to change currents or the DC link.
@@ -147,4 +231,40 @@ pub fn first_enabled_period(m: &Machine) -> Option<f64> {
         crate::Note::FirstEnabledPeriod(t) => Some(*t),
         _ => None,
     })
+}
+
+/// Whether `motor` fits the board `board` (its file's ranges): its DC link below the
+/// board's over-voltage trip and inside what the divider measures, and `motorgen
+/// verify`'s current step below the over-current trip. A motor that does not fit trips
+/// the image at once; the scenarios run every motor on every board it fits.
+pub fn fits(motor: &str, board: &str) -> Result<bool, String> {
+    let b = BoardFile::shipped(board)?;
+    let d = wiring::design(motor, &b.file_name(), &b.text)?;
+    let spec = wiring::spec(motor)?;
+    let out = d.board.as_ref().ok_or("no board")?;
+    let udc = d.drive.dc_link_voltage_v;
+    let step = motor_verify::scenarios::step_amplitude(&motor_verify::Setup::new(&spec, &d));
+    Ok(udc < out.board.over_voltage_v && udc < out.dc_link_full_scale_v && step < out.board.over_current_a)
+}
+
+/// Every (motor, board) the scenarios run: each board in `boards/` (each has a hardware
+/// description, or this fails) with each motor of [`image::motors`] that [`fits`] it; a
+/// board no motor fits fails too (its scenarios would run zero times).
+pub fn benches() -> Vec<(String, String)> {
+    let mut out = Vec::new();
+    for board in motor_test_support::board_stems() {
+        assert!(
+            hardware::for_board(&board).is_some(),
+            "boards/{board}.toml has no hardware description in crates/emulator/src/hardware"
+        );
+        let mut n = 0;
+        for motor in image::motors() {
+            if fits(&motor, &board).unwrap_or_else(|e| panic!("{motor} on {board}: {e}")) {
+                out.push((motor.clone(), board.clone()));
+                n += 1;
+            }
+        }
+        assert!(n > 0 || std::env::var_os("EMULATOR_MOTORS").is_some(), "no motor fits {board}");
+    }
+    out
 }

@@ -1,19 +1,19 @@
-//! The board around the chip, from the board file through codegen (the same data the
-//! image is generated from): pins, ADC inputs, sensing gains; and a drive at standstill
-//! as the default analog source.
+//! The image's design (motor and board file, the data the image is generated from) for
+//! the tests' setpoints and criteria, and the board's analog front end as the emulated
+//! hardware has it ([`crate::hardware`], not the board file): a drive at standstill as
+//! the default analog source.
 
-use codegen::board::Signal;
 use codegen::design::Design;
 use codegen::spec::Spec;
 
-use crate::soc::{Analog, Pin, Wiring};
+use crate::hardware::{Analog as Signal, Hardware};
+use crate::soc::Analog;
 
-/// The default board's design for `motor` (`motors/<motor>.toml` on
-/// `boards/<default>.toml`).
-pub fn design(motor: &str) -> Result<Design, String> {
+/// The design of `motors/<motor>.toml` on the board file `board_file` with text
+/// `board_text` (what the image is built from).
+pub fn design(motor: &str, board_file: &str, board_text: &str) -> Result<Design, String> {
     let (spec_file, spec) = read(&format!("motors/{motor}.toml"))?;
-    let (board_file, board_text) = read(&format!("boards/{}.toml", codegen::board::DEFAULT_BOARD))?;
-    codegen::design_with_board(&spec_file, &spec, &board_file, &board_text).map_err(|e| e.to_string())
+    codegen::design_with_board(&spec_file, &spec, board_file, board_text).map_err(|e| e.to_string())
 }
 
 /// `motors/<motor>.toml` parsed: the machine data `motorgen verify`'s plant takes beyond
@@ -28,94 +28,43 @@ pub fn spec(motor: &str) -> Result<Spec, String> {
 }
 
 /// A repository file's name and text.
-fn read(file: &str) -> Result<(String, String), String> {
+pub fn read(file: &str) -> Result<(String, String), String> {
     let text = std::fs::read_to_string(crate::image::repo().join(file)).map_err(|e| format!("{file}: {e}"))?;
     Ok((file.to_string(), text))
 }
 
 /// Amplitude of the resolver SIN/COS inputs at the excitation's extremum, as a fraction
-/// of half the ADC range around mid-scale. The board file does not state the front end's
-/// swing, so this is the test's choice, inside the rails; the image's angle observer
-/// scales its trig-identity error with it (thesis A (4.10)), an atan2 error does not.
+/// of half the ADC range around mid-scale. Neither board states the front end's swing,
+/// so this is the test's choice, inside the rails; the image's angle observer scales its
+/// trig-identity error with it (thesis A (4.10)), an atan2 error does not.
 pub const RESOLVER_AMPLITUDE: f64 = 0.4;
 
-/// The chip's connections on the design's board.
-pub fn wiring(d: &Design) -> Result<Wiring, String> {
-    let out = d.board.as_ref().ok_or("the design has no board")?;
-    let b = &out.board;
-    let pin = |s: Signal| -> Result<Pin, String> {
-        let p = b.pin(s).ok_or_else(|| format!("the board has no {}", s.key()))?;
-        Ok(Pin {
-            port: p.port,
-            number: p.number,
-            af: p.af.unwrap_or(u8::MAX),
-        })
-    };
-    let gates = [
-        pin(Signal::GateUHigh)?,
-        pin(Signal::GateVHigh)?,
-        pin(Signal::GateWHigh)?,
-        pin(Signal::GateULow)?,
-        pin(Signal::GateVLow)?,
-        pin(Signal::GateWLow)?,
-    ];
-    let adc_inputs = b.adc.clone().map(|q| q.iter().map(|s| (s.channel, s.signal)).collect());
-    Ok(Wiring {
-        gates,
-        break_pin: pin(Signal::BreakInput)?,
-        excitation: pin(Signal::ResolverExcitation)?,
-        adc_inputs,
-        vref: b.adc_reference_v,
-        break_idle_high: !codegen::board::break_active_high(b),
-    })
-}
-
-/// The board's analog front end: what the pins of the sensed signals carry for a given
-/// drive state — phase current i → offset + gain·i, the DC link through its divider, the
-/// resolver SIN/COS at mid-scale ± [`RESOLVER_AMPLITUDE`] of half the range times
-/// sin/cos θ_r and the excitation's sign (synchronous demodulation, thesis A §4.3).
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// The board's analog front end as the hardware has it: what the pins of the sensed
+/// signals carry for a given drive state — phase current i → the board's zero level +
+/// its signed gain·i, the DC link through its divider, the resolver SIN/COS at mid-scale
+/// ± [`RESOLVER_AMPLITUDE`] of half the range times sin/cos θ_r and the excitation's sign
+/// (synchronous demodulation, thesis A §4.3).
+#[derive(Clone, Debug, PartialEq)]
 pub struct Sensing {
-    gain_v_per_a: f64,
-    offset_v: f64,
-    divider: f64,
-    vref: f64,
+    hw: Hardware,
 }
 
 impl Sensing {
-    /// The sensing of `d`'s board (board file: `current_gain`, `current_offset`,
-    /// `dc_link_divider`, `adc_reference`).
-    pub fn new(d: &Design) -> Result<Self, String> {
-        let b = &d.board.as_ref().ok_or("the design has no board")?.board;
-        Ok(Self {
-            gain_v_per_a: b.current_gain_v_per_a,
-            offset_v: b.current_offset_v,
-            divider: b.dc_link_divider,
-            vref: b.adc_reference_v,
-        })
+    /// The sensing of `hw`.
+    pub fn new(hw: &Hardware) -> Self {
+        Self { hw: hw.clone() }
     }
 
     /// Voltage at the pin of `signal` with phase currents `currents` \[A\], DC link
     /// `dc_link_v` \[V\], resolver angle `theta_r` \[rad\] and the excitation's level.
-    pub fn volts(
-        &self,
-        signal: Signal,
-        currents: [f64; 3],
-        dc_link_v: f64,
-        theta_r: f64,
-        excitation_high: bool,
-    ) -> f64 {
-        let half = self.vref / 2.0;
+    pub fn volts(&self, signal: Signal, currents: [f64; 3], dc_link_v: f64, theta_r: f64, excitation_high: bool) -> f64 {
+        let half = self.hw.vref / 2.0;
         let sign = if excitation_high { 1.0 } else { -1.0 };
-        let current = |k: usize| self.offset_v + self.gain_v_per_a * currents[k];
         match signal {
-            Signal::CurrentU => current(0),
-            Signal::CurrentV => current(1),
-            Signal::CurrentW => current(2),
-            Signal::DcLink => dc_link_v * self.divider,
-            Signal::ResolverSin => half + RESOLVER_AMPLITUDE * half * sign * theta_r.sin(),
-            Signal::ResolverCos => half + RESOLVER_AMPLITUDE * half * sign * theta_r.cos(),
-            _ => 0.0,
+            Signal::Current(k) => self.hw.current_volts(currents[k]),
+            Signal::DcLink => dc_link_v * self.hw.dc_link_ratio,
+            Signal::Sin => half + RESOLVER_AMPLITUDE * half * sign * theta_r.sin(),
+            Signal::Cos => half + RESOLVER_AMPLITUDE * half * sign * theta_r.cos(),
         }
     }
 }
@@ -134,13 +83,13 @@ pub struct Standstill {
 }
 
 impl Standstill {
-    /// Zero current at the motor's nominal DC-link voltage.
-    pub fn new(d: &Design) -> Result<Self, String> {
-        Ok(Self {
+    /// Zero current at the motor's nominal DC-link voltage, on `hw`.
+    pub fn new(d: &Design, hw: &Hardware) -> Self {
+        Self {
             currents: [0.0; 3],
             dc_link_v: d.drive.dc_link_voltage_v,
-            sensing: Sensing::new(d)?,
-        })
+            sensing: Sensing::new(hw),
+        }
     }
 }
 

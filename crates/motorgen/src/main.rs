@@ -312,6 +312,10 @@ fn run(command: Command) -> Result<(), Failure> {
                     if codegen::board::is_board_file(&text) {
                         let b = codegen::board_source(&name, &text)?;
                         outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
+                        // Stated facts that contradict the board's parts' datasheets.
+                        for w in &b.warnings {
+                            output::warn(format_args!("{w}"));
+                        }
                     } else {
                         let d = codegen::design_source(&name, &text)?;
                         outln!("ok: {name} ({})", d.name);

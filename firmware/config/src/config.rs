@@ -237,10 +237,19 @@ pub const PORTS_CONFIG: [PortConfig; PORTS] = match registers::port_config(&ROUT
     None => panic!("a board pin outside GPIOA..C or an AF above 15"),
 };
 
-/// The gate pins as outputs driven low (the fault path).
+/// The gate pins as GPIO outputs (the fault path).
 pub const GATES_OUTPUT: [Field; PORTS] = registers::output_mode(&board::GATE_PINS);
-/// BSRR reset bits of the gate pins.
-pub const GATES_LOW: [u32; PORTS] = registers::reset_bits(&board::GATE_PINS);
+/// BSRR writes that drive every gate pin to its off level (`board::GATE_OFF_LEVELS`: high
+/// for a driver input that is active low, e.g. the L6398's LIN).
+pub const GATES_OFF: [u32; PORTS] = registers::level_bits(&board::GATE_PINS, &board::GATE_OFF_LEVELS);
+/// GPIOx_PUPDR of the break pin: a pull to the break's inactive level unless the board's
+/// comparator drives the line both ways (`board::BREAK_PULL`).
+pub const BREAK_PULL: [Field; PORTS] = registers::pull(board::IO_PINS[0], board::BREAK_PULL);
+/// TIM1_CCER: the three complementary outputs enabled with the gate driver's polarities.
+pub const CCER: u32 = registers::ccer(board::TIM1_CCER_POLARITY);
+/// TIM1_CR2: TRGO/TRGO2 = OC4REF and the gate driver's idle levels, written before the
+/// BDTR write whose LOCK level 1 freezes them.
+pub const CR2: u32 = registers::cr2(board::TIM1_CR2_IDLE);
 /// Port and pin number of the resolver excitation (read back for demodulation).
 pub const EXCITATION: (usize, u32) = registers::split(board::IO_PINS[1]);
 
@@ -256,7 +265,8 @@ pub const WATCHDOG: (u8, u16) = {
 /// Trips on the measured values, as codes (see [`crate::adc_frame::Trips`]).
 pub const TRIPS: crate::adc_frame::Trips = crate::adc_frame::Trips {
     current_offset: board::CURRENT_OFFSET_CODE,
-    current_codes: (board::OVER_CURRENT_A / board::CURRENT_PER_LSB) as i32,
+    // |per-LSB|: the scale carries the sensing's sign (negative for low-side shunts).
+    current_codes: (board::OVER_CURRENT_A / board::CURRENT_PER_LSB).abs() as i32,
     dc_link_code: (board::OVER_VOLTAGE_V / board::DC_LINK_PER_LSB) as u16,
     speed: board::OVER_SPEED_E_RAD_S,
 };
@@ -348,6 +358,32 @@ mod tests {
         assert!(close(IQ_PER_NM, motor::current_loop::IQ_PER_NM, 0.0));
         // Thesis A §6.2: order 20 → 21 taps.
         assert_eq!(FILTER_TAPS, 21);
+    }
+
+    /// The board's gate-driver and sensing facts in the registers, by hand (RM0440
+    /// TIMx_CCER, TIMx_CR2, GPIOx_BSRR): on the reference board (1EDI20N12AF, all in
+    /// phase; Hall sensors) CCER = 0x555 (six outputs enabled, no polarity bit), CR2 =
+    /// 0x0070_0070 (TRGO/TRGO2 = OC4REF, every idle level low), the fault path resets all
+    /// six gate pins, the current scale is positive; on the NUCLEO (L6398, LIN active low;
+    /// low-side shunts) CCER = 0xDDD, CR2 = 0x0070_2A70, PA7/PB0/PB1 set and PA8–PA10
+    /// reset when off, the scale negative and the trip distance positive.
+    #[test]
+    fn gate_driver_and_sensing_registers() {
+        match option_env!("BOARD") {
+            None | Some("motorgen-reference") => {
+                assert_eq!((CCER, CR2), (0x555, 0x0070_0070));
+                assert_eq!(GATES_OFF, registers::reset_bits(&board::GATE_PINS));
+                assert!(board::CURRENT_PER_LSB > 0.0);
+            }
+            Some("nucleo-g474re-ihm08m1") => {
+                assert_eq!((CCER, CR2), (0xDDD, 0x0070_2A70));
+                assert_eq!(GATES_OFF, [0x0700_0080, 0x0000_0003, 0]);
+                assert!(board::CURRENT_PER_LSB < 0.0);
+                assert_eq!(BREAK_PULL[0].value, 0b01 << 12);
+            }
+            Some(_) => {}
+        }
+        assert!(TRIPS.current_codes > 0);
     }
 
     /// The FIR has DC gain exactly 1 (Σ taps = 2^15, output gain 2^0): a constant

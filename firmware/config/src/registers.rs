@@ -128,6 +128,50 @@ pub const fn reset_bits(pins: &[u8]) -> [u32; PORTS] {
     out
 }
 
+/// BSRR value that drives each of `pins` to its level in `levels` (1: set, BSy bits
+/// 0–15; 0: reset, BRy bits 16–31; RM0440 GPIOx_BSRR), per port: the fault path's
+/// write that turns every switch off whatever its driver's input logic.
+pub const fn level_bits(pins: &[u8], levels: &[u8]) -> [u32; PORTS] {
+    let mut out = [0; PORTS];
+    let mut k = 0;
+    while k < pins.len() && k < levels.len() {
+        let (port, n) = split(pins[k]);
+        if port < PORTS {
+            out[port] |= if levels[k] != 0 { 1 << n } else { 1 << (16 + n) };
+        }
+        k += 1;
+    }
+    out
+}
+
+/// GPIOx_PUPDR write giving `pin` the pull `code` (RM0440 GPIOx_PUPDR, 2 bits per pin:
+/// 00 none, 01 pull-up, 10 pull-down), per port.
+pub const fn pull(pin: u8, code: u8) -> [Field; PORTS] {
+    let mut out = [Field { mask: 0, value: 0 }; PORTS];
+    let (port, n) = split(pin);
+    if port < PORTS {
+        out[port] = Field {
+            mask: 0b11 << (2 * n),
+            value: ((code & 0b11) as u32) << (2 * n),
+        };
+    }
+    out
+}
+
+/// TIMx_CCER of the three PWM channels (RM0440 TIMx_CCER): CC1E, CC1NE, CC2E, CC2NE,
+/// CC3E, CC3NE set (bits 0, 2, 4, 6, 8, 10 = 0x555), with the board's polarity bits
+/// CCxP/CCxNP (`motor::board::TIM1_CCER_POLARITY`, only bits 1, 3, 5, 7, 9, 11 taken).
+pub const fn ccer(polarity: u32) -> u32 {
+    0x555 | (polarity & 0xAAA)
+}
+
+/// TIMx_CR2 (RM0440 TIMx_CR2): MMS (bits 6:4) and MMS2 (bits 23:20) = OC4REF, and the
+/// board's idle levels OIS1..OIS3N (`motor::board::TIM1_CR2_IDLE`, only bits 8–13
+/// taken). Written before BDTR: LOCK level 1 freezes OISx/OISxN (RM0440 TIMx_BDTR).
+pub const fn cr2(idle: u32) -> u32 {
+    ((MMS_OC4REF as u32 & 0b111) << 4) | ((MMS_OC4REF as u32 & 0xF) << 20) | (idle & 0x3F00)
+}
+
 /// ADC_JSQR.JEXTSEL of TIM1_TRGO2 for ADC1/ADC2 injected conversions (RM0440 ADC chapter, table
 /// "ADC1/2 external triggers for injected channels"; ST's LL: `LL_ADC_INJ_TRIG_EXT_TIM1_TRGO2 = ADC_JSQR_JEXTSEL_3`).
 pub const JEXTSEL_TIM1_TRGO2: u32 = 8;
@@ -296,6 +340,38 @@ mod tests {
         assert_eq!(reset_bits(&pins), [0x0700_0000, 0xE000_0000, 0]);
         assert_eq!(port_config(&[0x32], &[1]), None); // port D
         assert_eq!(port_config(&[0x08], &[16]), None);
+    }
+
+    /// The NUCLEO's gates PA8, PA9, PA10, PA7, PB0, PB1 with the L6398's off levels
+    /// 0, 0, 0, 1, 1, 1: port A sets PA7 (bit 7) and resets PA8–PA10 (bits 24–26),
+    /// port B sets PB0, PB1 (bits 0, 1) — 0x0700_0080 and 0x0000_0003. PA6 pulled up:
+    /// PUPDR bits 12–13 = 01.
+    #[test]
+    fn gate_off_levels_and_break_pull_by_hand() {
+        let pins = [0x08, 0x09, 0x0A, 0x07, 0x10, 0x11];
+        assert_eq!(level_bits(&pins, &[0, 0, 0, 1, 1, 1]), [0x0700_0080, 0x0000_0003, 0]);
+        assert_eq!(level_bits(&pins, &[0; 6]), [0x0780_0000, 0x0003_0000, 0]);
+        assert_eq!(
+            pull(0x06, 0b01)[0],
+            Field {
+                mask: 0b11 << 12,
+                value: 0b01 << 12
+            }
+        );
+        assert_eq!(pull(0x06, 0b01)[1], Field::default());
+    }
+
+    /// CCER with every output enabled (0x555) and the L6398's CC1NP..CC3NP (0x888):
+    /// 0xDDD; CR2 with MMS = 111 (0x70), MMS2 = 0111 (0x70_0000) and OIS1N..OIS3N
+    /// (0x2A00): 0x0070_2A70. Stray bits outside the fields are dropped.
+    #[test]
+    fn polarity_and_idle_registers_by_hand() {
+        assert_eq!(ccer(0x888), 0xDDD);
+        assert_eq!(ccer(0), 0x555);
+        assert_eq!(ccer(0xFFFF_FFFF), 0xFFF);
+        assert_eq!(cr2(0x2A00), 0x0070_2A70);
+        assert_eq!(cr2(0), 0x0070_0070);
+        assert_eq!(cr2(0xFFFF_FFFF), 0x0070_3F70);
     }
 
     /// JSQR of ADC2 on the reference board (IN3, IN4, IN17), TRGO2, rising edge:

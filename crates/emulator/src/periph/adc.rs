@@ -123,6 +123,12 @@ impl Adc {
         }
     }
 
+    /// Sampling cycles ADC_SMPR1/2 give channel `ch` (RM0440 §21.7.6).
+    pub fn smp_cycles(&self, ch: u8) -> f64 {
+        let smpr = if ch < 10 { self.reg(0x14) } else { self.reg(0x18) };
+        sampling_cycles(smpr >> (3 * u32::from(ch % 10)))
+    }
+
     /// ADEN (the converter is enabled).
     pub fn enabled(&self) -> bool {
         self.reg(0x08) & ADEN != 0

@@ -64,6 +64,20 @@ impl Port {
         }
     }
 
+    /// The level pin `n`'s pull-up or pull-down holds it at while undriven (GPIOx_PUPDR,
+    /// RM0440 §9.4.4: 01 pull-up, 10 pull-down; active in input, output and alternate-
+    /// function modes, not in analog mode), `None` without one.
+    pub fn pull(&self, n: u8) -> Option<bool> {
+        if self.mode(n) == Mode::Analog {
+            return None;
+        }
+        match (self.regs[3] >> (2 * u32::from(n))) & 3 {
+            0b01 => Some(true),
+            0b10 => Some(false),
+            _ => None,
+        }
+    }
+
     /// Output data bit of pin `n`.
     pub fn odr(&self, n: u8) -> bool {
         self.regs[ODR] & (1 << n) != 0

@@ -189,6 +189,27 @@ impl Scs {
         }
     }
 
+    /// Priority of IRQ `n` as the NVIC holds it: the upper four bits of its IPR byte
+    /// (the STM32G4 implements 4 priority bits, PM0214 §4.3.7 / RM0440 §16.1; the lower
+    /// bits read as zero).
+    pub fn priority(&self, n: u32) -> u8 {
+        self.ipr.get(n as usize).copied().unwrap_or(0) & 0xF0
+    }
+
+    /// A byte or half-word read of NVIC_IPR at `off` (from 0xE000_0000).
+    pub fn read_ipr(&self, off: u32, size: usize) -> u32 {
+        let i = (off - 0xE400) as usize;
+        (0..size).fold(0, |acc, k| acc | (u32::from(self.ipr[i + k] & 0xF0) << (8 * k)))
+    }
+
+    /// A byte or half-word write of NVIC_IPR (byte-accessible, ARMv7-M B3.4.9).
+    pub fn write_ipr(&mut self, off: u32, size: usize, value: u32) {
+        let i = (off - 0xE400) as usize;
+        for k in 0..size {
+            self.ipr[i + k] = (value >> (8 * k)) as u8 & 0xF0;
+        }
+    }
+
     /// VTOR.
     pub fn vtor(&self) -> u32 {
         self.scb[2]
@@ -203,10 +224,7 @@ impl Scs {
             0xE180..=0xE19C => self.enabled[((off - 0xE180) / 4) as usize],
             0xE200..=0xE21C => self.pending[((off - 0xE200) / 4) as usize],
             0xE280..=0xE29C => self.pending[((off - 0xE280) / 4) as usize],
-            0xE400..=0xE4EC => {
-                let i = (off - 0xE400) as usize;
-                u32::from_le_bytes([self.ipr[i], self.ipr[i + 1], self.ipr[i + 2], self.ipr[i + 3]])
-            }
+            0xE400..=0xE4EC => self.read_ipr(off, 4),
             0xED00..=0xED8C => self.scb[((off - 0xED00) / 4) as usize],
             0xED90..=0xEDBC => self.mpu[((off - 0xED90) / 4) as usize],
             0xEF34..=0xEF3C => self.fp[((off - 0xEF34) / 4) as usize],
@@ -233,10 +251,7 @@ impl Scs {
             0xE180..=0xE19C => self.enabled[((off - 0xE180) / 4) as usize] &= !value,
             0xE200..=0xE21C => self.pending[((off - 0xE200) / 4) as usize] |= value,
             0xE280..=0xE29C => self.pending[((off - 0xE280) / 4) as usize] &= !value,
-            0xE400..=0xE4EC => {
-                let i = (off - 0xE400) as usize;
-                self.ipr[i..i + 4].copy_from_slice(&value.to_le_bytes());
-            }
+            0xE400..=0xE4EC => self.write_ipr(off, 4, value),
             0xED00 => return Err(Broken::new("SCB_CPUID", "read-only (ARMv7-M B3.2.3)")),
             0xED04..=0xED8C => self.scb[((off - 0xED00) / 4) as usize] = value,
             0xED90 => return Err(Broken::new("MPU_TYPE", "read-only (ARMv7-M B3.5.5)")),

@@ -4,7 +4,11 @@
 //! MOE/BIF). Times are in timer ticks from the counter start.
 
 use super::clock::unknown;
+use crate::bridge::Wave;
 use crate::violation::Broken;
+
+/// The window a stopped counter's constant outputs are described over \[s\].
+const STOPPED_WINDOW_S: f64 = 1e-6;
 
 /// BDTR bits (RM0440 §28.6.20).
 const MOE: u32 = 1 << 15;
@@ -16,6 +20,10 @@ const LOCK_SHIFT: u32 = 8;
 const LOCK1_FIELDS: u32 = 0xFF | (1 << 12) | (1 << 13) | (1 << 14) | (0xF << 16) | (0xF << 20) | (3 << 24) | (3 << 28);
 /// Level 2 adds OSSR/OSSI (bits 11, 10).
 const LOCK2_FIELDS: u32 = LOCK1_FIELDS | (3 << 10);
+/// TIMx_CR2 OIS1..OIS4, OIS5, OIS6 (RM0440 TIMx_CR2).
+const OIS_BITS: u32 = 0x7F00 | (1 << 16) | (1 << 18);
+/// TIMx_CCER CC1P, CC1NP, …, CC4P, CC4NP, CC5P, CC6P (RM0440 TIMx_CCER).
+const CCER_POLARITY_BITS: u32 = 0xAAAA | (1 << 17) | (1 << 21);
 /// SR.BIF (RM0440 §28.6.5).
 pub const BIF: u32 = 1 << 7;
 /// SR.UIF.
@@ -229,60 +237,99 @@ impl Tim1 {
         (self.reg(0x04) >> 20) & 0xF == 0b0111
     }
 
-    /// Gate levels (high sides, then low sides) at `t`: with MOE = 0 and OSSI = 1 the
-    /// idle levels OISx/OISxN (RM0440 §28.3.17, Table "Output control bits"); with MOE = 1
-    /// OCxREF with the dead time delaying each rising edge (§28.3.14).
-    pub fn gate_levels(&self, t: u64) -> [bool; 6] {
+    /// The dead time in timer ticks (BDTR.DTG, RM0440 TIMx_BDTR).
+    pub fn dead_ticks(&self) -> u64 {
+        u64::from(crate::periph::dead_time_ticks(self.bdtr() as u8))
+    }
+
+    /// OCxREF of channel `ch` over one carrier period from the update event (counter
+    /// at 0, counting up), in seconds with `tick_s` per timer tick; a stopped counter
+    /// holds its level. PWM mode 1 is active while CNT < CCR: `[0, c)` and `[2a − c, 2a)`
+    /// ticks of the centre-aligned period 2a (RM0440 §28.3.3, OCxM); mode 2 its
+    /// complement; forced modes constant.
+    fn ref_wave(&self, ch: usize, tick_s: f64) -> Wave {
+        let p = self.period_ticks();
+        if self.started_at.is_none() || p == 0 {
+            let level = self.oc_ref(ch, self.reg(0x24)).unwrap_or(false);
+            return Wave::constant(level, STOPPED_WINDOW_S);
+        }
+        let len = p as f64 * tick_s;
+        let a = self.arr as f64;
+        let c = f64::from(self.active_ccr[ch]).min(a);
+        let pwm1 = Wave::from_intervals(len, vec![(0.0, c * tick_s), ((2.0 * a - c) * tick_s, len)]);
+        match self.oc_mode(ch) {
+            0b0110 => pwm1,
+            0b0111 => pwm1.not(),
+            0b0101 => Wave::constant(true, len),
+            _ => Wave::constant(false, len),
+        }
+    }
+
+    /// The six outputs (CH1..CH3, CH1N..CH3N) over one carrier period from the last
+    /// update event, `None` where the timer does not drive the pin (Hi-Z), as RM0440's
+    /// Table "Output control bits for complementary tim_ocx and tim_ocxn channels with
+    /// break feature" gives them from MOE, OSSI, OSSR, CCxE, CCxNE: with MOE = 1 and both
+    /// outputs enabled OCxREF with the dead time on each rising edge, XOR CCxP, and its
+    /// complement likewise XOR CCxNP; one output enabled: OCxREF XOR its polarity, the
+    /// other Hi-Z (OSSR = 0) or at its inactive level CCxP/CCxNP (OSSR = 1); MOE = 0:
+    /// Hi-Z with OSSI = 0, the idle levels OISx/OISxN with OSSI = 1 (either output
+    /// enabled).
+    pub fn outputs(&self, tick_s: f64) -> [Option<Wave>; 6] {
         let cr2 = self.reg(0x04);
         let ccer = self.reg(0x20);
-        let mut out = [false; 6];
+        let bdtr = self.bdtr();
+        let (ossi, ossr) = (bdtr & (1 << 10) != 0, bdtr & (1 << 11) != 0);
+        let mut out: [Option<Wave>; 6] = Default::default();
         for ch in 0..3 {
-            let (e, ne) = (ccer & (1 << (4 * ch)) != 0, ccer & (1 << (4 * ch + 2)) != 0);
-            if !self.moe() {
-                out[ch] = e && cr2 & (1 << (8 + 2 * ch)) != 0;
-                out[ch + 3] = ne && cr2 & (1 << (9 + 2 * ch)) != 0;
-                continue;
-            }
-            let dead = u64::from(crate::periph::dead_time_ticks(self.bdtr() as u8)) * self.tick;
-            let now = self.oc_ref(ch, self.counter_at(t)).unwrap_or(false);
-            let before = self
-                .oc_ref(ch, self.counter_at(t.saturating_sub(dead)))
-                .unwrap_or(false);
-            out[ch] = e && now && before;
-            out[ch + 3] = ne && !now && !before;
+            let bit = |b: usize| ccer & (1 << (4 * ch + b)) != 0;
+            let (e, p, ne, np) = (bit(0), bit(1), bit(2), bit(3));
+            let r = self.ref_wave(ch, tick_s);
+            let len = r.len;
+            let xor = |w: &Wave, pol: bool| if pol { w.not() } else { w.clone() };
+            let level = |l: bool| Some(Wave::constant(l, len));
+            let (hi, lo) = if !self.moe() {
+                if ossi && (e || ne) {
+                    (
+                        level(cr2 & (1 << (8 + 2 * ch)) != 0),
+                        level(cr2 & (1 << (9 + 2 * ch)) != 0),
+                    )
+                } else {
+                    (None, None)
+                }
+            } else {
+                let dead = self.dead_ticks() as f64 * tick_s;
+                match (e, ne) {
+                    (false, false) => (None, None),
+                    (true, true) => (
+                        Some(xor(&r.delay_rise(dead), p)),
+                        Some(xor(&r.not().delay_rise(dead), np)),
+                    ),
+                    (true, false) => (Some(xor(&r, p)), if ossr { level(np) } else { None }),
+                    (false, true) => (if ossr { level(p) } else { None }, Some(xor(&r, np))),
+                }
+            };
+            out[ch] = hi;
+            out[ch + 3] = lo;
         }
         out
     }
 
-    /// Fraction of the carrier period each high side u, v, w is on with the active
-    /// compare values, or `None` while the bridge does not switch (MOE = 0: the outputs
-    /// at their idle levels, RM0440 §28.3.17; or a channel with CCxE or CCxNE clear, a
-    /// half-bridge the model does not drive). Centre-aligned counting 0 → ARR → 0 with
-    /// PWM mode 1 (OCxREF active while CNT < CCR, RM0440 §28.6.7 OCxM) gives CCR/ARR,
-    /// mode 2 its complement, forced active/inactive 1/0. The dead time is not counted:
-    /// the plant's inverter is ideal (volt-second average, thesis A (3.3)), as in
-    /// `motorgen verify`.
-    pub fn duties(&self) -> Option<[f64; 3]> {
-        if !self.moe() || self.arr == 0 {
-            return None;
-        }
-        let ccer = self.reg(0x20);
-        let arr = f64::from(self.arr);
-        let mut d = [0.0; 3];
-        for (ch, duty) in d.iter_mut().enumerate() {
-            if ccer & (1 << (4 * ch)) == 0 || ccer & (1 << (4 * ch + 2)) == 0 {
-                return None;
+    /// Seconds per timer tick.
+    pub fn tick_s(&self) -> f64 {
+        self.tick as f64 / crate::soc::UNITS_PER_S
+    }
+
+    /// The six outputs at `t` (bus units) — the pins' levels for GPIO IDR reads — `None`
+    /// where Hi-Z.
+    pub fn outputs_at(&self, t: u64) -> [Option<bool>; 6] {
+        let tick_s = self.tick_s();
+        let phase = match self.started_at {
+            Some(start) if self.period_ticks() > 0 => {
+                ((t.saturating_sub(start) / self.tick) % self.period_ticks()) as f64 * tick_s
             }
-            let mode = self.oc_mode(ch);
-            let high = f64::from(self.active_ccr[ch]).min(arr) / arr;
-            *duty = match mode {
-                0b0110 => high,
-                0b0111 => 1.0 - high,
-                0b0101 => 1.0,
-                _ => 0.0,
-            };
-        }
-        Some(d)
+            _ => 0.0,
+        };
+        self.outputs(tick_s).map(|w| w.map(|w| w.at(phase)))
     }
 
     /// Register read at `t`.
@@ -346,6 +393,28 @@ impl Tim1 {
                 }
             }
             0x44 => self.write_bdtr(value)?,
+            // CR2: OISx/OISxN (bits 8–14, 16, 18) are frozen from LOCK level 1 on, the CCER
+            // polarity bits from level 2 (RM0440 TIMx_BDTR LOCK[1:0]): the timer ignores
+            // such a write, so the image's idle levels must be written before BDTR.
+            0x04 | 0x20 => {
+                let lock = (self.bdtr() >> LOCK_SHIFT) & 3;
+                let (frozen, what, level) = if off == 0x04 {
+                    (OIS_BITS, "OISx/OISxN", 1)
+                } else {
+                    (CCER_POLARITY_BITS, "CCxP/CCxNP", 2)
+                };
+                if self.bdtr_written && lock >= level && (value ^ self.regs[i]) & frozen != 0 {
+                    return Err(Broken::new(
+                        if off == 0x04 { "TIM1_CR2" } else { "TIM1_CCER" },
+                        format!(
+                            "{what} changed ({:#x} → {:#x}) under LOCK level {lock}: write-protected, the timer keeps the old levels (RM0440 TIMx_BDTR LOCK) — write them before the BDTR write",
+                            self.regs[i] & frozen,
+                            value & frozen
+                        ),
+                    ));
+                }
+                self.regs[i] = value;
+            }
             _ => self.regs[i] = value,
         }
         Ok(())

@@ -1,11 +1,10 @@
 //! The real image, run: reset → clocks → peripherals → the first control interrupt → the
-//! first enabled PWM period, on every motor in `motors/` with the default board, in
-//! strict mode; and reintroduced bring-up defects fail with the rule they break.
+//! first enabled PWM period, on every board in `boards/` with every motor that fits it,
+//! in strict mode; and reintroduced bring-up defects fail with the rule they break.
 
 use crate::BOOT_LIMIT_S;
-use motor_emulator::image::motors;
 use motor_emulator::periph::system::IRQ_ADC1_2;
-use motor_emulator::rig::Rig;
+use motor_emulator::rig::{Bench, Rig, benches};
 use motor_emulator::{Note, Patches, Stop};
 
 /// Exception number of the control interrupt (16 + IRQ, ARMv7-M B1.5.2).
@@ -13,8 +12,10 @@ const CONTROL_IRQ: u32 = 16 + IRQ_ADC1_2;
 
 #[test]
 fn every_motor_boots_to_its_first_enabled_pwm_period() {
-    for motor in motors() {
-        let mut rig = Rig::new(&motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
+    for (motor, board) in benches() {
+        let bench = Bench::new(&motor, &board).unwrap();
+        let motor = bench.name();
+        let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{motor}: {e}"));
         let enabled =
             |m: &motor_emulator::Machine| m.soc().notes.iter().any(|n| matches!(n, Note::FirstEnabledPeriod(_)));
         // Zero torque every setpoint period from reset: frames before the CAN join are lost.
@@ -79,7 +80,8 @@ fn lock_in_a_second_bdtr_write_is_refused_with_the_rule() {
         bdtr_lock_second_write: true,
         ..Patches::default()
     };
-    let mut rig = Rig::new("fischer-ti085", patches).unwrap();
+    let bench = Bench::new("fischer-ti085", codegen::board::DEFAULT_BOARD).unwrap().patched(patches);
+    let mut rig = Rig::new(bench).unwrap();
     let err = rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false).unwrap_err();
     let Stop::Violation(v) = err else {
         panic!("expected a strict-mode violation, got {err}");
@@ -102,7 +104,8 @@ fn aden_written_once_after_calibration_is_refused_with_the_rule() {
         single_aden_write: true,
         ..Patches::default()
     };
-    let mut rig = Rig::new("fischer-ti085", patches).unwrap();
+    let bench = Bench::new("fischer-ti085", codegen::board::DEFAULT_BOARD).unwrap().patched(patches);
+    let mut rig = Rig::new(bench).unwrap();
     let result = rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false);
     let lost = rig.machine.soc().adc.iter().map(|a| a.lost_aden_writes).sum::<u32>();
     assert!(
@@ -125,8 +128,10 @@ fn aden_written_once_after_calibration_is_refused_with_the_rule() {
 /// control step alone.
 #[test]
 fn control_interrupt_instructions_fit_the_period() {
-    for motor in motors() {
-        let mut rig = Rig::new(&motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
+    for (motor, board) in benches() {
+        let bench = Bench::new(&motor, &board).unwrap();
+        let motor = bench.name();
+        let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{motor}: {e}"));
         rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
         let torque = rig.design.board.as_ref().unwrap().board.torque_resolution_nm * 100.0;
         let before = rig.machine.handler_instructions(CONTROL_IRQ).len();

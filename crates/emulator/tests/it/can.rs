@@ -1,13 +1,12 @@
-//! The torque setpoint over CAN on the real image, every motor on the default board:
+//! The torque setpoint over CAN on the real image, every board with every motor that fits it:
 //! frames every setpoint period keep the drive on and move the compare values; silence
 //! ramps to zero and switches off within the designed time (board `[can]`: timeout, then
 //! the ramp from at most the peak current); malformed frames (wrong id, short DLC,
 //! extended id, remote) change nothing.
 
 use crate::BOOT_LIMIT_S;
-use motor_emulator::image::motors;
-use motor_emulator::rig::Rig;
-use motor_emulator::{Frame, Machine, Patches};
+use motor_emulator::rig::{Bench, Rig, benches};
+use motor_emulator::{Frame, Machine};
 
 /// Time from the last valid frame until MOE clears, driving `frames` (sent every
 /// setpoint period) after it; the drive must stay on until the timeout.
@@ -38,8 +37,10 @@ fn off_after_silence(rig: &mut Rig, motor: &str, frames: &[Frame]) -> f64 {
 
 #[test]
 fn setpoints_drive_and_silence_ramps_to_off_in_the_designed_time() {
-    for motor in motors() {
-        let mut rig = Rig::new(&motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
+    for (motor, board) in benches() {
+        let bench = Bench::new(&motor, &board).unwrap();
+        let motor = bench.name();
+        let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{motor}: {e}"));
         rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
         let b = rig.design.board.as_ref().unwrap().board.clone();
         let period = rig.pwm_period_s();
@@ -92,8 +93,10 @@ fn setpoints_drive_and_silence_ramps_to_off_in_the_designed_time() {
 
 #[test]
 fn malformed_frames_are_ignored() {
-    for motor in motors() {
-        let mut rig = Rig::new(&motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
+    for (motor, board) in benches() {
+        let bench = Bench::new(&motor, &board).unwrap();
+        let motor = bench.name();
+        let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{motor}: {e}"));
         rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
         let b = rig.design.board.as_ref().unwrap().board.clone();
         let period = rig.pwm_period_s();

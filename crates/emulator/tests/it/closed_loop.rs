@@ -1,8 +1,10 @@
-//! The closed loop on the real image, every motor on the default board: `motorgen
-//! verify`'s simulated drive (blocked rotor, as in its `current_step`) behind the ADC
-//! inputs, driven by the compare values the image programs; a q-axis current step
-//! commanded as a CAN torque setpoint T = i_q/K_t (the design's `iq_per_nm`), judged by
-//! `current_step`'s own criteria (`motor_verify::scenarios::current_step_checks`).
+//! The closed loop on the real image, every board with every motor that fits it:
+//! `motorgen verify`'s simulated drive (blocked rotor, as in its `current_step`) behind
+//! the ADC inputs through the board's own sensing (its hardware description, not the
+//! board file), driven by the switches the board's gate driver turns on from the pins
+//! the image drives; a q-axis current step commanded as a CAN torque setpoint T =
+//! i_q/K_t (the design's `iq_per_nm`), judged by `current_step`'s own criteria
+//! (`motor_verify::scenarios::current_step_checks`).
 //!
 //! The d-axis step of `current_step` has no counterpart here: over CAN the image takes a
 //! torque, and runs i_d = 0.
@@ -15,9 +17,7 @@
 
 use crate::BOOT_LIMIT_S;
 use motor_emulator::drive::{Drive, Sample};
-use motor_emulator::image::motors;
-use motor_emulator::rig::Rig;
-use motor_emulator::{Patches, wiring};
+use motor_emulator::rig::{Bench, Rig, benches};
 use motor_sim::plant::SpeedProfile;
 use motor_verify::Setup;
 use motor_verify::scenarios::{current_step, current_step_checks, current_step_samples, step_amplitude};
@@ -30,118 +30,131 @@ const SETTLE_S: f64 = 0.02;
 /// period the image's sample can fall in before its main loop has read the frame.
 const SLACK_PERIODS: f64 = 2.0;
 
+/// The step's outcome: verify's criteria measured on the image (name, measured, unit,
+/// verify's figure, designed, criterion, pass).
+pub struct Outcome {
+    /// i_q reference of the step \[A\].
+    pub target: f64,
+    /// Every criterion as (name, pass, line for the report).
+    pub checks: Vec<(String, bool, String)>,
+}
+
+impl Outcome {
+    /// The criteria that failed.
+    pub fn failed(&self) -> Vec<String> {
+        self.checks.iter().filter(|c| !c.1).map(|c| c.0.clone()).collect()
+    }
+}
+
 /// The rig with the closed-loop drive, booted and settled at zero torque, and the spec
-/// (for `verify`'s `Setup`: the same machine model).
-fn closed_loop(motor: &str) -> (Rig, codegen::spec::Spec) {
-    let spec = wiring::spec(motor).unwrap_or_else(|e| panic!("{motor}: {e}"));
-    let mut rig = Rig::with_analog(motor, Patches::default(), |d| {
-        Ok(Box::new(Drive::new(
-            &Setup::new(&spec, d),
-            SpeedProfile::constant(0.0),
-        )?))
-    })
-    .unwrap_or_else(|e| panic!("{motor}: {e}"));
-    rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
+/// (for `verify`'s `Setup`: the same machine model). `Err` names what stopped it first:
+/// a strict-mode rule, or the criterion "boot" / "zero torque" with the fault record.
+fn closed_loop(bench: Bench) -> Result<(Rig, codegen::spec::Spec), String> {
+    let spec = motor_emulator::wiring::spec(&bench.motor)?;
+    let mut rig = Rig::with_analog(bench, |d, hw| {
+        Ok(Box::new(Drive::new(&Setup::new(&spec, d), SpeedProfile::constant(0.0), hw)))
+    })?;
+    rig.boot(BOOT_LIMIT_S).map_err(|e| format!("boot: {e}"))?;
     let t = rig.machine.soc().time_s() + SETTLE_S;
     rig.run(t, |_| Some(0.0), |_| false)
-        .unwrap_or_else(|e| panic!("{motor}: {e}; {}", rig.machine.summary()));
-    (rig, spec)
+        .map_err(|e| format!("zero torque: {e}; {}", rig.machine.summary()))?;
+    if !rig.machine.soc().tim1.moe() {
+        return Err(format!(
+            "zero torque: the drive switched itself off (fault record: {})",
+            rig.fault_cause().unwrap_or_else(|| "none".into())
+        ));
+    }
+    Ok((rig, spec))
 }
 
 /// Sends zero torque until the next setpoint frame, `torque_nm` from then on, until
 /// `periods` carrier periods after that frame; returns the frame's time \[s\].
-fn step_torque(rig: &mut Rig, motor: &str, torque_nm: f64, periods: f64) -> f64 {
+fn step_torque(rig: &mut Rig, torque_nm: f64, periods: f64) -> Result<f64, String> {
     let now = rig.machine.soc().time_s();
     let frame = rig.setpoint_period_s();
     // Frames go out every setpoint period from reset (`Rig::run`).
     let at = (now / frame).ceil() * frame;
     let end = at + periods * rig.pwm_period_s();
     rig.run(end, |t| Some(if t >= at { torque_nm } else { 0.0 }), |_| false)
-        .unwrap_or_else(|e| panic!("{motor}: {e}; {}", rig.machine.summary()));
-    at
+        .map_err(|e| format!("{e}; {}", rig.machine.summary()))?;
+    Ok(at)
 }
 
-#[test]
-fn current_step_through_a_can_torque_setpoint_meets_verifys_criteria() {
-    for motor in motors() {
-        let (mut rig, spec) = closed_loop(&motor);
-        let design = rig.design.clone();
-        let setup = Setup::new(&spec, &design);
-        let ts = design.drive.sample_period_s;
-        assert!(
-            (rig.pwm_period_s() / ts - 1.0).abs() < 1e-9,
-            "{motor}: one sample per carrier period assumed"
-        );
-        let n = current_step_samples(&setup);
-        let board = design.board.as_ref().unwrap().board.clone();
-        let lsb_a = board.adc_reference_v / 4096.0 / board.current_gain_v_per_a;
-        let Some(iq_per_nm) = design.current_loop.feedforward.iq_per_nm.filter(|k| *k > 0.0) else {
-            // No torque constant: every torque is i_q = 0.
-            let torque = board.torque_resolution_nm * 1000.0;
-            let at = step_torque(&mut rig, &motor, torque, n as f64 + 10.0);
-            let drive = rig.analog_as::<Drive>().unwrap();
-            let after: Vec<Sample> = drive.samples.iter().filter(|s| s.t >= at).copied().collect();
-            let peak = after.iter().map(|s| s.i[0].abs().max(s.i[1].abs())).fold(0.0, f64::max);
-            assert!(
-                after.len() > n && after.iter().all(|s| s.duties.is_some()),
-                "{motor}: the drive did not stay on under {torque} N·m"
-            );
-            assert!(
-                peak <= lsb_a,
-                "{motor}: |i_dq| reached {peak} A under {torque} N·m without a torque constant (one ADC step: {lsb_a} A)"
-            );
-            println!(
-                "{motor}: no torque constant (iq_per_nm = 0): {torque} N·m → on, |i_dq| ≤ {peak:.3e} A \
-                 (one ADC step {lsb_a:.3} A) over {} periods",
-                after.len()
-            );
-            continue;
-        };
-        // verify's step height, as a torque setpoint; the reference the image gets is the
-        // frame's quantised torque times K_t⁻¹.
-        let a = step_amplitude(&setup);
-        let frame = rig.setpoint(a / iq_per_nm);
-        let raw = i16::from_le_bytes([frame.data[0], frame.data[1]]);
-        let target = f64::from(raw) * board.torque_resolution_nm * iq_per_nm;
-        let at = step_torque(
-            &mut rig,
-            &motor,
-            f64::from(raw) * board.torque_resolution_nm,
-            n as f64 + 10.0,
-        );
-
+/// Runs verify's current step on `bench` and measures its criteria; `Err` when the run
+/// stops before (a strict-mode rule, the boot, a trip at zero torque). `Ok(None)` for a
+/// motor without a torque constant, after checking that it stays on at zero current.
+pub fn current_step_on(bench: Bench) -> Result<Option<Outcome>, String> {
+    let name = bench.name();
+    let (mut rig, spec) = closed_loop(bench)?;
+    let design = rig.design.clone();
+    let setup = Setup::new(&spec, &design);
+    let ts = design.drive.sample_period_s;
+    assert!(
+        (rig.pwm_period_s() / ts - 1.0).abs() < 1e-9,
+        "{name}: one sample per carrier period assumed"
+    );
+    let n = current_step_samples(&setup);
+    let board = design.board.as_ref().unwrap().board.clone();
+    let lsb_a = board.adc_reference_v / 4096.0 / board.current.gain_v_per_a.abs();
+    let Some(iq_per_nm) = design.current_loop.feedforward.iq_per_nm.filter(|k| *k > 0.0) else {
+        // No torque constant: every torque is i_q = 0.
+        let torque = board.torque_resolution_nm * 1000.0;
+        let at = step_torque(&mut rig, torque, n as f64 + 10.0)?;
         let drive = rig.analog_as::<Drive>().unwrap();
-        let s = &drive.samples;
-        // The image samples at t_n, its compare values act from the update at t_{n+1}
-        // (thesis A §4.6, as verify's bench): the step's first sample is the one before
-        // the first update whose duties moved after the frame.
-        let before = s.iter().rposition(|x| x.t < at).expect("samples before the step");
-        let moved = (before + 1..s.len())
-            .find(|&k| s[k].duties != s[before].duties)
-            .unwrap_or_else(|| panic!("{motor}: the duties never moved after the frame"));
+        let after: Vec<Sample> = drive.samples.iter().filter(|s| s.t >= at).copied().collect();
+        let peak = after.iter().map(|s| s.i[0].abs().max(s.i[1].abs())).fold(0.0, f64::max);
         assert!(
-            s[moved].t - at <= SLACK_PERIODS * ts + ts,
-            "{motor}: the image took the setpoint only {} s after the frame",
-            s[moved].t - at
+            after.len() > n && after.iter().all(|s| s.duties.is_some()),
+            "{name}: the drive did not stay on under {torque} N·m"
         );
-        let first = moved - 1;
-        assert!(s.len() > first + n, "{motor}: record too short");
-        let window = &s[first..=first + n];
         assert!(
-            window.iter().all(|x| x.duties.is_some()),
-            "{motor}: the drive switched off"
+            peak <= lsb_a,
+            "{name}: |i_dq| reached {peak} A under {torque} N·m without a torque constant (one ADC step: {lsb_a} A)"
         );
-        let y: Vec<f64> = window.iter().map(|x| x.i[1]).collect();
-        let checks = current_step_checks(&design, 1, &y, target);
-        let verified = current_step(&setup);
-        let mut failed = Vec::new();
         println!(
-            "{motor}: i_q step 0 → {target:.3} A as {raw} × {} N·m",
-            board.torque_resolution_nm
+            "{name}: no torque constant (iq_per_nm = 0): {torque} N·m → on, |i_dq| ≤ {peak:.3e} A \
+             (one ADC step {lsb_a:.3} A) over {} periods",
+            after.len()
         );
-        for c in &checks {
+        return Ok(None);
+    };
+    // verify's step height, as a torque setpoint; the reference the image gets is the
+    // frame's quantised torque times K_t⁻¹.
+    let a = step_amplitude(&setup);
+    let frame = rig.setpoint(a / iq_per_nm);
+    let raw = i16::from_le_bytes([frame.data[0], frame.data[1]]);
+    let target = f64::from(raw) * board.torque_resolution_nm * iq_per_nm;
+    let at = step_torque(&mut rig, f64::from(raw) * board.torque_resolution_nm, n as f64 + 10.0)?;
+    let drive = rig.analog_as::<Drive>().unwrap();
+    let s = &drive.samples;
+    // The image samples at t_n, its compare values act from the update at t_{n+1}
+    // (thesis A §4.6, as verify's bench): the step's first sample is the one before the
+    // first update whose duties moved after the frame.
+    let before = s.iter().rposition(|x| x.t < at).expect("samples before the step");
+    let moved = (before + 1..s.len())
+        .find(|&k| s[k].duties != s[before].duties)
+        .ok_or_else(|| format!("the duties never moved after the frame at {at} s"))?;
+    assert!(
+        s[moved].t - at <= SLACK_PERIODS * ts + ts,
+        "{name}: the image took the setpoint only {} s after the frame",
+        s[moved].t - at
+    );
+    let first = moved - 1;
+    if s.len() <= first + n || !s[first..=first + n].iter().all(|x| x.duties.is_some()) {
+        return Err(format!(
+            "stays on: the drive switched off during the step (fault record: {})",
+            rig.fault_cause().unwrap_or_else(|| "none".into())
+        ));
+    }
+    let window = &s[first..=first + n];
+    let y: Vec<f64> = window.iter().map(|x| x.i[1]).collect();
+    let checks = current_step_checks(&design, 1, &y, target);
+    let verified = current_step(&setup);
+    let checks = checks
+        .iter()
+        .map(|c| {
             let sim = verified.checks.iter().find(|v| v.quantity == c.quantity);
-            println!(
+            let line = format!(
                 "  {}: image {:.4} {}, verify {} , designed {}, {} → {}",
                 c.quantity,
                 c.measured,
@@ -151,10 +164,24 @@ fn current_step_through_a_can_torque_setpoint_meets_verifys_criteria() {
                 c.criterion,
                 if c.pass { "pass" } else { "FAIL" }
             );
-            if !c.pass {
-                failed.push(c.quantity.clone());
-            }
+            (c.quantity.clone(), c.pass, line)
+        })
+        .collect();
+    Ok(Some(Outcome { target, checks }))
+}
+
+#[test]
+fn current_step_through_a_can_torque_setpoint_meets_verifys_criteria() {
+    for (motor, board) in benches() {
+        let bench = Bench::new(&motor, &board).unwrap();
+        let name = bench.name();
+        let Some(out) = current_step_on(bench).unwrap_or_else(|e| panic!("{name}: {e}")) else {
+            continue;
+        };
+        println!("{name}: i_q step 0 → {:.3} A", out.target);
+        for c in &out.checks {
+            println!("{}", c.2);
         }
-        assert!(failed.is_empty(), "{motor}: {failed:?} failed on the emulated image");
+        assert!(out.failed().is_empty(), "{name}: {:?} failed on the emulated image", out.failed());
     }
 }

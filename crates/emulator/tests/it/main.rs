@@ -1,9 +1,11 @@
 //! The real image on the emulated G474, one test binary: boot, protection, CAN and the
 //! closed loop, on every motor in `motors/` (README, "Scenarios").
 
+mod boards;
 mod boot;
 mod can;
 mod closed_loop;
+mod defects;
 mod protection;
 
 /// Upper bound for the bring-up \[s\]: the ADC regulator's 2 × 20 µs, a calibration each,

@@ -1,15 +1,15 @@
-//! Protection on the real image, every motor on the default board: the break input, a
-//! phase current at the ADC rail, a HardFault, a stalled control interrupt. "Off" means
-//! no gate pin can switch on: none routed to TIM1 with MOE = 1, none a GPIO output high.
+//! Protection on the real image, every board with every motor that fits it: the break
+//! input, a phase current at the ADC rail, a HardFault, a stalled control interrupt.
+//! "Off" means no switch is commanded on: the gate pins, through their GPIO mode and
+//! alternate function and the board's gate driver, turn no switch of the bridge on.
 
 use crate::BOOT_LIMIT_S;
-use motor_emulator::image::motors;
 use motor_emulator::periph::gpio::Mode;
-use motor_emulator::rig::Rig;
-use motor_emulator::{HARD_FAULT, Machine, Patches, Stop};
+use motor_emulator::rig::{Bench, Rig, benches};
+use motor_emulator::{HARD_FAULT, Machine, Stop};
 
-fn booted(motor: &str) -> Rig {
-    let mut rig = Rig::new(motor, Patches::default()).unwrap_or_else(|e| panic!("{motor}: {e}"));
+fn booted(motor: &str, board: &str) -> Rig {
+    let mut rig = Rig::new(Bench::new(motor, board).unwrap()).unwrap_or_else(|e| panic!("{motor}: {e}"));
     rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
     // A few enabled periods.
     let t = rig.machine.soc().time_s() + 5.0 * rig.pwm_period_s();
@@ -52,8 +52,9 @@ fn stays_off(rig: &mut Rig, motor: &str, periods: f64, off_after_s: f64) -> Opti
 /// violation).
 #[test]
 fn break_input_switches_the_outputs_off_for_good() {
-    for motor in motors() {
-        let mut rig = booted(&motor);
+    for (motor, board) in benches() {
+        let mut rig = booted(&motor, &board);
+        let motor = rig.bench.name();
         let t0 = rig.machine.soc().time_s();
         let period = rig.pwm_period_s();
         {
@@ -77,8 +78,9 @@ fn break_input_switches_the_outputs_off_for_good() {
 /// image's TRIPS check), and it stays off with the current back at zero.
 #[test]
 fn phase_current_at_the_rail_trips() {
-    for motor in motors() {
-        let mut rig = booted(&motor);
+    for (motor, board) in benches() {
+        let mut rig = booted(&motor, &board);
+        let motor = rig.bench.name();
         let t0 = rig.machine.soc().time_s();
         let period = rig.pwm_period_s();
         // Far beyond the sensor's range: the ADC input above V_REF+ reads 4095.
@@ -92,27 +94,27 @@ fn phase_current_at_the_rail_trips() {
     }
 }
 
-/// A HardFault mid-run: MOE cleared and the six gate pins driven low as GPIO outputs
-/// (fault.rs), then the watchdog resets the chip.
+/// A HardFault mid-run: MOE cleared and the six gate pins driven to their off levels as
+/// GPIO outputs (fault.rs: high for the L6398's active-low LIN), then the watchdog
+/// resets the chip.
 #[test]
 fn hard_fault_switches_the_gates_off_and_the_watchdog_resets() {
-    for motor in motors() {
-        let mut rig = booted(&motor);
+    for (motor, board) in benches() {
+        let mut rig = booted(&motor, &board);
+        let motor = rig.bench.name();
         let t0 = rig.machine.soc().time_s();
         rig.machine.inject(HARD_FAULT);
         let end = t0 + 2.0 * rig.pwm_period_s();
         rig.machine.run_until(end).unwrap_or_else(|e| panic!("{motor}: {e}"));
         let soc = rig.machine.soc();
         assert!(!soc.tim1.moe(), "{motor}: MOE still set after the HardFault");
-        for g in soc.wiring.gates {
-            let port = &soc.gpio[usize::from(g.port)];
-            assert_eq!(
-                port.mode(g.number),
-                Mode::Output,
-                "{motor}: gate pin {g:?} not a GPIO output"
-            );
-            assert!(!port.odr(g.number), "{motor}: gate pin {g:?} high");
+        let off = rig.hardware.off_levels();
+        for (k, (p, n)) in soc.wiring.gates.into_iter().enumerate() {
+            let port = &soc.gpio[usize::from(p)];
+            assert_eq!(port.mode(n), Mode::Output, "{motor}: gate pin {k} not a GPIO output");
+            assert_eq!(port.odr(n), off[k], "{motor}: gate pin {k} not at its off level");
         }
+        assert!(!soc.gates_can_switch(), "{motor}: a switch still on");
         // The handler started the watchdog with its reset timeout (≈ 0.5 s) or kept
         // the configured one running: the chip resets.
         let err = rig.machine.run_until(t0 + 1.0).unwrap_err();
@@ -126,8 +128,9 @@ fn hard_fault_switches_the_gates_off_and_the_watchdog_resets() {
 /// `[watchdog].timeout`, rounded up by the image's PR/RLR).
 #[test]
 fn stalled_control_interrupt_ends_in_a_watchdog_reset() {
-    for motor in motors() {
-        let mut rig = booted(&motor);
+    for (motor, board) in benches() {
+        let mut rig = booted(&motor, &board);
+        let motor = rig.bench.name();
         let t0 = rig.machine.soc().time_s();
         let timeout = rig.design.board.as_ref().unwrap().board.watchdog_timeout_s;
         let period = rig.pwm_period_s();

@@ -366,6 +366,24 @@ fn check_and_design_take_board_files() {
         stderr.contains("wrong-af.toml:16:14: `pins.gate_u_low`: PA5 has no TIM1_CH1N"),
         "{stderr}"
     );
+    // A stated polarity contradicting the named driver: accepted, warned at the key with
+    // the datasheet's passage (issue 25).
+    let nucleo = std::fs::read_to_string(root.join("boards/nucleo-g474re-ihm08m1.toml")).unwrap();
+    let stated = nucleo.replace(
+        "part = \"L6398\"",
+        "part = \"L6398\"\nlow_side_input = \"in_phase\"\nlow_side_pull = \"down\"",
+    );
+    let dir = motor_test_support::tmp("motorgen-cli", "stated-polarity");
+    let file = dir.join("stated.toml");
+    std::fs::write(&file, &stated).unwrap();
+    let out = run(&["check", file.to_str().unwrap()]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    let line = stated[..stated.find("\"in_phase\"").unwrap()].matches('\n').count() + 1;
+    assert!(
+        stderr.contains(&format!("warning: {}:{line}:18: `gate_driver.low_side_input`: the board states in_phase but its part L6398 has inverted (L6398 datasheet §3 truth table", file.display())),
+        "{stderr}"
+    );
     let out = run(&[
         "design",
         "motors/chalmers-hev50.toml",

@@ -1,7 +1,8 @@
 //! Fault handling: every fault path records why (the fault record, kept across the
 //! reset in `.uninit`: [`crate::fault_record`]), switches all six gate outputs off — MOE
-//! cleared (the timer drives its idle levels) and the six pins forced low as GPIO
-//! outputs, so no code that still runs can re-enable them — then waits for the
+//! cleared (the timer drives its idle levels) and the six pins forced to their off
+//! levels as GPIO outputs (high for an active-low driver input such as the L6398's LIN,
+//! `motor::board::GATE_OFF_LEVELS`), so no code that still runs can re-enable them — then waits for the
 //! independent watchdog to reset the MCU (started here with its default timeout if it
 //! was not running yet). A stack overflow reaches the HardFault handler (the stack lies
 //! at the bottom of RAM, memory.x), whose entry switches to a fresh stack first.
@@ -58,7 +59,7 @@ fn outputs_off_and_wait(record: &FaultRecord) -> ! {
     // outputs towards the off state, which is safe whatever those owners did last.
     let dp = unsafe { pac::Peripherals::steal() };
     dp.TIM1.bdtr().modify(|_, w| w.moe().clear_bit());
-    pins::gates_low(&dp.GPIOA, &dp.GPIOB, &dp.GPIOC);
+    pins::gates_off(&dp.GPIOA, &dp.GPIOB, &dp.GPIOC);
     watchdog::start_default(&dp.IWDG);
     log_fault(record);
     loop {

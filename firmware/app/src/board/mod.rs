@@ -5,7 +5,7 @@
 //! | module | drives |
 //! |---|---|
 //! | [`clocks`] | 170 MHz system clock, peripheral clocks |
-//! | [`pins`] | the board's pins (from the board file), gate pins forced low |
+//! | [`pins`] | the board's pins (from the board file), gate pins forced to their off levels |
 //! | [`pwm`] | TIM1: PWM, dead time, break, ADC trigger at the board's sampling instant |
 //! | [`resolver`] | TIM3: resolver excitation locked to the carrier |
 //! | [`adc`] | ADC1/ADC2 injected conversions |

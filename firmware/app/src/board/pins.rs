@@ -7,7 +7,7 @@
 
 use stm32g4::stm32g474 as pac;
 
-use crate::config::{EXCITATION, GATES_LOW, GATES_OUTPUT, PORTS_CONFIG};
+use crate::config::{BREAK_PULL, EXCITATION, GATES_OFF, GATES_OUTPUT, PORTS_CONFIG};
 use crate::registers::{Field, PortConfig};
 
 /// Read-modify-write of one GPIO register with a computed field.
@@ -34,19 +34,29 @@ macro_rules! route {
     }};
 }
 
-/// Routes the board's timer, break and CAN pins to their peripherals.
+/// Routes the board's timer, break and CAN pins to their peripherals; the break pin gets
+/// the pull to its inactive level first ([`crate::config::BREAK_PULL`]), so that an
+/// open-drain comparator's line never floats into TIM1_BKIN.
 pub fn init(gpioa: &pac::GPIOA, gpiob: &pac::GPIOB, gpioc: &pac::GPIOC) {
+    let [pa, pb, pc] = BREAK_PULL;
+    rmw!(gpioa.pupdr(), pa);
+    rmw!(gpiob.pupdr(), pb);
+    rmw!(gpioc.pupdr(), pc);
     let [a, b, c] = PORTS_CONFIG;
     route!(gpioa, a);
     route!(gpiob, b);
     route!(gpioc, c);
 }
 
-/// Forces the six gate signals low as plain GPIO outputs, independent of the
-/// timer: the last line of defence of the fault handlers.
-pub fn gates_low(gpioa: &pac::GPIOA, gpiob: &pac::GPIOB, gpioc: &pac::GPIOC) {
-    let [ra, rb, rc] = GATES_LOW;
-    // SAFETY: BSRR bits 16–31 reset the pins named; writing 0 elsewhere has no effect.
+/// Forces the six gate signals to their off levels as plain GPIO outputs, independent of
+/// the timer: the last line of defence of the fault handlers. The level is each driver
+/// input's (`motor::board::GATE_OFF_LEVELS`): low for an in-phase input, high for an
+/// active-low one such as the L6398's LIN — driving that one low would turn its switch on.
+/// The output data is written before the mode, so a pin never drives the wrong level.
+pub fn gates_off(gpioa: &pac::GPIOA, gpiob: &pac::GPIOB, gpioc: &pac::GPIOC) {
+    let [ra, rb, rc] = GATES_OFF;
+    // SAFETY: BSRR bits 0–15 set and 16–31 reset the pins named; writing 0 elsewhere has
+    // no effect (RM0440 GPIOx_BSRR).
     unsafe {
         gpioa.bsrr().write(|w| w.bits(ra));
         gpiob.bsrr().write(|w| w.bits(rb));

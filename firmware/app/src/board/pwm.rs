@@ -15,8 +15,12 @@
 //!   the carrier maximum for low-side shunts, at the minimum otherwise), routed as TRGO2
 //!   (MMS2 = OC4REF) to the injected conversions and as TRGO (MMS = OC4REF) to TIM3,
 //!   which resets the resolver excitation at the same instant.
-//! * TIM1_BDTR is written once ([`crate::config::BDTR`]): dead time, OSSR = OSSI = 1 and
-//!   idle levels 0 (with MOE = 0 all six outputs are driven to their off level), break
+//! * Output polarities and idle levels come from the board's gate driver
+//!   ([`crate::config::CCER`], [`crate::config::CR2`]: CCxP/CCxNP and OISx/OISxN, RM0440
+//!   TIMx_CCER, TIMx_CR2), written before BDTR's LOCK freezes the idle levels: an
+//!   active-low input (the L6398's LIN) is driven inverted and idles high.
+//! * TIM1_BDTR is written once ([`crate::config::BDTR`]): dead time, OSSR = OSSI = 1 (with
+//!   MOE = 0 all six outputs are driven to their idle, off, levels), break
 //!   enable with the board's polarity and filter, LOCK level 1. LOCK and the fields it
 //!   protects are write-once after reset (RM0440 §29.3.18): the old second write for
 //!   LOCK never took effect.
@@ -27,8 +31,8 @@
 use stm32g4::stm32g474 as pac;
 
 use crate::bringup::{self, BreakActive, BreakControl};
-use crate::config::{BDTR, PWM_PERIOD, TRIGGER};
-use crate::registers::{MMS_OC4REF, PWM_MODE_1};
+use crate::config::{BDTR, CCER, CR2, PWM_PERIOD, TRIGGER};
+use crate::registers::PWM_MODE_1;
 
 /// Configures TIM1 with the outputs disabled (MOE = 0) and 50 % duty.
 pub fn init(tim1: &pac::TIM1) {
@@ -62,24 +66,16 @@ pub fn init(tim1: &pac::TIM1) {
             .oc4pe()
             .set_bit()
     });
-    // SAFETY: MMS and MMS2 take OC4REF's code (RM0440 TIMx_CR2; ST's LL_TIM_TRGO_OC4REF,
-    // LL_TIM_TRGO2_OC4).
-    tim1.cr2()
-        .write(|w| unsafe { w.mms().bits(MMS_OC4REF).mms2().bits(MMS_OC4REF) });
-    tim1.ccer().write(|w| {
-        w.cc1e()
-            .set_bit()
-            .cc1ne()
-            .set_bit()
-            .cc2e()
-            .set_bit()
-            .cc2ne()
-            .set_bit()
-            .cc3e()
-            .set_bit()
-            .cc3ne()
-            .set_bit()
-    });
+    // SAFETY: the host-tested value (motor_config::registers::cr2): MMS and MMS2 take
+    // OC4REF's code (RM0440 TIMx_CR2; ST's LL_TIM_TRGO_OC4REF, LL_TIM_TRGO2_OC4) and
+    // OIS1..OIS3N the gate driver's off levels — before the BDTR write below, whose LOCK
+    // level 1 freezes them (RM0440 TIMx_BDTR LOCK[1:0] = 01), as ST's HAL writes the idle
+    // states in HAL_TIM_PWM_ConfigChannel before HAL_TIMEx_ConfigBreakDeadTime.
+    tim1.cr2().write(|w| unsafe { w.bits(CR2) });
+    // SAFETY: the host-tested value (motor_config::registers::ccer): CC1E..CC3NE and the
+    // gate driver's polarities CCxP/CCxNP (an active-low input such as the L6398's LIN
+    // needs its output inverted, RM0440 TIMx_CCER).
+    tim1.ccer().write(|w| unsafe { w.bits(CCER) });
     // BKIN from the pin (reset value, made explicit), not inverted: the polarity is
     // BDTR.BKP (TIMx_AF1.BKINP must be programmed together with it).
     tim1.af1().modify(|_, w| w.bkine().set_bit().bkinp().clear_bit());

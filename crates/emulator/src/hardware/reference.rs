@@ -1,0 +1,72 @@
+//! The motorgen reference inverter: thesis A's controller as this project specifies it
+//! (the board the firmware assumed before boards were data). It has no published
+//! schematic; this is its design, stated here for the emulator and, separately, in its
+//! board file: SiC MOSFETs, each behind an isolated single-channel driver
+//! (1EDI20N12AF), Hall-type phase-current sensors, an over-current comparator on the
+//! break input, the resolver front end and a CAN transceiver.
+
+use super::{Analog, AnalogInput, Driver, DriverInput, Hardware, Logic, Pull};
+
+/// A 1EDI20N12AF's IN+: non-inverting with an internal pull-down, IN− tied to ground
+/// (1EDI20N12AF data sheet Rev. 2.0, pin description).
+const fn in_plus(pin: &'static str) -> DriverInput {
+    DriverInput {
+        pin,
+        logic: Logic::ActiveHigh,
+        pull: Pull::Down,
+    }
+}
+
+/// The front ends' output resistance: op-amp output plus the anti-aliasing series
+/// resistor of the design.
+const FRONT_END_OHM: f64 = 1_100.0;
+
+/// The hardware.
+pub fn hardware() -> Hardware {
+    let input = |pin, signal, source| AnalogInput {
+        pin,
+        signal,
+        source_ohm: FRONT_END_OHM,
+        source,
+    };
+    Hardware {
+        board: "motorgen-reference",
+        chip: "STM32G474RE",
+        legs: [
+            [in_plus("PA8"), in_plus("PB13")],
+            [in_plus("PA9"), in_plus("PB14")],
+            [in_plus("PA10"), in_plus("PB15")],
+        ],
+        driver: Driver {
+            part: "1EDI20N12AF",
+            // One single-channel driver per switch: nothing couples a leg's two switches
+            // and no driver inserts dead time (1EDI20N12AF data sheet).
+            interlock: false,
+            dead_time_s: 0.0,
+            // The design's switching allowance: the driver's turn-off propagation plus
+            // the SiC switch's turn-off; TIM1's dead time must exceed it (thesis A §3.2:
+            // switches do not turn off instantly, so a dead time separates them).
+            turn_off_s: 200e-9,
+        },
+        analog: vec![
+            input("PA0", Analog::Current(0), "Hall sensor u"),
+            input("PA6", Analog::Current(1), "Hall sensor v"),
+            input("PA4", Analog::Current(2), "Hall sensor w"),
+            input("PA2", Analog::DcLink, "DC-link divider buffer"),
+            input("PA1", Analog::Sin, "resolver SIN front end"),
+            input("PA7", Analog::Cos, "resolver COS front end"),
+        ],
+        // Hall sensors mounted positive for a current out of the leg: 15 mV/A about
+        // mid-supply (sized for thesis A's Fischer TI085, ±110 A).
+        current_gain_v_per_a: 0.015,
+        current_offset_v: 1.65,
+        // 3.3 V at 750 V (1.25 × thesis A's 600 V accumulator).
+        dc_link_ratio: 0.0044,
+        vref: 3.3,
+        break_pin: "PB12",
+        break_active_low: true,
+        excitation_pin: "PC6",
+        // CAN RX on PB8: the transceiver's RXD idles high.
+        boot0_may_be_high: true,
+    }
+}

@@ -1,0 +1,95 @@
+//! Board files with one fact wrong, built into images and run on the emulated board
+//! they claim to describe (its own hardware description, not the file): each fails with
+//! the rule or the criterion that catches it. Built from the NUCLEO-G474RE +
+//! X-NUCLEO-IHM08M1 file (the motor: the first that fits it).
+
+use crate::BOOT_LIMIT_S;
+use crate::closed_loop::current_step_on;
+use motor_emulator::rig::{Bench, Rig, benches};
+use motor_emulator::{Stop, Violation};
+
+const BOARD: &str = "nucleo-g474re-ihm08m1";
+
+/// The bench with the board file's `from` replaced by `to` (exactly once).
+fn variant(from: &str, to: &str) -> Bench {
+    let motor = benches()
+        .into_iter()
+        .find(|(_, b)| b == BOARD)
+        .map(|(m, _)| m)
+        .expect("a motor fits the NUCLEO");
+    let bench = Bench::new(&motor, BOARD).unwrap();
+    assert_eq!(bench.board.text.matches(from).count(), 1, "{from:?} once in the board file");
+    let text = bench.board.text.replace(from, to);
+    bench.board_text(text)
+}
+
+/// Boots the variant; the violation that stopped it.
+fn boot_violation(bench: Bench) -> Violation {
+    let name = bench.name();
+    let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{name}: {e}"));
+    match rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false) {
+        Err(Stop::Violation(v)) => v,
+        r => panic!("{name}: expected a strict-mode rule, got {r:?}"),
+    }
+}
+
+/// The driver named wrongly (an IR2110, in-phase inputs, where the shield has L6398s
+/// with an active-low LIN): the image idles CHxN low, which turns all three low sides on
+/// as soon as the pins are routed.
+#[test]
+fn wrong_gate_driver_shorts_the_phases_at_bring_up() {
+    let v = boot_violation(variant("part = \"L6398\"", "part = \"IR2110\""));
+    println!("driver polarity wrong: {v}");
+    assert!(
+        v.rule.contains("phases shorted through the low sides while the image means the outputs off"),
+        "{v}"
+    );
+}
+
+/// The break input said to be active high: the comparator's idle-high line is a break
+/// from the moment it is routed; the image halts at bring-up with the outputs off.
+#[test]
+fn wrong_break_polarity_halts_at_bring_up() {
+    let bench = variant(
+        "polarity = \"active_low\"         # the shield's",
+        "polarity = \"active_high\"        # the shield's",
+    );
+    let name = bench.name();
+    let mut rig = Rig::new(bench).unwrap();
+    let e = rig.boot(BOOT_LIMIT_S).unwrap_err();
+    println!("break polarity wrong: {e}");
+    assert!(e.contains("no enabled PWM period") && e.contains("bring-up"), "{name}: {e}");
+}
+
+/// The shunts said to be in line: the sign of the current sensing flips and the current
+/// loops feed back positively.
+#[test]
+fn wrong_current_sign_fails_the_closed_loop() {
+    let bench = variant("placement = \"low_side\"", "placement = \"inline\"");
+    let name = bench.name();
+    let r = current_step_on(bench);
+    let failed = match r {
+        Err(e) => e,
+        Ok(Some(out)) => format!("{:?}", out.failed()),
+        Ok(None) => panic!("{name}: a motor without a torque constant"),
+    };
+    println!("current sign wrong: {failed}");
+    assert!(failed != "[]", "{name}: the step passed");
+}
+
+/// The amplifier gain 10 % high and 10 % low: the image's currents are read 10 % off and
+/// the step misses verify's criteria.
+#[test]
+fn current_gain_ten_percent_off_fails_the_step() {
+    for gain in ["5.698", "4.662"] {
+        let bench = variant("amplifier_gain = 5.18", &format!("amplifier_gain = {gain}"));
+        let name = bench.name();
+        let out = current_step_on(bench)
+            .unwrap_or_else(|e| panic!("{name}: {e}"))
+            .expect("a torque constant");
+        for c in &out.checks {
+            println!("gain {gain}: {}", c.2);
+        }
+        assert!(!out.failed().is_empty(), "{name}: a 10 % gain error passed");
+    }
+}
