@@ -28,8 +28,8 @@ use unicorn_engine::{RegisterARM, Unicorn};
 
 pub use periph::fdcan::Frame;
 pub use soc::{Analog, Note, Patches, Pulse, Soc, UNITS_PER_S, Wiring};
-pub use violation::Violation;
 use violation::Broken;
+pub use violation::Violation;
 
 use image::Image;
 
@@ -432,11 +432,17 @@ impl Machine {
         if let Some(b) = self.uc.get_data_mut().basepri_request.take() {
             self.reg_w(RegisterARM::BASEPRI, b)?;
         }
-        if let Some(n) = self.injected.pop() {
-            if n == HARD_FAULT && self.active.iter().any(|&(a, _, _)| a == HARD_FAULT) {
-                return self.fault();
+        if !self.injected.is_empty() {
+            // All injected at once, before any instruction of a handler runs: a second
+            // HardFault is a fault at the first one's first instruction.
+            while let Some(n) = self.injected.pop() {
+                if n == HARD_FAULT && self.active.iter().any(|&(a, _, _)| a == HARD_FAULT) {
+                    self.fault()?;
+                } else {
+                    self.enter(n)?;
+                }
             }
-            return self.enter(n);
+            return Ok(());
         }
         if !self.active.is_empty() {
             return Ok(());

@@ -145,7 +145,8 @@ impl Rig {
         if !reached {
             return Err(format!(
                 "no enabled PWM period within {limit_s} s{}; {}",
-                self.fault_cause().map_or(String::new(), |c| format!(" (fault record: {c})")),
+                self.fault_cause()
+                    .map_or(String::new(), |c| format!(" (fault record: {c})")),
                 self.machine.summary()
             ));
         }
@@ -264,7 +265,10 @@ pub fn benches() -> Vec<(String, String)> {
                 n += 1;
             }
         }
-        assert!(n > 0 || std::env::var_os("EMULATOR_MOTORS").is_some(), "no motor fits {board}");
+        assert!(
+            n > 0 || std::env::var_os("EMULATOR_MOTORS").is_some(),
+            "no motor fits {board}"
+        );
     }
     out
 }

@@ -394,7 +394,9 @@ impl Soc {
                     }
                 }
                 Some((per, s)) => undriven(format!("AF{af} routes {per}_{s} to {name}, not a TIM1 output")),
-                None => undriven(format!("AF{af} routes no signal to {name} (DS12288 alternate functions)")),
+                None => undriven(format!(
+                    "AF{af} routes no signal to {name} (DS12288 alternate functions)"
+                )),
             },
             Mode::Input => undriven(format!("{name} is an input")),
             Mode::Analog => undriven(format!("{name} is in analog mode (its reset state)")),
@@ -430,11 +432,7 @@ impl Soc {
         }
         let d = &self.wiring.hw.driver;
         let legs = std::array::from_fn(|leg| {
-            bridge::leg(
-                d,
-                [&inputs[leg], &inputs[leg + 3]],
-                [&levels[leg], &levels[leg + 3]],
-            )
+            bridge::leg(d, [&inputs[leg], &inputs[leg + 3]], [&levels[leg], &levels[leg + 3]])
         });
         Ok((pins, legs))
     }
@@ -471,7 +469,12 @@ impl Soc {
             let both = bridge::overlap(&hw.driver, s);
             if broken.is_none() && both > 0.0 {
                 broken = Some(Broken::new(
-                    format!("{}/{} (leg {})", inputs[leg].pin, inputs[leg + 3].pin, ["u", "v", "w"][leg]),
+                    format!(
+                        "{}/{} (leg {})",
+                        inputs[leg].pin,
+                        inputs[leg + 3].pin,
+                        ["u", "v", "w"][leg]
+                    ),
                     format!(
                         "shoot-through: both switches of the leg conduct together for {:.0} ns per period — TIM1's dead time ({:.0} ns) and the {}'s own ({:.0} ns) do not cover the switches' {:.0} ns turn-off",
                         both * 1e9,
@@ -515,7 +518,11 @@ impl Soc {
                             GATE_NAMES[k],
                             inputs[k].pin,
                             hw.driver.part,
-                            if inputs[k].logic == crate::hardware::Logic::ActiveLow { "low" } else { "high" }
+                            if inputs[k].logic == crate::hardware::Logic::ActiveLow {
+                                "low"
+                            } else {
+                                "high"
+                            }
                         )
                     })
                     .collect();
@@ -625,11 +632,7 @@ impl Soc {
             Block::Syscfg => self.syscfg.read(off)?,
             Block::Tim1 => {
                 let v = self.tim1.read(off, t)?;
-                if off == 0x10 {
-                    self.sr_read(v)
-                } else {
-                    v
-                }
+                if off == 0x10 { self.sr_read(v) } else { v }
             }
             Block::Cordic => self.cordic.read(off)?,
             Block::Rcc => self.clocks.rcc_read(off)?,
@@ -663,8 +666,12 @@ impl Soc {
             self.sr_in_irq = None;
             return v;
         }
+        // Only the interrupt's first read arms the pulse: a run that stops inside an
+        // interrupt must not start it right after that interrupt's BIF re-read.
+        let first_read = self.sr_in_irq.is_none();
         for p in &mut self.pulses {
             if let Pulse::AfterSrReadInIrq { after, len } = *p
+                && first_read
                 && self.now >= after
             {
                 // One instruction after the read.

@@ -57,7 +57,14 @@ impl Sensing {
 
     /// Voltage at the pin of `signal` with phase currents `currents` \[A\], DC link
     /// `dc_link_v` \[V\], resolver angle `theta_r` \[rad\] and the excitation's level.
-    pub fn volts(&self, signal: Signal, currents: [f64; 3], dc_link_v: f64, theta_r: f64, excitation_high: bool) -> f64 {
+    pub fn volts(
+        &self,
+        signal: Signal,
+        currents: [f64; 3],
+        dc_link_v: f64,
+        theta_r: f64,
+        excitation_high: bool,
+    ) -> f64 {
         let half = self.hw.vref / 2.0;
         let sign = if excitation_high { 1.0 } else { -1.0 };
         match signal {

@@ -71,7 +71,13 @@ fn foreign(cx: &mut ResolveContext<'_>, v: Option<Range<usize>>, key: &str, kind
     }
 }
 
-fn required<'v>(cx: &mut ResolveContext<'_>, v: Option<&'v Val>, section: Range<usize>, key: &str, what: &str) -> Option<&'v Val> {
+fn required<'v>(
+    cx: &mut ResolveContext<'_>,
+    v: Option<&'v Val>,
+    section: Range<usize>,
+    key: &str,
+    what: &str,
+) -> Option<&'v Val> {
     if v.is_none() {
         cx.err(section, key, format!("missing `{key}`: {what}"), what.to_string());
     }
@@ -153,9 +159,22 @@ pub(super) fn resolve(
                     "sample_instant = \"low_side_centre\"",
                 );
             }
-            let shunt = required(cx, c.shunt.as_ref(), section.clone(), "current_sensing.shunt", "the shunt resistance, e.g. shunt = \"10 mΩ\"").and_then(|v| {
+            let shunt = required(
+                cx,
+                c.shunt.as_ref(),
+                section.clone(),
+                "current_sensing.shunt",
+                "the shunt resistance, e.g. shunt = \"10 mΩ\"",
+            )
+            .and_then(|v| {
                 spans.push(("current_sensing.shunt".into(), v.span()));
-                cx.quantity("current_sensing.shunt", v, Kind::Resistance, Provenance::Datasheet, true)
+                cx.quantity(
+                    "current_sensing.shunt",
+                    v,
+                    Kind::Resistance,
+                    Provenance::Datasheet,
+                    true,
+                )
             });
             let gain = required(cx, c.amplifier_gain.as_ref(), section.clone(), "current_sensing.amplifier_gain", "the amplifier's gain from the shunt voltage (its leg-side terminal minus the other) to the ADC pin, e.g. amplifier_gain = 5.18; negative for an inverting stage").and_then(|v| {
                 spans.push(("current_sensing.amplifier_gain".into(), v.span()));
@@ -191,13 +210,35 @@ pub(super) fn resolve(
             for (v, key) in [
                 (c.placement.as_ref().map(Spanned::span), "current_sensing.placement"),
                 (c.shunt.as_ref().map(Spanned::span), "current_sensing.shunt"),
-                (c.amplifier_gain.as_ref().map(Spanned::span), "current_sensing.amplifier_gain"),
+                (
+                    c.amplifier_gain.as_ref().map(Spanned::span),
+                    "current_sensing.amplifier_gain",
+                ),
             ] {
-                foreign(cx, v, key, "shunt", "a Hall sensor is described by sensitivity and direction");
+                foreign(
+                    cx,
+                    v,
+                    key,
+                    "shunt",
+                    "a Hall sensor is described by sensitivity and direction",
+                );
             }
-            let sens = required(cx, c.sensitivity.as_ref(), section.clone(), "current_sensing.sensitivity", "the sensor's output per ampere at the ADC pin, e.g. sensitivity = \"15 mV/A\"").and_then(|v| {
+            let sens = required(
+                cx,
+                c.sensitivity.as_ref(),
+                section.clone(),
+                "current_sensing.sensitivity",
+                "the sensor's output per ampere at the ADC pin, e.g. sensitivity = \"15 mV/A\"",
+            )
+            .and_then(|v| {
                 spans.push(("current_sensing.sensitivity".into(), v.span()));
-                cx.quantity("current_sensing.sensitivity", v, Kind::Transresistance, Provenance::Datasheet, true)
+                cx.quantity(
+                    "current_sensing.sensitivity",
+                    v,
+                    Kind::Transresistance,
+                    Provenance::Datasheet,
+                    true,
+                )
             });
             let direction = match &c.direction {
                 Some(d) => {

@@ -480,8 +480,16 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         );
     }
     for (moved, key, to) in [
-        (&s.current_gain, "sensing.current_gain", "[current_sensing]: kind, placement, shunt and amplifier_gain (or a Hall sensor's sensitivity and direction), from which the signed gain is derived"),
-        (&s.current_offset, "sensing.current_offset", "[current_sensing] offset = \"1.65 V\""),
+        (
+            &s.current_gain,
+            "sensing.current_gain",
+            "[current_sensing]: kind, placement, shunt and amplifier_gain (or a Hall sensor's sensitivity and direction), from which the signed gain is derived",
+        ),
+        (
+            &s.current_offset,
+            "sensing.current_offset",
+            "[current_sensing] offset = \"1.65 V\"",
+        ),
     ] {
         if let Some(v) = moved {
             cx.err(
@@ -924,7 +932,11 @@ mod tests {
             (Signal::CurrentW, "PC0", false),
         ] {
             let s = b.adc.iter().flatten().find(|s| s.signal == signal).unwrap();
-            assert_eq!((s.pin, s.sampling.fast, s.sampling.cycles), (pin, fast, 24.5), "{signal:?}");
+            assert_eq!(
+                (s.pin, s.sampling.fast, s.sampling.cycles),
+                (pin, fast, 24.5),
+                "{signal:?}"
+            );
         }
         assert_eq!(b.gate_driver.part.as_deref(), Some("L6398"));
         assert_eq!(tim1_ccer_polarity(&b), 0x0888);

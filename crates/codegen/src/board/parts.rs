@@ -196,7 +196,12 @@ mod tests {
         let p = gate_driver("l6398").unwrap();
         assert_eq!(
             (p.high_side.logic, p.high_side.pull, p.low_side.logic, p.low_side.pull),
-            (InputLogic::InPhase, InputPull::Down, InputLogic::Inverted, InputPull::Up)
+            (
+                InputLogic::InPhase,
+                InputPull::Down,
+                InputLogic::Inverted,
+                InputPull::Up
+            )
         );
         assert!(p.interlock);
         assert_eq!(p.dead_time_s, Some(320e-9));

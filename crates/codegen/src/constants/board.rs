@@ -205,7 +205,9 @@ impl<'a> OnBoard<'a> {
                 let v = c.o.tim1_ccer_polarity;
                 (intv(v.into(), "u32", "uint32_t"), format!("{v:#06x}"))
             }),
-            formula: Lit("CCxP (bit 4x−3) for an inverted high-side input, CCxNP (bit 4x−1) for an inverted low-side input, x = 1..3"),
+            formula: Lit(
+                "CCxP (bit 4x−3) for an inverted high-side input, CCxNP (bit 4x−1) for an inverted low-side input, x = 1..3",
+            ),
             equation: Lit("RM0440 TIMx_CCER; gate-driver datasheet (parts table)"),
             inputs: Of(|c| c.key("gate_driver")),
             json: Json::At("/board/tim1_ccer_polarity"),

@@ -241,7 +241,9 @@ fn a_stated_fact_contradicting_its_part_is_warned_at_the_key() {
     assert_eq!(b.warnings.len(), 2, "{:#?}", b.warnings);
     let w = &b.warnings[0];
     assert!(
-        w.starts_with(&format!("nucleo-stated.toml:{line}:{column}: `gate_driver.low_side_input`: ")),
+        w.starts_with(&format!(
+            "nucleo-stated.toml:{line}:{column}: `gate_driver.low_side_input`: "
+        )),
         "{w}"
     );
     for needle in ["in_phase", "L6398 has inverted", "truth table", "LIN is active low"] {

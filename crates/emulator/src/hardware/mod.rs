@@ -185,7 +185,9 @@ impl Hardware {
     pub fn adc_pin(&self, adc: usize, channel: u8) -> Option<&'static str> {
         let name = format!("ADC{adc}");
         let c = self.chip_data();
-        c.pin_names().into_iter().find(|p| c.adc_channel(p, &name) == Some(channel))
+        c.pin_names()
+            .into_iter()
+            .find(|p| c.adc_channel(p, &name) == Some(channel))
     }
 
     /// The analog input wired to `pin`, if any.

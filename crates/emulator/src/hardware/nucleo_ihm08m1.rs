@@ -129,7 +129,11 @@ mod tests {
     #[test]
     fn sensing_by_hand() {
         let h = super::hardware();
-        assert!((h.current_gain_v_per_a + 0.051_818).abs() < 1e-6, "{}", h.current_gain_v_per_a);
+        assert!(
+            (h.current_gain_v_per_a + 0.051_818).abs() < 1e-6,
+            "{}",
+            h.current_gain_v_per_a
+        );
         assert!((h.current_offset_v - 1.710_0).abs() < 1e-4, "{}", h.current_offset_v);
         assert!((h.dc_link_ratio - 0.052_212).abs() < 1e-6);
     }

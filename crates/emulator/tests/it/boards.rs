@@ -18,7 +18,11 @@ fn variant(from: &str, to: &str) -> Bench {
         .map(|(m, _)| m)
         .expect("a motor fits the NUCLEO");
     let bench = Bench::new(&motor, BOARD).unwrap();
-    assert_eq!(bench.board.text.matches(from).count(), 1, "{from:?} once in the board file");
+    assert_eq!(
+        bench.board.text.matches(from).count(),
+        1,
+        "{from:?} once in the board file"
+    );
     let text = bench.board.text.replace(from, to);
     bench.board_text(text)
 }
@@ -34,14 +38,18 @@ fn boot_violation(bench: Bench) -> Violation {
 }
 
 /// The driver named wrongly (an IR2110, in-phase inputs, where the shield has L6398s
-/// with an active-low LIN): the image idles CHxN low, which turns all three low sides on
-/// as soon as the pins are routed.
+/// with an active-low LIN): the image idles CHxN low, which turns each low side on as
+/// soon as its pin is routed. The bring-up routes port A first, so PA7 (u low) is the
+/// first: one low side on with MOE = 0 stops the run before PB0/PB1 would short the
+/// phases through the low sides.
 #[test]
-fn wrong_gate_driver_shorts_the_phases_at_bring_up() {
+fn wrong_gate_driver_turns_a_low_side_on_at_bring_up() {
     let v = boot_violation(variant("part = \"L6398\"", "part = \"IR2110\""));
     println!("driver polarity wrong: {v}");
+    assert!(v.rule.contains("while the image means the outputs off"), "{v}");
     assert!(
-        v.rule.contains("phases shorted through the low sides while the image means the outputs off"),
+        v.rule
+            .contains("u low side on (PA7 low, the L6398 input is active low)"),
         "{v}"
     );
 }
@@ -58,7 +66,10 @@ fn wrong_break_polarity_halts_at_bring_up() {
     let mut rig = Rig::new(bench).unwrap();
     let e = rig.boot(BOOT_LIMIT_S).unwrap_err();
     println!("break polarity wrong: {e}");
-    assert!(e.contains("no enabled PWM period") && e.contains("bring-up"), "{name}: {e}");
+    assert!(
+        e.contains("no enabled PWM period") && e.contains("bring-up"),
+        "{name}: {e}"
+    );
 }
 
 /// The shunts said to be in line: the sign of the current sensing flips and the current

@@ -80,7 +80,9 @@ fn lock_in_a_second_bdtr_write_is_refused_with_the_rule() {
         bdtr_lock_second_write: true,
         ..Patches::default()
     };
-    let bench = Bench::new("fischer-ti085", codegen::board::DEFAULT_BOARD).unwrap().patched(patches);
+    let bench = Bench::new("fischer-ti085", codegen::board::DEFAULT_BOARD)
+        .unwrap()
+        .patched(patches);
     let mut rig = Rig::new(bench).unwrap();
     let err = rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false).unwrap_err();
     let Stop::Violation(v) = err else {
@@ -104,7 +106,9 @@ fn aden_written_once_after_calibration_is_refused_with_the_rule() {
         single_aden_write: true,
         ..Patches::default()
     };
-    let bench = Bench::new("fischer-ti085", codegen::board::DEFAULT_BOARD).unwrap().patched(patches);
+    let bench = Bench::new("fischer-ti085", codegen::board::DEFAULT_BOARD)
+        .unwrap()
+        .patched(patches);
     let mut rig = Rig::new(bench).unwrap();
     let result = rig.run(BOOT_LIMIT_S, |_| Some(0.0), |_| false);
     let lost = rig.machine.soc().adc.iter().map(|a| a.lost_aden_writes).sum::<u32>();

@@ -52,7 +52,11 @@ impl Outcome {
 fn closed_loop(bench: Bench) -> Result<(Rig, codegen::spec::Spec), String> {
     let spec = motor_emulator::wiring::spec(&bench.motor)?;
     let mut rig = Rig::with_analog(bench, |d, hw| {
-        Ok(Box::new(Drive::new(&Setup::new(&spec, d), SpeedProfile::constant(0.0), hw)))
+        Ok(Box::new(Drive::new(
+            &Setup::new(&spec, d),
+            SpeedProfile::constant(0.0),
+            hw,
+        )))
     })?;
     rig.boot(BOOT_LIMIT_S).map_err(|e| format!("boot: {e}"))?;
     let t = rig.machine.soc().time_s() + SETTLE_S;
@@ -182,6 +186,10 @@ fn current_step_through_a_can_torque_setpoint_meets_verifys_criteria() {
         for c in &out.checks {
             println!("{}", c.2);
         }
-        assert!(out.failed().is_empty(), "{name}: {:?} failed on the emulated image", out.failed());
+        assert!(
+            out.failed().is_empty(),
+            "{name}: {:?} failed on the emulated image",
+            out.failed()
+        );
     }
 }

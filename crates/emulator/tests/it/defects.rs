@@ -194,7 +194,10 @@ fn lockup_breaks_tim1_only_with_cll() {
             let r = rig.machine.run_until(t + rig.pwm_period_s());
             match (cll, r) {
                 (true, Err(Stop::Lockup(_))) => {
-                    assert!(!rig.machine.soc().gates_can_switch(), "{name}: a switch on after the lockup");
+                    assert!(
+                        !rig.machine.soc().gates_can_switch(),
+                        "{name}: a switch on after the lockup"
+                    );
                     println!("{name}: lockup → break → outputs off");
                 }
                 (false, Err(Stop::Violation(v))) => assert_rule(&name, Some(v), &["locked up", "CLL clear"]),
@@ -234,7 +237,10 @@ fn a_break_pulse_inside_the_interrupt_is_not_missed() {
                 assert_rule(&name, Some(v), &["MOE set while SR.BIF is latched"]);
             } else {
                 r.unwrap_or_else(|e| panic!("{name}: {e}"));
-                assert!(!rig.machine.soc().gates_can_switch(), "{name}: outputs on after the break");
+                assert!(
+                    !rig.machine.soc().gates_can_switch(),
+                    "{name}: outputs on after the break"
+                );
                 println!("{name}: 200 ns break inside the interrupt → off for good");
             }
         }

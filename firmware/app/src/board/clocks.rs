@@ -67,6 +67,21 @@ pub fn init(rcc: &pac::RCC, pwr: &pac::PWR, flash: &pac::FLASH) -> bool {
     true
 }
 
+/// Enables the clocks of TIM1 and GPIOA..C, which the fault path writes: a fault before
+/// [`enable_peripherals`] (a bring-up halt on the option bytes) would otherwise write
+/// to unclocked peripherals, whose writes RM0440 does not support (§7.4, the RCC's
+/// peripheral clock enable registers), and leave the gate pins in their reset state
+/// instead of driving them off. Setting an enable bit that is already set changes
+/// nothing, so this is safe from any state.
+pub fn enable_gate_peripherals(rcc: &pac::RCC) {
+    rcc.ahb2enr()
+        .modify(|_, w| w.gpioaen().set_bit().gpioben().set_bit().gpiocen().set_bit());
+    rcc.apb2enr().modify(|_, w| w.tim1en().set_bit());
+    // Two clock cycles before the first access: read back, as in enable_peripherals.
+    let _ = rcc.ahb2enr().read();
+    let _ = rcc.apb2enr().read();
+}
+
 /// Enables the clocks of every peripheral the board uses.
 pub fn enable_peripherals(rcc: &pac::RCC) {
     rcc.ahb1enr().modify(|_, w| w.cordicen().set_bit().fmacen().set_bit());

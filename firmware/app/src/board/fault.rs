@@ -13,7 +13,7 @@ use cortex_m_rt::exception;
 use stm32g4::stm32g474 as pac;
 
 use super::can::Can;
-use super::{pins, watchdog};
+use super::{clocks, pins, watchdog};
 use crate::fault_frame::encode;
 use crate::fault_record::{
     ControlState, FaultCause, FaultRecord, RECORD_WORDS, STATE_WORDS, at_boot, classify_hard_fault,
@@ -58,6 +58,9 @@ fn outputs_off_and_wait(record: &FaultRecord) -> ! {
     // TIM1, GPIOA/B and the IWDG never run again; the writes below only move the
     // outputs towards the off state, which is safe whatever those owners did last.
     let dp = unsafe { pac::Peripherals::steal() };
+    // A halt before the bring-up enabled the peripheral clocks (the option-byte check)
+    // reaches here with TIM1 and the GPIO ports unclocked.
+    clocks::enable_gate_peripherals(&dp.RCC);
     dp.TIM1.bdtr().modify(|_, w| w.moe().clear_bit());
     pins::gates_off(&dp.GPIOA, &dp.GPIOB, &dp.GPIOC);
     watchdog::start_default(&dp.IWDG);
