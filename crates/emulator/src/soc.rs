@@ -993,6 +993,9 @@ impl Soc {
                 }
             }
             TimerEvent::Update => {
+                if let Some(b) = self.tim1.repetition_broken() {
+                    self.fail(b);
+                }
                 self.tim1.update();
                 self.bridge_changed(t);
                 if self.tim1.moe() && !self.notes.iter().any(|n| matches!(n, Note::FirstEnabledPeriod(_))) {

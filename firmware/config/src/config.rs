@@ -185,6 +185,11 @@ pub const BDTR: u32 = registers::bdtr(
 /// OC4M and CCR4 of the ADC trigger at the board's sampling instant (defect 8).
 pub const TRIGGER: (u8, u16) = registers::trigger_channel(board::SAMPLE_AT_CARRIER_MAXIMUM == 1, PWM_PERIOD);
 
+/// TIM1_RCR before the start and after it (`registers::repetition`): the update event
+/// at the board's sampling instant, one carrier period before the compare values computed
+/// from that sample take effect.
+pub const REPETITION: (u8, Option<u8>) = registers::repetition(board::SAMPLE_AT_CARRIER_MAXIMUM == 1);
+
 /// ADC_JSQR of ADC1 and ADC2: the board's channels on TIM1_TRGO2.
 pub const JSQR: [u32; 2] = match (
     registers::jsqr(&board::ADC1_CHANNELS),

@@ -234,6 +234,31 @@ pub const fn bdtr(dtg: u8, break_active_high: bool, break_filter: u8, lock: u8) 
 /// again until reset (RM0440, TIMx_BDTR).
 pub const LOCK_LEVEL_1: u8 = 0b01;
 
+/// TIMx_RCR before the counter starts, and after, for the update event one carrier
+/// period after the board's sampling instant (RM0440 TIM1 "Repetition counter": in
+/// centre-aligned mode the repetition counter REP_CNT counts overflows and underflows,
+/// an update event comes when it has run down and reloads it from RCR; "for odd values
+/// of RCR, the update event occurs either on the overflow or on the underflow depending
+/// on when the RCR register was written and when the counter was launched: if the RCR
+/// was written before launching the counter, the UEV occurs on the underflow. If the RCR
+/// was written after launching the counter, the UEV occurs on the overflow").
+///
+/// * Sampling at the carrier minimum: RCR = 1 before the UG that loads REP_CNT and
+///   before the start: the update at every underflow.
+/// * Sampling at the carrier maximum (low-side shunts): RCR = 0 at the UG (REP_CNT = 0)
+///   and RCR = 1 written right after the start, before the first overflow half a period
+///   later: the update at every overflow.
+///
+/// Either way the compare values a control step computes from a sample take effect one
+/// period after it and hold for one period, the loop delay of 1.5·T_s the current loop
+/// is designed for (thesis A §4.6; `codegen`'s `FIRMWARE_LOOP_DELAY_PERIODS`). With the
+/// update at the underflow and the sample at the maximum they would act after half a
+/// period: a faster loop than designed. Returns (RCR at init, RCR after the start —
+/// `None`: no write).
+pub const fn repetition(at_carrier_maximum: bool) -> (u8, Option<u8>) {
+    if at_carrier_maximum { (0, Some(1)) } else { (1, None) }
+}
+
 /// OCxM codes (RM0440, TIMx_CCMR1/2 OCxM): PWM mode 1 (active while CNT < CCR) and 2.
 pub const PWM_MODE_1: u8 = 0b110;
 /// PWM mode 2: active while CNT ≥ CCR (up-counting).
@@ -247,9 +272,8 @@ pub const MMS_OC4REF: u8 = 0b0111;
 /// Centre-aligned mode 1 counts 0 → ARR → 0. PWM mode 1 on CH1–3 makes a high side
 /// conduct while CNT < CCRx, so around the carrier minimum (CNT = 0) the high sides
 /// conduct and around the maximum (CNT = ARR) the low sides do. The update event does
-/// *not* mark the maximum: with RCR = 1 loaded before the counter starts, the first
-/// repetition-counter underflow comes at the first overflow and the update event at the
-/// following underflow — every carrier minimum (RM0440 §29.3.5, Figure "update rate
+/// *not* mark the sampling instant by itself: it comes once per period, at the underflow
+/// or at the overflow as [`repetition`] sets it up (RM0440 §29.3.5, Figure "update rate
 /// examples depending on mode and TIMx_RCR"). So the trigger comes from channel 4:
 /// OC4REF as TRGO2 for the ADC and as TRGO for TIM3.
 ///
@@ -359,6 +383,16 @@ mod tests {
             }
         );
         assert_eq!(pull(0x06, 0b01)[1], Field::default());
+    }
+
+    /// The update event's place, by hand from RM0440 §29.3.5's rule (RCR written before
+    /// the launch: underflow; after it: overflow): sampling at the minimum keeps RCR = 1
+    /// throughout; at the maximum RCR = 0 goes into REP_CNT at the UG and 1 is written
+    /// after the launch.
+    #[test]
+    fn repetition_puts_the_update_at_the_sampling_instant() {
+        assert_eq!(repetition(false), (1, None));
+        assert_eq!(repetition(true), (0, Some(1)));
     }
 
     /// CCER with every output enabled (0x555) and the L6398's CC1NP..CC3NP (0x888):

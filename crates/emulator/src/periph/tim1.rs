@@ -40,7 +40,7 @@ const KNOWN: &[u32] = &[
 pub enum TimerEvent {
     /// OC4REF rose: TRGO (MMS = OC4REF) and TRGO2 (MMS2 = OC4REF).
     Trigger,
-    /// Update event at the underflow (RCR = 1).
+    /// Update event: at the underflow or the overflow (RCR = 1, [`Tim1::update_at_overflow`]).
     Update,
 }
 
@@ -66,6 +66,16 @@ pub struct Tim1 {
     pub break_active: bool,
     /// Phase of OC4REF's rising edge within the period, for the active CCR4/OC4M.
     trig_phase: Option<u64>,
+    /// The repetition counter REP_CNT, as the last UG or update event loaded it from RCR.
+    rep_cnt: u32,
+    /// The update events fall on the overflows (REP_CNT = 0 at the start), not the
+    /// underflows (REP_CNT = 1) — RM0440 §28.3.3: "if the RCR was written before
+    /// launching the counter, the UEV occurs on the underflow. If the RCR was written
+    /// after launching the counter, the UEV occurs on the overflow".
+    pub update_at_overflow: bool,
+    /// Started with RCR = 0 (REP_CNT = 0): RCR = 1 must be written before this first
+    /// overflow (bus units), or every overflow and underflow would be an update event.
+    rcr_due: Option<u64>,
 }
 
 impl Default for Tim1 {
@@ -91,6 +101,9 @@ impl Tim1 {
             triggers: 0,
             break_active: false,
             trig_phase: None,
+            rep_cnt: 0,
+            update_at_overflow: false,
+            rcr_due: None,
         }
     }
 
@@ -212,6 +225,7 @@ impl Tim1 {
             return None;
         }
         let offset = match event {
+            TimerEvent::Update if self.update_at_overflow => u64::from(self.arr) * self.tick,
             TimerEvent::Update => p,
             TimerEvent::Trigger => self.trig_phase? * self.tick,
         };
@@ -221,15 +235,27 @@ impl Tim1 {
     }
 
     /// The update event: preloaded compare values become active (OCxPE, RM0440
-    /// §28.3.10), UIF is set.
+    /// §28.3.10), REP_CNT is reloaded from RCR, UIF is set.
     pub fn update(&mut self) {
         for ch in 0..4 {
             self.active_ccr[ch] = self.regs[(0x34 / 4) + ch];
         }
         self.arr = self.reg(0x2C);
+        self.rep_cnt = self.reg(0x30);
         self.regs[0x10 / 4] |= UIF;
         self.updates += 1;
         self.trig_phase = self.trigger_phase().ok().flatten();
+    }
+
+    /// At an update event: a counter started with REP_CNT = 0 whose RCR is still 0 updates
+    /// at every overflow and underflow from now on, which the model does not follow.
+    pub fn repetition_broken(&mut self) -> Option<Broken> {
+        self.rcr_due.take().map(|_| {
+            Broken::new(
+                "TIM1_RCR",
+                "still 0 at the first overflow of a counter started with REP_CNT = 0: an update at every overflow and underflow, twice per period, is not modelled (RM0440 §28.3.3) — write RCR = 1 right after the start",
+            )
+        })
     }
 
     /// TRGO2 source: true if MMS2 = OC4REF (0111, RM0440 §28.6.2).
@@ -243,10 +269,11 @@ impl Tim1 {
     }
 
     /// OCxREF of channel `ch` over one carrier period from the update event (counter
-    /// at 0, counting up), in seconds with `tick_s` per timer tick; a stopped counter
-    /// holds its level. PWM mode 1 is active while CNT < CCR: `[0, c)` and `[2a − c, 2a)`
-    /// ticks of the centre-aligned period 2a (RM0440 §28.3.3, OCxM); mode 2 its
-    /// complement; forced modes constant.
+    /// at 0 counting up, or at ARR counting down when the updates fall on the overflows),
+    /// in seconds with `tick_s` per timer tick; a stopped counter holds its level. PWM
+    /// mode 1 is active while CNT < CCR: `[0, c)` and `[2a − c, 2a)` ticks of the
+    /// centre-aligned period 2a from the underflow, `[a − c, a + c)` from the overflow
+    /// (RM0440 §28.3.3, OCxM); mode 2 its complement; forced modes constant.
     fn ref_wave(&self, ch: usize, tick_s: f64) -> Wave {
         let p = self.period_ticks();
         if self.started_at.is_none() || p == 0 {
@@ -256,7 +283,13 @@ impl Tim1 {
         let len = p as f64 * tick_s;
         let a = self.arr as f64;
         let c = f64::from(self.active_ccr[ch]).min(a);
-        let pwm1 = Wave::from_intervals(len, vec![(0.0, c * tick_s), ((2.0 * a - c) * tick_s, len)]);
+        // From the overflow the counter runs down from a and back up: CNT < c on
+        // (a − c, a + c).
+        let pwm1 = if self.update_at_overflow {
+            Wave::from_intervals(len, vec![((a - c) * tick_s, (a + c) * tick_s)])
+        } else {
+            Wave::from_intervals(len, vec![(0.0, c * tick_s), ((2.0 * a - c) * tick_s, len)])
+        };
         match self.oc_mode(ch) {
             0b0110 => pwm1,
             0b0111 => pwm1.not(),
@@ -325,7 +358,13 @@ impl Tim1 {
         let tick_s = self.tick_s();
         let phase = match self.started_at {
             Some(start) if self.period_ticks() > 0 => {
-                ((t.saturating_sub(start) / self.tick) % self.period_ticks()) as f64 * tick_s
+                let p = self.period_ticks();
+                let from_update = if self.update_at_overflow {
+                    p - u64::from(self.arr)
+                } else {
+                    0
+                };
+                ((t.saturating_sub(start) / self.tick + from_update) % p) as f64 * tick_s
             }
             _ => 0.0,
         };
@@ -361,12 +400,21 @@ impl Tim1 {
                             "CMS other than centre-aligned mode 1 is not modelled (RM0440 §28.6.1)",
                         ));
                     }
-                    if self.reg(0x28) != 0 || self.reg(0x30) != 1 {
+                    // One update per period: RCR = 1 with REP_CNT = 1 (updates at the
+                    // underflows) or REP_CNT = 0 and RCR = 1 from before the first
+                    // overflow (updates at the overflows).
+                    let rcr = self.reg(0x30);
+                    // (REP_CNT 0, RCR 1 written between the UG and the launch is left out:
+                    // RM0440's rule names only before/after the launch.)
+                    let one_per_period = matches!((self.rep_cnt, rcr), (1, 1) | (0, 0));
+                    if self.reg(0x28) != 0 || !one_per_period {
                         return Err(Broken::new(
                             "TIM1_CR1",
-                            "PSC ≠ 0 or RCR ≠ 1 at start: the model's update rate is one per period (RM0440 §28.3.3)",
+                            "PSC ≠ 0, or RCR and the repetition counter loaded at the last UG other than 1/1 (update at the underflows) or 0 with RCR = 1 written before the first overflow (update at the overflows): the model's update rate is one per period (RM0440 §28.3.3)",
                         ));
                     }
+                    self.update_at_overflow = self.rep_cnt == 0;
+                    self.rcr_due = (rcr == 0).then(|| t + u64::from(self.reg(0x2C)) * self.tick);
                     self.started_at = Some(t);
                     self.trig_phase = self.trigger_phase()?;
                 } else if value & 1 == 0 && was {
@@ -381,10 +429,27 @@ impl Tim1 {
                     self.regs[i] |= BIF;
                 }
             }
+            // RCR: with the counter started at REP_CNT = 0, the 1 must come before the
+            // first overflow.
+            0x30 => {
+                if self.started_at.is_some() && value != self.regs[i] {
+                    match self.rcr_due {
+                        Some(due) if value == 1 && t < due => self.rcr_due = None,
+                        _ => {
+                            return Err(Broken::new(
+                                "TIM1_RCR",
+                                "RCR changed while the counter runs, other than 0 → 1 before the first overflow: the update rate is not modelled (RM0440 §28.3.3)",
+                            ));
+                        }
+                    }
+                }
+                self.regs[i] = value;
+            }
             // EGR.UG: re-initialise the counter and load the preloaded registers.
             0x14 => {
                 if value & 1 != 0 {
                     self.update();
+                    self.update_at_overflow = self.rep_cnt == 0;
                     self.regs[0x10 / 4] &= !UIF;
                     self.updates -= 1;
                     if self.started_at.is_some() {
@@ -468,5 +533,53 @@ impl Tim1 {
         self.regs[0x44 / 4] = v;
         self.apply_break();
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// ARR = 100, CCR1 = 30 in PWM mode 1, tick = 8 bus units. RCR = 1 before the UG and
+    /// the start: updates at the underflows, 200 ticks apart from the start, CH1's
+    /// reference high on [0, 30) and [170, 200) ticks from there. RCR = 0 at the UG, 1
+    /// written right after the start: updates at the overflows, 100 ticks after the
+    /// start and every 200 after, the reference high on [70, 130) ticks from there (the
+    /// counter runs 100 → 0 → 100, below 30 from tick 70 to 130). Never written: the
+    /// first overflow is refused.
+    #[test]
+    fn update_at_the_underflow_or_the_overflow() {
+        let setup = |rcr_at_ug: u32| {
+            let mut t = Tim1::new();
+            t.write(0x2C, 100, 0).unwrap();
+            t.write(0x34, 30, 0).unwrap();
+            t.write(0x18, 0b110 << 4, 0).unwrap();
+            // OC4 in PWM mode 2 (the trigger channel).
+            t.write(0x1C, 0b111 << 12, 0).unwrap();
+            t.write(0x30, rcr_at_ug, 0).unwrap();
+            t.write(0x14, 1, 0).unwrap();
+            t.write(0x00, 0b01 << 5 | 1, 80).unwrap();
+            t
+        };
+        let tick_s = 8.0 / crate::soc::UNITS_PER_S;
+        let t = setup(1);
+        assert!(!t.update_at_overflow);
+        assert_eq!(t.next(TimerEvent::Update, 81), Some(80 + 200 * 8));
+        let w = t.ref_wave(0, tick_s);
+        assert_eq!(w.high.len(), 2);
+        assert!((w.high[0].1 - 30.0 * tick_s).abs() < 1e-15 && (w.high[1].0 - 170.0 * tick_s).abs() < 1e-15);
+        let mut t = setup(0);
+        assert!(t.update_at_overflow);
+        t.write(0x30, 1, 88).unwrap();
+        assert_eq!(t.next(TimerEvent::Update, 81), Some(80 + 100 * 8));
+        assert_eq!(t.next(TimerEvent::Update, 80 + 100 * 8 + 1), Some(80 + 300 * 8));
+        assert!(t.repetition_broken().is_none());
+        let w = t.ref_wave(0, tick_s);
+        assert_eq!(w.high.len(), 1);
+        assert!((w.high[0].0 - 70.0 * tick_s).abs() < 1e-15 && (w.high[0].1 - 130.0 * tick_s).abs() < 1e-15);
+        assert!(setup(0).repetition_broken().is_some());
+        // RCR written after the first overflow: refused.
+        let mut t2 = setup(0);
+        assert!(t2.write(0x30, 1, 80 + 100 * 8).is_err());
     }
 }

@@ -7,9 +7,13 @@
 //!   mode 1 on CH1–CH3 with preload: a high side conducts while CNT < CCR, so duty =
 //!   CCR/ARR, the high sides conduct around the carrier minimum and the low sides
 //!   around the maximum.
-//! * Repetition counter RCR = 1, loaded before the counter starts: one update event per
-//!   carrier period, at the *underflow* (carrier minimum, RM0440 §29.3.5), where the
-//!   preloaded compare values from the last control step take effect.
+//! * Repetition counter: one update event per carrier period, at the board's sampling
+//!   instant — the *underflow* (carrier minimum) for sampling there, RCR = 1 loaded before
+//!   the counter starts; the *overflow* (carrier maximum) for low-side shunts, RCR = 0 at
+//!   the UG and RCR = 1 written right after the start (RM0440 §29.3.5;
+//!   [`crate::config::REPETITION`]). The preloaded compare values from a control step
+//!   take effect there, one period after the sample they came from (the 1.5·T_s loop
+//!   delay the current loop is designed for).
 //! * The ADC trigger is not the update event: channel 4 (no pin) makes OC4REF rise at
 //!   the board's `sensing.sample_instant` ([`crate::config::TRIGGER`]: one tick before
 //!   the carrier maximum for low-side shunts, at the minimum otherwise), routed as TRGO2
@@ -31,7 +35,7 @@
 use stm32g4::stm32g474 as pac;
 
 use crate::bringup::{self, BreakActive, BreakControl};
-use crate::config::{BDTR, CCER, CR2, PWM_PERIOD, TRIGGER};
+use crate::config::{BDTR, CCER, CR2, PWM_PERIOD, REPETITION, TRIGGER};
 use crate::registers::PWM_MODE_1;
 
 /// Configures TIM1 with the outputs disabled (MOE = 0) and 50 % duty.
@@ -39,7 +43,8 @@ pub fn init(tim1: &pac::TIM1) {
     tim1.cr1().write(|w| w.cms().set(0b01).arpe().set_bit());
     tim1.psc().write(|w| w.psc().set(0));
     tim1.arr().write(|w| w.arr().set(u32::from(PWM_PERIOD)));
-    tim1.rcr().write(|w| w.rep().set(1));
+    // REP_CNT is loaded from it by the UG at the end.
+    tim1.rcr().write(|w| w.rep().set(u16::from(REPETITION.0)));
     let half = u32::from(PWM_PERIOD / 2);
     tim1.ccr1().write(|w| w.ccr().set(half));
     tim1.ccr2().write(|w| w.ccr().set(half));
@@ -111,6 +116,11 @@ pub fn arm_break(tim1: &pac::TIM1) -> Result<(), BreakActive> {
 /// Starts the carrier (and with it the ADC triggers).
 pub fn start(tim1: &pac::TIM1) {
     tim1.cr1().modify(|_, w| w.cen().set_bit());
+    // With the update at the overflow: RCR written after the launch, long before the
+    // first overflow half a carrier period later (RM0440 §29.3.5).
+    if let Some(rep) = REPETITION.1 {
+        tim1.rcr().write(|w| w.rep().set(u16::from(rep)));
+    }
 }
 
 /// Compare values for the next period (preloaded, applied at the next update).
