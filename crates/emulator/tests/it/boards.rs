@@ -70,6 +70,13 @@ fn wrong_break_polarity_halts_at_bring_up() {
         e.contains("no enabled PWM period") && e.contains("bring-up"),
         "{name}: {e}"
     );
+    // The cause: TIM1 sees its break input active with the comparator idle (the pin
+    // high, BKP = 1), so the image's check after arming the break halts it.
+    let soc = rig.machine.soc();
+    assert!(
+        soc.tim1.break_active && !soc.tim1.moe(),
+        "{name}: the break is not what stopped it"
+    );
 }
 
 /// The shunts said to be in line: the sign of the current sensing flips and the current

@@ -119,7 +119,7 @@ fn hard_fault_switches_the_gates_off_and_the_watchdog_resets() {
         // the configured one running: the chip resets.
         let err = rig.machine.run_until(t0 + 1.0).unwrap_err();
         assert!(matches!(err, Stop::WatchdogReset(_)), "{motor}: {err}");
-        println!("{motor}: HardFault → gates low; {err}");
+        println!("{motor}: HardFault → gates at their off levels; {err}");
     }
 }
 
