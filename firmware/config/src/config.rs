@@ -378,17 +378,17 @@ mod tests {
             None | Some("motorgen-reference") => {
                 assert_eq!((CCER, CR2), (0x555, 0x0070_0070));
                 assert_eq!(GATES_OFF, registers::reset_bits(&board::GATE_PINS));
-                assert!(board::CURRENT_PER_LSB > 0.0);
+                assert!(board::CURRENT_PER_LSB.is_sign_positive());
             }
             Some("nucleo-g474re-ihm08m1") => {
                 assert_eq!((CCER, CR2), (0xDDD, 0x0070_2A70));
                 assert_eq!(GATES_OFF, [0x0700_0080, 0x0000_0003, 0]);
-                assert!(board::CURRENT_PER_LSB < 0.0);
+                assert!(board::CURRENT_PER_LSB.is_sign_negative());
                 assert_eq!(BREAK_PULL[0].value, 0b01 << 12);
             }
             Some(_) => {}
         }
-        assert!(TRIPS.current_codes > 0);
+        assert!(TRIPS.current_codes.is_positive());
     }
 
     /// The FIR has DC gain exactly 1 (Σ taps = 2^15, output gain 2^0): a constant
