@@ -9,7 +9,7 @@
 //! complementary tim_ocx and tim_ocxn channels with break feature"). So an inverted
 //! (active-low) input needs its polarity bit set — "active" becomes low — and its idle
 //! bit set — "off" becomes high. TIMx_CR2.OISx/OISxN are frozen by BDTR's LOCK level 1
-//! (RM0440 TIMx_BDTR LOCK[1:0] = 01), so they are written before the BDTR write.
+//! (RM0440 TIMx_BDTR LOCK\[1:0\] = 01), so they are written before the BDTR write.
 
 use std::ops::Range;
 
