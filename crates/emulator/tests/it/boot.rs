@@ -29,6 +29,27 @@ fn every_motor_boots_to_its_first_enabled_pwm_period() {
             "{motor}: no enabled PWM period within {BOOT_LIMIT_S} s; {}",
             rig.machine.summary()
         );
+        // The polarities and idle levels the emulated board's gate driver needs (its own
+        // description, not the board file): an active-low input's TIM1 output inverted
+        // (CCxP/CCxNP: TIMx_CCER bit 4·ch + 1, + 3 for CHxN) and idling high (OISx/OISxN:
+        // TIMx_CR2 bit 8 + 2·ch, + 9 for CHxN; RM0440 TIMx_CCER, TIMx_CR2) — on the NUCLEO
+        // CC1NP..CC3NP and OIS1N..OIS3N (the L6398's LIN), on the reference board none.
+        // The OIS bits were written before BDTR's LOCK (a later write is a strict rule).
+        let off = rig.hardware.off_levels();
+        let (ccer, cr2) = (soc.tim1.reg(0x20), soc.tim1.reg(0x04));
+        for (k, &high) in off.iter().enumerate() {
+            let (ch, n) = (k % 3, k / 3);
+            assert_eq!(
+                (ccer >> (4 * ch + 1 + 2 * n)) & 1 == 1,
+                high,
+                "{motor}: CCER {ccer:#x}, output {k}"
+            );
+            assert_eq!(
+                (cr2 >> (8 + 2 * ch + n)) & 1 == 1,
+                high,
+                "{motor}: CR2 {cr2:#x}, output {k}"
+            );
+        }
         let first_isr = m
             .handled
             .iter()
