@@ -434,8 +434,8 @@ mod tests {
     /// Every declared constant of every motor, alone and on every board, has a
     /// SCREAMING_SNAKE_CASE name unique in its group and a JSON pointer to the same value in
     /// the JSON design; only the firmware's fixed choices, which the design does not compute
-    /// — the CAN protocol, the commissioning routines' parameters, the ADC clock — have
-    /// none. (The golden tests check the motors without a board, in the generated code.)
+    /// — the CAN protocol, the commissioning routines' parameters, the ADC, timer, FDCAN and
+    /// LSI clocks — have none. (The golden tests check the motors without a board, in the generated code.)
     #[test]
     fn every_constant_is_named_once_and_is_its_json_value() {
         for (stem, rel, text) in motor_test_support::motors() {
@@ -463,7 +463,8 @@ mod tests {
                         if k.json_path.is_empty() {
                             let fixed = matches!(
                                 (g.name, k.name.as_str()),
-                                ("can" | "commissioning", _) | ("board", "ADC_CLOCK_HZ")
+                                ("can" | "commissioning", _)
+                                    | ("board", "ADC_CLOCK_HZ" | "TIMER_CLOCK_HZ" | "FDCAN_CLOCK_HZ" | "LSI_HZ")
                             );
                             assert!(fixed, "{at} has no JSON pointer");
                             continue;

@@ -35,7 +35,7 @@ use crate::spec::Spec;
 use sections::Context;
 pub use sections::adc::AdcOut;
 pub use sections::angle_observer::ObserverOut;
-pub use sections::board::BoardOut;
+pub use sections::board::{BoardOut, Trip, TripSource, Trips};
 pub use sections::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
 pub use sections::drive::DriveOut;
 pub use sections::motor::{MotorOut, Origin};
@@ -137,11 +137,12 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
 }
 
 /// The motor's `design` on `board` (read from `board_src`): the board section (the
-/// board's constants with this motor, and the checks that need both, as warnings at the
-/// board key, see `sections::board`), added to the design with its warnings; an error
-/// if a board value comes out non-finite with this motor.
+/// board's constants with this motor and the trips the image uses, see `sections::board`),
+/// added to the design with its warnings; errors at the board keys where the motor does
+/// not fit the board (current and DC-link sensing, power-stage ceilings, over-speed), or
+/// where a board value comes out non-finite with this motor.
 pub fn on_board(mut design: Design, board: &Board, board_src: Source<'_>) -> Result<Design, Diagnostics> {
-    let (out, warnings) = sections::board::board(board, board_src.text, &design);
+    let (out, warnings) = sections::board::board(board, board_src, &design).map_err(Diagnostics)?;
     if let Some((path, x)) = finite::first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&out))) {
         return Err(board_src
             .error(
