@@ -146,15 +146,21 @@ fn inputs_hash(motor: &str) -> u64 {
     h
 }
 
-/// `target/firmware/<motor>.elf` for the default board, built as `motorgen firmware`
-/// builds it (`MOTOR=<motor> cargo build --release --target thumbv7em-none-eabihf -p
-/// motor-firmware` in `firmware/`, its own target directory) and copied there with a
-/// stamp of its inputs: an image whose stamp matches is reused without running cargo
-/// (switching `MOTOR` makes cargo rebuild the image, a minute each on 2 cores).
+/// `target/firmware/<motor>.elf` for the motor's board ([`crate::wiring::board_for`]: the
+/// default board, or `target/firmware/<board>/<motor>.elf` for a motor that only fits
+/// another), built as `motorgen firmware` builds it (`MOTOR=<motor> BOARD=<board> cargo
+/// build --release --target thumbv7em-none-eabihf -p motor-firmware` in `firmware/`, its
+/// own target directory) and copied there with a stamp of its inputs: an image whose
+/// stamp matches is reused without running cargo (switching `MOTOR` makes cargo rebuild
+/// the image, a minute each on 2 cores).
 pub fn build(motor: &str) -> Result<Image, String> {
     let _guard = BUILD.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let repo = repo();
-    let dir = repo.join("target").join("firmware");
+    let board = crate::wiring::board_for(motor)?;
+    let mut dir = repo.join("target").join("firmware");
+    if board != codegen::board::DEFAULT_BOARD {
+        dir = dir.join(&board);
+    }
     let elf = dir.join(format!("{motor}.elf"));
     let stamp = dir.join(format!("{motor}.emulator-stamp"));
     let hash = format!("{:016x}", inputs_hash(motor));
@@ -177,7 +183,7 @@ pub fn build(motor: &str) -> Result<Image, String> {
         .current_dir(&firmware)
         .env("CARGO_TARGET_DIR", firmware.join("target"))
         .env("MOTOR", motor)
-        .env("BOARD", codegen::board::DEFAULT_BOARD)
+        .env("BOARD", &board)
         .env_remove("MOTORS_DIR")
         .env_remove("BOARDS_DIR")
         .output()

@@ -1,4 +1,4 @@
-//! A test rig: one motor's image on the default board at standstill, with the vehicle
+//! A test rig: one motor's image on its board (`wiring::board_for`) at standstill, with the vehicle
 //! unit's setpoint frames on the CAN bus.
 
 use codegen::design::Design;
@@ -19,7 +19,7 @@ pub const OPTR_BOOT_FROM_FLASH: u32 = 0xFFEF_F8AA & !(1 << 26);
 pub struct Rig {
     /// The emulated chip running the image.
     pub machine: Machine,
-    /// The motor's design on the default board.
+    /// The motor's design on its board.
     pub design: Design,
     /// The next setpoint frame is due at this time \[s\].
     next_frame_s: f64,

@@ -2,9 +2,9 @@
 //! STM32G474 image of one motor or of every motor in `motors/`, on a board of `boards/`
 //! (default `motorgen-reference`).
 //!
-//! Per motor: designs the spec on the board first (a bad spec or board file stops here
-//! with its located diagnostic; what does not fit between them is printed as warnings
-//! on stderr), runs
+//! Per motor: designs the spec on the board first (a bad spec or board file, or a motor
+//! the board does not fit, stops here with its located diagnostic; the design's warnings
+//! are printed once on stderr), runs
 //! `cargo build --release --target thumbv7em-none-eabihf -p motor-firmware` in
 //! `firmware/` with `MOTOR=<stem>`, `MOTORS_DIR`, `BOARD=<board>` and `BOARDS_DIR` (one
 //! shared target directory, so only the app crate rebuilds per motor), copies the ELF to
@@ -38,6 +38,9 @@ const PACKAGE: &str = "motor-firmware";
 /// The project's flash budget for one image \[bytes\] — a budget, not the chip's limit:
 /// the STM32G474RE has 512 KiB of flash (DS12288 Table 2).
 pub const FLASH_LIMIT: u64 = 64 * 1024;
+/// How cargo prints a `cargo::warning` of `motor-config`'s build script (the design's
+/// warnings for this motor on the board, which `run` has printed already).
+const BUILD_SCRIPT_WARNING: &str = "warning: motor-config@";
 /// Erased-flash byte, for gaps between segments in the `.bin`.
 const ERASED: u8 = 0xFF;
 /// Largest span of load addresses accepted for a `.bin` \[bytes\]: more means a
@@ -294,6 +297,11 @@ fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, Failu
     let relay = std::thread::spawn(move || {
         let mut seen = String::new();
         for line in BufReader::new(err).lines().map_while(Result::ok) {
+            // The build script's `cargo::warning`s are the design's warnings about the
+            // board, which were printed once before cargo ran.
+            if line.starts_with(BUILD_SCRIPT_WARNING) {
+                continue;
+            }
             errln!("{line}");
             seen.push_str(&line);
             seen.push('\n');
@@ -412,15 +420,13 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<()
         ));
     }
     // Every selected spec must design on the board before cargo runs (located
-    // diagnostics); what does not fit is a warning.
+    // diagnostics, a motor the board does not fit among them).
     let mut designs = Vec::new();
     let mut failed = Vec::new();
     for stem in &selected {
         match super::design_on(&motors.join(format!("{stem}.toml")), Some(&board_file)) {
             Ok(d) => {
-                for w in d.board.iter().flat_map(|b| &b.warnings) {
-                    crate::output::warn(format_args!("{stem} on {board}: {w}"));
-                }
+                crate::warn_design(&d);
                 designs.push(d);
             }
             Err(f) => {

@@ -64,11 +64,17 @@ enum Command {
         board: Option<PathBuf>,
     },
     /// Validate motor specs and board files (a file with a top-level `chip` is a board);
-    /// warnings go to stderr; exit 1 if any has a problem.
+    /// with --board, each motor spec on that board (what the image of the pair needs: the
+    /// board's sensing and ratings, the trips it will use). Warnings go to stderr; exit 1
+    /// if any has a problem.
     Check {
         /// One or more motor specs or board files.
         #[arg(required = true, value_name = "FILE")]
         specs: Vec<PathBuf>,
+        /// A board file (boards/NAME.toml): checks every motor spec given on it and prints
+        /// the trip levels its image would use.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
     /// Write a commented starting spec to DIR/STEM.toml, DIR defaulting to motors/
     /// (never overwrites).
@@ -107,6 +113,10 @@ enum Command {
         /// The motor spec.
         #[arg(value_name = "SPEC")]
         spec: PathBuf,
+        /// A board file: the motor on that board (refused where it does not fit), simulated
+        /// with the board's current and DC-link sensing as the image would run.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
     /// Write a self-contained HTML report (verification table, SVG plots, every constant
     /// with formula and provenance) to DIR/STEM.html (exit 3 if a figure fails).
@@ -215,6 +225,15 @@ fn read_input(path: &Path) -> Input {
     }
 }
 
+/// Prints the design's warnings on stderr, once each (each is located at its key:
+/// `file:line:column: `key`: …`). Every command that designs calls it once, whatever the
+/// output format.
+fn warn_design(d: &codegen::Design) {
+    for w in &d.warnings {
+        output::warn(format_args!("{w}"));
+    }
+}
+
 fn design(path: &Path) -> Result<codegen::Design, Failure> {
     let text = read_spec(path)?;
     Ok(codegen::design_source(&path.display().to_string(), &text)?)
@@ -265,6 +284,7 @@ fn run(command: Command) -> Result<(), Failure> {
             board,
         } => {
             let d = design_on(&spec, board.as_deref())?;
+            warn_design(&d);
             let out = match format.output() {
                 Some(o) => render(&d, o, templates.as_deref())?,
                 None if matches!(format, Format::Json) => serde_json::to_string_pretty(&d)
@@ -283,6 +303,7 @@ fn run(command: Command) -> Result<(), Failure> {
         } => {
             atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
             let d = design_on(&spec, board.as_deref())?;
+            warn_design(&d);
             let stem = spec
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -302,22 +323,45 @@ fn run(command: Command) -> Result<(), Failure> {
             }
             Ok(())
         }
-        Command::Check { specs } => {
-            // Every spec is checked; the exit code is the gravest failure's (I/O over bad input).
+        Command::Check { specs, board } => {
+            // Every file is checked; the exit code is the gravest failure's (I/O over bad input).
             let mut failed = Vec::new();
+            let board_file = match &board {
+                Some(b) => match read_spec(b) {
+                    Ok(text) => Some((b.display().to_string(), text)),
+                    Err(f) => {
+                        failed.push(f.exit);
+                        f.report();
+                        None
+                    }
+                },
+                None => None,
+            };
+            let (mut motors, mut boards) = (0, 0);
             for path in &specs {
                 // Read once; a file with a top-level `chip` is a board, anything else a motor.
                 let name = path.display().to_string();
                 let checked = read_spec(path).and_then(|text| {
                     if codegen::board::is_board_file(&text) {
+                        boards += 1;
                         let b = codegen::board_source(&name, &text)?;
                         outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
-                    } else {
-                        let d = codegen::design_source(&name, &text)?;
-                        outln!("ok: {name} ({})", d.name);
-                        for w in &d.warnings {
-                            output::warn(format_args!("{name}: {w}"));
+                        return Ok(());
+                    }
+                    motors += 1;
+                    let d = match (&board, &board_file) {
+                        (Some(_), Some((bname, btext))) => codegen::design_with_board(&name, &text, bname, btext)?,
+                        // The board could not be read (reported above): the spec alone.
+                        (Some(_), None) => codegen::design_source(&name, &text)?,
+                        (None, _) => codegen::design_source(&name, &text)?,
+                    };
+                    warn_design(&d);
+                    match &d.board {
+                        Some(b) => {
+                            outln!("ok: {name} ({}) on {} ({})", d.name, b.board.file, b.board.name);
+                            out!("{}", codegen::summary::board(b, &d));
                         }
+                        None => outln!("ok: {name} ({})", d.name),
                     }
                     Ok(())
                 });
@@ -325,6 +369,11 @@ fn run(command: Command) -> Result<(), Failure> {
                     failed.push(f.exit);
                     f.report();
                 }
+            }
+            if board.is_none() && motors > 0 && boards > 0 {
+                output::stderr(format_args!(
+                    "note: motor specs and board files were checked each on its own; `--board FILE` checks the motors on a board\n"
+                ));
             }
             match Exit::gravest(&failed) {
                 None => Ok(()),
@@ -390,7 +439,7 @@ fn run(command: Command) -> Result<(), Failure> {
             });
             firmware::run(which, &motors, &board, &boards)
         }
-        Command::Verify { spec } => verify::run(&spec),
+        Command::Verify { spec, board } => verify::run(&spec, board.as_deref()),
         Command::Report { spec, out } => report::run(&spec, &out),
         Command::Identify { what } => identify::run(what),
         Command::Capture {

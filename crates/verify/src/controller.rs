@@ -30,6 +30,8 @@ fn axis(g: &AxisGains) -> PiConfig {
 /// * sample period, observer speed scaling f_s·π/2^31 (4.20), angle lead k (4.23);
 /// * current ADC: Q1.15 codes around [`CURRENT_OFFSET`] at `CURRENT_PER_LSB`
 ///   (full scale margin·√2·I_peak, (4.16)), three phases; DC link at `DC_LINK_PER_LSB`;
+///   for a design on a board, the board's offset code, amperes per code, phases and DC-link
+///   scale, as the image's `config::PARAMETERS` takes them;
 /// * observer gains K̃_p, K̃_i (4.22) as the Q1.31 integers, error form;
 /// * n_p, n_r, θ_off (4.5) (θ_off = 0 when the spec gives none);
 /// * PI gains, back-calculation, active damping and prefilter per axis;
@@ -42,13 +44,29 @@ pub fn controller_parameters(d: &Design) -> ControllerParameters {
     let cl = &d.current_loop;
     let o = &d.angle_observer;
     let s = &d.scaling;
+    // On a board, its sensing (the firmware's `config::PARAMETERS`); else the design's
+    // full scales.
+    let (current_offset_code, current_per_lsb, current_phases, dc_link_per_lsb) = match &d.board {
+        Some(b) => (
+            b.current_offset_code,
+            b.amps_per_lsb as f32,
+            b.current_phases,
+            b.dc_link_volts_per_lsb as f32,
+        ),
+        None => (
+            CURRENT_OFFSET,
+            s.phase_current.si_per_lsb as f32,
+            3,
+            s.dc_link_voltage.si_per_lsb as f32,
+        ),
+    };
     ControllerParameters {
         sample_period: d.drive.sample_period_s as f32,
         speed_per_lsb: s.speed.si_per_lsb as f32,
-        current_offset_code: CURRENT_OFFSET,
-        current_per_lsb: s.phase_current.si_per_lsb as f32,
-        current_phases: 3,
-        dc_link_per_lsb: s.dc_link_voltage.si_per_lsb as f32,
+        current_offset_code,
+        current_per_lsb,
+        current_phases,
+        dc_link_per_lsb,
         observer_kp_q31: o.gains.kp_q31,
         observer_ki_q31: o.gains.ki_q31,
         observer_error_form: o.error_form,

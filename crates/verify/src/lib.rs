@@ -349,6 +349,22 @@ pub fn verify(setup: &Setup<'_>) -> Verification {
     }
 }
 
+/// Parses and designs `text` (named `file` in messages) on the board `board_text`
+/// (`codegen::design_with_board`: refused where the motor does not fit the board), then
+/// verifies the design with the board's current and DC-link sensing.
+pub fn verify_source_on(
+    file: &str,
+    text: &str,
+    board_file: &str,
+    board_text: &str,
+) -> Result<(Design, Verification), Diagnostics> {
+    let source = Source { file, text };
+    let spec = codegen::spec::parse(source)?;
+    let design = codegen::design_with_board(file, text, board_file, board_text)?;
+    let v = verify(&Setup::new(&spec, &design));
+    Ok((design, v))
+}
+
 /// Parses and designs `text` (named `file` in messages), then verifies the design.
 pub fn verify_source(file: &str, text: &str) -> Result<(Design, Verification), Diagnostics> {
     let source = Source { file, text };

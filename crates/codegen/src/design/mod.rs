@@ -94,6 +94,12 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         errors: Vec::new(),
         warnings: Vec::new(),
     };
+    // The motor values against each other and the drive first: a value off by a unit
+    // prefix is refused at its key before it makes the sections below fail confusingly.
+    sections::plausibility::plausibility(&mut cx);
+    if !cx.errors.is_empty() {
+        return Err(failed(cx));
+    }
     let drive = sections::drive::drive(&mut cx);
     let current_loop = sections::current_loop::current_loop(&mut cx);
     let angle_observer = sections::angle_observer::angle_observer(&mut cx);
@@ -103,7 +109,7 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     let (true, Some(current_loop), Some(angle_observer), Some(fir)) =
         (cx.errors.is_empty(), current_loop, angle_observer, fir)
     else {
-        return Err(Diagnostics(cx.errors));
+        return Err(failed(cx));
     };
     let motor = sections::motor::motor(&mut cx, current_loop.hot.as_ref().map(|h| h.phase_resistance_ohm));
     let per_unit = sections::per_unit::per_unit(spec);
@@ -112,7 +118,10 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
             cx.warnings.extend(notes);
             out
         }
-        Err(e) => return Err(Diagnostics(vec![*e])),
+        Err(e) => {
+            cx.errors.push(*e);
+            return Err(failed(cx));
+        }
     };
     let design = Design {
         schema_version: SCHEMA_VERSION,
@@ -134,6 +143,18 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     };
     finite::check(&design, spec, src).map_err(|e| Diagnostics(vec![*e]))?;
     Ok(design)
+}
+
+/// The errors of a design that fails, the first carrying the spec's cross-checks that
+/// disagree as notes (a design that succeeds has them as warnings): a wrong value often
+/// shows in a cross-check before it breaks a rule.
+fn failed(cx: Context<'_>) -> Diagnostics {
+    let notes = sections::plausibility::cross_check_notes(&cx);
+    let mut errors = cx.errors;
+    if let Some(first) = errors.first_mut() {
+        first.notes.extend(notes);
+    }
+    Diagnostics(errors)
 }
 
 /// The motor's `design` on `board` (read from `board_src`): the board section (the

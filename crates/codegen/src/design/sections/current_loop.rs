@@ -122,11 +122,14 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     let limit = continuous::bandwidth_limit(c.method, fs);
     if c.bandwidth.value >= limit {
         let pct = if c.method == Method::PolePlacement { 17 } else { 30 };
-        cx.warnings.push(format!(
-            "current loop: α = {:.1} rad/s ({:.0} Hz) is not below {pct} % of f_s = {fs} Hz, the guideline of thesis A §5.4.1 (the sampled-loop margins are what the design checks)",
-            c.bandwidth.value,
-            c.bandwidth.value / (2.0 * PI)
-        ));
+        cx.warn_at(
+            &c.bandwidth,
+            format!(
+                "current loop: α = {:.1} rad/s ({:.0} Hz) is not below {pct} % of f_s = {fs} Hz, the guideline of thesis A §5.4.1 (the sampled-loop margins are what the design checks)",
+                c.bandwidth.value,
+                c.bandwidth.value / (2.0 * PI)
+            ),
+        );
     }
     let r = m.phase_resistance.value;
     let requests = requests(spec, r, ts);
@@ -171,7 +174,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         let want = 9f64.ln() / c.bandwidth.value;
         let worst = t[0].min(t[1]);
         if (worst / want - 1.0).abs() > 0.10 {
-            cx.warnings.push(format!(
+            let text = format!(
                 "current loop: sampled at f_s = {fs} Hz with the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
                 worst * 1e3,
                 want * 1e3,
@@ -182,7 +185,8 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
                 } else {
                     "raise f_s or lower the bandwidth"
                 }
-            ));
+            );
+            cx.warn_at(&c.bandwidth, text);
         }
     }
     let hot = hot_variant(cx, r, ts);
@@ -259,9 +263,10 @@ fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
             let promise = Promise::of(&requests[0]);
             for (axis, g) in [('d', &d), ('q', &q)] {
                 if let Some(b) = g.sampled.breach(&promise) {
-                    cx.warnings.push(format!(
-                        "hot-resistance variant (R_s = {r_hot:.4} Ω): the sampled {axis}-axis loop is {b}"
-                    ));
+                    cx.warn_at(
+                        &t.max_winding_temperature,
+                        format!("hot-resistance variant (R_s = {r_hot:.4} Ω): the sampled {axis}-axis loop is {b}"),
+                    );
                 }
             }
             Some(HotVariant {
@@ -272,10 +277,11 @@ fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
             })
         }
         Err(_) => {
-            cx.warnings.push(format!(
+            let text = format!(
                 "no hot-resistance variant: the design is infeasible with R_s({} °C) = {r_hot:.4} Ω",
                 t.max_winding_temperature.value
-            ));
+            );
+            cx.warn_at(&t.max_winding_temperature, text);
             None
         }
     }
