@@ -182,3 +182,103 @@ fn check_verdict_matches_the_simulated_step() {
         "accepted {accepted}, refused {refused}, unstable {unstable_seen}"
     );
 }
+
+/// The largest bandwidth `check` names passes `verify`: on every motor in `motors/` and
+/// for every method (delay compensation on, ζ = 1/√2), a bandwidth of 40 % of ω_s is
+/// refused at `current_loop.bandwidth` naming a largest one; that one is accepted and its
+/// current-loop scenarios — the ones whose criteria depend on α: `current_step`,
+/// `decoupling`, `dc_link_step` — pass every criterion. (Issue 27: the search judged
+/// margins, overshoot and rise only; the bandwidth it named failed `decoupling` on every
+/// motor, 2.66–2.80× against ≥ 3×.)
+#[test]
+fn the_largest_bandwidth_check_names_passes_verify() {
+    let mut problems = Vec::new();
+    let mut n = 0;
+    for stem in motor_test_support::motor_stems() {
+        let text = std::fs::read_to_string(motor_test_support::repo().join(format!("motors/{stem}.toml"))).unwrap();
+        let fs = spec::parse(Source { file: &stem, text: &text })
+            .unwrap()
+            .drive
+            .switching_frequency
+            .value;
+        let alpha = 0.4 * 2.0 * std::f64::consts::PI * fs;
+        for method in ["imc", "pole_placement", "imc_active_damping"] {
+            let name = format!("{stem} {method}");
+            let Verdict::Refused(problem, Some(best)) = judge(&name, &with_loop(&text, &body(method, alpha, true))) else {
+                problems.push(format!("{name}: α = {alpha:.0} rad/s is not refused naming a bandwidth"));
+                continue;
+            };
+            let Verdict::Accepted(sd) = judge(&name, &with_loop(&text, &body(method, best, true))) else {
+                problems.push(format!("{name}: the named {best} rad/s is not accepted ({problem})"));
+                continue;
+            };
+            let (s, d) = *sd;
+            let setup = Setup::new(&s, &d);
+            for scenario in [
+                motor_verify::scenarios::current_step,
+                motor_verify::scenarios::decoupling,
+                motor_verify::scenarios::dc_link_step,
+            ] {
+                let r = scenario(&setup);
+                for c in r.checks.iter().filter(|c| !c.pass) {
+                    problems.push(format!(
+                        "{name}: named {best} rad/s, {}: {} = {} ({})",
+                        r.id, c.quantity, c.measured, c.criterion
+                    ));
+                }
+                if r.id == "decoupling" {
+                    println!("{name}: named {best} rad/s, decoupling {:.3}×", r.checks[0].measured);
+                }
+            }
+            n += 1;
+        }
+    }
+    assert!(problems.is_empty(), "{}", problems.join("\n"));
+    assert!(n >= 15, "{n} motor × method pairs");
+}
+
+#[test]
+#[ignore]
+fn explore_decoupling_model_against_verify() {
+    use codegen::design::current_loop::at_speed as decoupling;
+    for stem in motor_test_support::motor_stems() {
+        let text = std::fs::read_to_string(motor_test_support::repo().join(format!("motors/{stem}.toml"))).unwrap();
+        let fs = spec::parse(Source { file: &stem, text: &text }).unwrap().drive.switching_frequency.value;
+        let ws = 2.0 * std::f64::consts::PI * fs;
+        for method in ["imc", "pole_placement", "imc_active_damping"] {
+            for frac in [0.01, 0.02, 0.04, 0.06, 0.08, 0.1, 0.13, 0.16, 0.2] {
+                let alpha = frac * ws;
+                let t = with_loop(&text, &body(method, alpha, true));
+                let src = Source { file: &stem, text: &t };
+                let s = spec::parse(src).unwrap();
+                let Ok(d) = design::design(&s, src) else {
+                    continue;
+                };
+                let v = motor_verify::scenarios::decoupling(&Setup::new(&s, &d));
+                let m = &d.motor;
+                let dr = decoupling::Drive {
+                    resistance_ohm: m.phase_resistance_ohm,
+                    ld: m.d_inductance_h,
+                    lq: m.q_inductance_h,
+                    flux_linkage_wb: m.flux_linkage_wb,
+                    peak_current_a: m.peak_current_a,
+                    voltage_limit_v: d.current_loop.voltage_limit_v,
+                    max_electrical_speed: m.max_electrical_speed_rad_s,
+                    sample_period_s: d.drive.sample_period_s,
+                    dc_link_voltage_v: d.drive.dc_link_voltage_v,
+                    dc_link_voltage_min_v: d.drive.dc_link_voltage_min_v,
+                    method: d.current_loop.method,
+                    damping: d.current_loop.damping.unwrap_or(0.0),
+                };
+                let x = decoupling::decoupling(&dr, [&d.current_loop.d, &d.current_loop.q], alpha);
+                let dl = decoupling::dc_link_step(&dr, [&d.current_loop.d, &d.current_loop.q], alpha);
+                let vd = motor_verify::scenarios::dc_link_step(&Setup::new(&s, &d));
+                println!("   dc link: verify last {:.4} peak {:.4}; model last {:.4} peak {:.4} ripple {:.4} kick {:.4}", vd.checks[1].measured, vd.checks[0].measured, dl.last_a, dl.peak_a, dl.ripple_a, dl.kick_a);
+                println!(
+                    "{stem} {method} α={alpha:.0} verify {:.3} ({:?}) model {:.3} ({:.4}/{:.4})",
+                    v.checks[0].measured, v.checks[0].quantity, x.ratio, x.excursion_a[0], x.excursion_a[1]
+                );
+            }
+        }
+    }
+}

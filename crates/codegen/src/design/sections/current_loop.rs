@@ -14,6 +14,7 @@ use crate::design::current_loop::analysis::{
     AxisGains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE,
 };
 use crate::design::current_loop::continuous::{self, CurrentLoopError, Promise};
+use crate::design::current_loop::at_speed;
 use crate::design::current_loop::{self, Axis, FIRMWARE_LOOP_DELAY_PERIODS, Request, axis_letter, bandwidth, discrete};
 use crate::design::thermal;
 use crate::diagnostic::{Diagnostic, Source};
@@ -138,12 +139,34 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         .ok();
     let promise = Promise::of(&requests[0]);
     let designed_os = promise.overshoot_pct;
-    if let Some((gd, gq)) = &gains
-        && let Some((axis, breach)) = [('d', gd), ('q', gq)]
+    let drive = drive(spec, r, ts, cx.max_electrical_frequency());
+    // The floors on both axes, then the decoupling figure (`verify`'s criterion).
+    let floor_breach = gains.as_ref().and_then(|(gd, gq)| {
+        [('d', gd), ('q', gq)]
             .iter()
             .find_map(|(a, g)| g.sampled.breach(&promise).map(|b| (*a, b)))
-    {
-        let best = bandwidth::largest_bandwidth(&requests).map(round_down_3);
+    });
+    let at_speed_breach = match (&gains, &floor_breach) {
+        (Some((gd, gq)), None) => bandwidth::at_speed_breach(&drive, [gd, gq], c.bandwidth.value),
+        _ => None,
+    };
+    if let Some(breach) = at_speed_breach {
+        let best = bandwidth::largest_bandwidth(&requests, Some(&drive)).map(round_down_3);
+        let b = &c.bandwidth;
+        cx.errors.push(cx.src.error(
+            b.span.clone(),
+            &b.key,
+            format!("at α = {:.1} rad/s (f_s = {fs} Hz) the loop {breach}", b.value),
+            match best {
+                Some(a) => format!(
+                    "a bandwidth up to {a:.0} rad/s, the largest that meets the sampled-loop floors and the at-speed figures for this motor at f_s = {fs} Hz"
+                ),
+                None => "a higher f_s: no bandwidth meets the floors and the at-speed figures for this motor at this f_s".to_string(),
+            },
+        ));
+    }
+    if let Some((axis, breach)) = floor_breach {
+        let best = bandwidth::largest_bandwidth(&requests, Some(&drive)).map(round_down_3);
         let b = &c.bandwidth;
         cx.errors.push(cx.src.error(
             b.span.clone(),
@@ -161,7 +184,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             ),
             match best {
                 Some(a) => format!(
-                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes for this motor at f_s = {fs} Hz, or a higher f_s"
+                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes and the decoupling figure for this motor at f_s = {fs} Hz, or a higher f_s"
                 ),
                 None => "a higher f_s: no bandwidth meets the floors for this motor at this f_s".to_string(),
             },
@@ -232,6 +255,27 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             iq_per_nm: kt.map(|k| 1.0 / k),
         },
     })
+}
+
+/// The drive the at-speed figures are judged on (`current_loop::at_speed`).
+fn drive(spec: &Spec, r: f64, ts: f64, max_electrical_frequency: f64) -> at_speed::Drive {
+    let m = &spec.motor;
+    let c = &spec.current_loop;
+    let zeta = c.damping.as_ref().map_or(0.0, |z| z.value);
+    at_speed::Drive {
+        resistance_ohm: r,
+        ld: m.d_inductance.value,
+        lq: m.q_inductance.value,
+        flux_linkage_wb: m.flux_linkage.as_ref().map(|p| p.value),
+        peak_current_a: std::f64::consts::SQRT_2 * m.peak_current.value,
+        voltage_limit_v: spec.drive.dc_link_voltage.value / 3f64.sqrt(),
+        max_electrical_speed: 2.0 * PI * max_electrical_frequency,
+        sample_period_s: ts,
+        dc_link_voltage_v: spec.drive.dc_link_voltage.value,
+        dc_link_voltage_min_v: spec.drive.dc_link_voltage_min.value,
+        method: c.method,
+        damping: zeta,
+    }
 }
 
 /// The spec's current-loop requests for the d and q axes with resistance `r` \[Ω\] at
