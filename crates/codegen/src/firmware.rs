@@ -519,7 +519,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
     FirmwareLimit {
         firmware_messages: &["FIR too long for the FMAC memory", "the FMAC supports 1 to 127 taps"],
         firmware_item: "firmware/app/src/board/fmac.rs: the FMAC's load; firmware/control/src/fir.rs: FmacFir::new, process",
-        limit: "FMAC: 2·taps + 2·(padding) ≤ 256 words, at most 127 taps (RM0440 §18.3.2)",
+        limit: "FMAC: an N-tap FIR needs 2N + 1 of the 256 words, so at most 127 taps (RM0440 §18.3.8); the image's layout takes 2N + 2d words, d = 2 or, at 127 taps, 1",
         rule: "design::fir (the FIR's validation), at fir.order / fir.stop_attenuation",
         cases: &[Case {
             home: Home::Spec,
