@@ -39,8 +39,8 @@ enum Command {
         /// Directory with replacement templates (for rust, c, markdown).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
-        /// A board file (boards/NAME.toml): adds the `board` constants and the checks
-        /// of the motor on that board.
+        /// A board file, or the stem of one in boards/ (e.g. motorgen-reference): adds the
+        /// `board` constants and the checks of the motor on that board.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
@@ -58,8 +58,8 @@ enum Command {
         /// motor.dbc.j2).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
-        /// A board file: adds its `board` and `can` constants (as `design --board`) and
-        /// writes STEM.dbc.
+        /// A board file or the stem of one in boards/: adds its `board` and `can` constants
+        /// (as `design --board`) and writes STEM.dbc.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
@@ -71,8 +71,8 @@ enum Command {
         /// One or more motor specs or board files.
         #[arg(required = true, value_name = "FILE")]
         specs: Vec<PathBuf>,
-        /// A board file (boards/NAME.toml): checks every motor spec given on it and prints
-        /// the trip levels its image would use.
+        /// A board file, or the stem of one in boards/ (e.g. motorgen-reference): checks
+        /// every motor spec given on it and prints the trip levels its image would use.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
@@ -113,8 +113,9 @@ enum Command {
         /// The motor spec.
         #[arg(value_name = "SPEC")]
         spec: PathBuf,
-        /// A board file: the motor on that board (refused where it does not fit), simulated
-        /// with the board's current and DC-link sensing as the image would run.
+        /// A board file or the stem of one in boards/: the motor on that board (refused
+        /// where it does not fit), simulated with the board's current and DC-link sensing
+        /// as the image would run.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
@@ -256,14 +257,43 @@ fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failu
 
 /// `motors/` in the working directory, else the one in this repository.
 fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
+    shipped_dir(dir, "motors")
+}
+
+/// `dir` if given, else `folder` (`motors` or `boards`) in the working directory, else the
+/// one in this repository.
+fn shipped_dir(dir: Option<PathBuf>, folder: &str) -> PathBuf {
     dir.unwrap_or_else(|| {
-        let here = PathBuf::from("motors");
+        let here = PathBuf::from(folder);
         if here.is_dir() {
             here
         } else {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("motors")
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(folder)
         }
     })
+}
+
+/// A spec or board argument: the file it names if there is one, else a bare name (no
+/// folder) looked up in `folder` (`motors` or `boards`, as [`shipped_dir`] finds it) with or
+/// without `.toml`: `--board motorgen-reference` is `boards/motorgen-reference.toml`. A name
+/// found nowhere stays as given, and reading it reports the missing file.
+fn locate(path: PathBuf, folder: &str) -> PathBuf {
+    let bare = path.components().count() == 1 && path.parent().is_none_or(|p| p.as_os_str().is_empty());
+    if path.exists() || !bare {
+        return path;
+    }
+    let dir = shipped_dir(None, folder);
+    let mut with_toml = path.clone().into_os_string();
+    with_toml.push(".toml");
+    [dir.join(&path), dir.join(with_toml)]
+        .into_iter()
+        .find(|p| p.is_file())
+        .unwrap_or(path)
+}
+
+/// [`locate`] for an optional board argument.
+fn locate_board(board: Option<PathBuf>) -> Option<PathBuf> {
+    board.map(|b| locate(b, "boards"))
 }
 
 fn main() -> ExitCode {
@@ -283,6 +313,7 @@ fn run(command: Command) -> Result<(), Failure> {
             templates,
             board,
         } => {
+            let (spec, board) = (locate(spec, "motors"), locate_board(board));
             let d = design_on(&spec, board.as_deref())?;
             warn_design(&d);
             let out = match format.output() {
@@ -302,6 +333,7 @@ fn run(command: Command) -> Result<(), Failure> {
             board,
         } => {
             atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+            let (spec, board) = (locate(spec, "motors"), locate_board(board));
             let d = design_on(&spec, board.as_deref())?;
             warn_design(&d);
             let stem = spec
@@ -326,6 +358,8 @@ fn run(command: Command) -> Result<(), Failure> {
         Command::Check { specs, board } => {
             // Every file is checked; the exit code is the gravest failure's (I/O over bad input).
             let mut failed = Vec::new();
+            let board = locate_board(board);
+            let specs: Vec<PathBuf> = specs.into_iter().map(|p| locate(p, "motors")).collect();
             let board_file = match &board {
                 Some(b) => match read_spec(b) {
                     Ok(text) => Some((b.display().to_string(), text)),
@@ -439,7 +473,7 @@ fn run(command: Command) -> Result<(), Failure> {
             });
             firmware::run(which, &motors, &board, &boards)
         }
-        Command::Verify { spec, board } => verify::run(&spec, board.as_deref()),
+        Command::Verify { spec, board } => verify::run(&locate(spec, "motors"), locate_board(board).as_deref()),
         Command::Report { spec, out } => report::run(&spec, &out),
         Command::Identify { what } => identify::run(what),
         Command::Capture {
