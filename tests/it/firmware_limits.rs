@@ -158,9 +158,22 @@ fn near_limits(seed: u64) -> (String, String, String) {
         *text = set_toml_key(text, key, &value);
         what.push(format!("{key} = {value}"));
     };
-    let rates = ["10 kbit/s", "20 kbit/s", "50 kbit/s", "100 kbit/s", "125 kbit/s", "250 kbit/s", "1 Mbit/s"];
+    let rates = [
+        "10 kbit/s",
+        "20 kbit/s",
+        "50 kbit/s",
+        "100 kbit/s",
+        "125 kbit/s",
+        "250 kbit/s",
+        "1 Mbit/s",
+    ];
     if rng.chance(0.5) {
-        set(&mut board, "can.bit_rate", format!("\"{}\"", rng.pick(&rates)), &mut what);
+        set(
+            &mut board,
+            "can.bit_rate",
+            format!("\"{}\"", rng.pick(&rates)),
+            &mut what,
+        );
     }
     if rng.chance(0.5) {
         let ns = (rng.uniform() * 5929.0).round();
@@ -194,7 +207,12 @@ fn near_limits(seed: u64) -> (String, String, String) {
     if rng.chance(0.3) {
         // Log-uniform from 1.3 kHz to 80 kHz (check refuses what the motor cannot use).
         let f = 1.3e3 * (80e3f64 / 1.3e3).powf(rng.uniform());
-        set(&mut motor, "drive.switching_frequency", format!("\"{f:.0} Hz\""), &mut what);
+        set(
+            &mut motor,
+            "drive.switching_frequency",
+            format!("\"{f:.0} Hz\""),
+            &mut what,
+        );
     }
     (what.join(", "), motor, board)
 }

@@ -119,10 +119,7 @@ pub fn dead_time(seconds: f64) -> Result<u8, Refusal> {
             (f64::from(ns) * f64::from(TIMER_CLOCK_HZ) / 1e9).ceil(),
             TIMER_CLOCK_HZ / 1_000_000
         ),
-        accepted: format!(
-            "a dead time up to {longest} ns ({:.3} µs)",
-            f64::from(longest) / 1e3
-        ),
+        accepted: format!("a dead time up to {longest} ns ({:.3} µs)", f64::from(longest) / 1e3),
     })
 }
 

@@ -187,10 +187,22 @@ mod tests {
     #[test]
     fn sets_a_key_in_its_table() {
         let text = "name = \"x\"\n[a]\nk = 1 # c\n[a.b]\nk = 2\n";
-        assert_eq!(set_toml_key(text, "a.k", "5"), "name = \"x\"\n[a]\nk = 5\n[a.b]\nk = 2\n");
-        assert_eq!(set_toml_key(text, "a.b.k", "7"), "name = \"x\"\n[a]\nk = 1 # c\n[a.b]\nk = 7\n");
-        assert_eq!(set_toml_key(text, "a.j", "3"), "name = \"x\"\n[a]\nj = 3\nk = 1 # c\n[a.b]\nk = 2\n");
-        assert_eq!(set_toml_key(text, "name", "\"y\""), "name = \"y\"\n[a]\nk = 1 # c\n[a.b]\nk = 2\n");
+        assert_eq!(
+            set_toml_key(text, "a.k", "5"),
+            "name = \"x\"\n[a]\nk = 5\n[a.b]\nk = 2\n"
+        );
+        assert_eq!(
+            set_toml_key(text, "a.b.k", "7"),
+            "name = \"x\"\n[a]\nk = 1 # c\n[a.b]\nk = 7\n"
+        );
+        assert_eq!(
+            set_toml_key(text, "a.j", "3"),
+            "name = \"x\"\n[a]\nj = 3\nk = 1 # c\n[a.b]\nk = 2\n"
+        );
+        assert_eq!(
+            set_toml_key(text, "name", "\"y\""),
+            "name = \"y\"\n[a]\nk = 1 # c\n[a.b]\nk = 2\n"
+        );
         assert!(std::panic::catch_unwind(|| set_toml_key(text, "c.k", "1")).is_err());
     }
 

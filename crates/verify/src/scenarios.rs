@@ -20,7 +20,9 @@ use super::figures::{designed_rise_time, designed_step};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use codegen::design::Design;
 use codegen::design::current_loop::analysis::{OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
-use codegen::design::current_loop::at_speed::{self as decoupling, KICK_ALLOWANCE, MIN_DECOUPLING_RATIO, SETTLED_SHARE};
+use codegen::design::current_loop::at_speed::{
+    self as decoupling, KICK_ALLOWANCE, MIN_DECOUPLING_RATIO, SETTLED_SHARE,
+};
 use codegen::spec::Method;
 use motor_sim::bench::Bench;
 use motor_sim::figures::step_figures;
@@ -415,10 +417,7 @@ pub fn dc_link_step(s: &Setup<'_>) -> ScenarioResult {
     let u1 = decoupling::dc_link_after(u0, u_min);
     let rho = (u1 - u0).abs() / u0;
     let spans = decoupling::STEP_SPANS;
-    let settle = samples(
-        s,
-        spans / disturbance_pole(s) + spans / d.current_loop.bandwidth_rad_s,
-    );
+    let settle = samples(s, spans / disturbance_pole(s) + spans / d.current_loop.bandwidth_rad_s);
     let n = samples(s, spans / d.current_loop.bandwidth_rad_s);
     let pre = n / 2;
     let err = |i: &[f64; 2]| (i[0] * i[0] + (i[1] - a) * (i[1] - a)).sqrt();

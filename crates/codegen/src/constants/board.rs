@@ -293,7 +293,13 @@ impl<'a> OnBoard<'a> {
                 "f_FDCAN = rate·prescaler·(1 + TSEG1 + TSEG2), sample point nearest 87.5 %, smallest prescaler, SJW = TSEG2; fields value − 1",
             ),
             equation: Lit("RM0440 §44.4.9 (FDCAN_NBTP); CiA 601-3"),
-            inputs: Of(|c| format!("{}, FDCAN kernel clock {} Hz", c.key("can.bit_rate"), c.o.can_timing.kernel_clock_hz)),
+            inputs: Of(|c| {
+                format!(
+                    "{}, FDCAN kernel clock {} Hz",
+                    c.key("can.bit_rate"),
+                    c.o.can_timing.kernel_clock_hz
+                )
+            }),
             json: Json::At("/board/can_timing/nbtp"),
         },
         Decl {

@@ -313,10 +313,13 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<Note>) {
         })
     };
     if let Some(why @ (NoInjection::SaliencyTooSmall { .. } | NoInjection::SwitchingTooSlow { .. })) = &no_injection {
-        warnings.push(("sensorless.injection_frequency", format!(
-            "sensorless: no signal injection by default: {why}; set sensorless.injection_frequency (and \
+        warnings.push((
+            "sensorless.injection_frequency",
+            format!(
+                "sensorless: no signal injection by default: {why}; set sensorless.injection_frequency (and \
              injection_voltage) to inject below 5α_c (thesis B §4.3.5)"
-        )));
+            ),
+        ));
     }
     let injection = no_injection.is_none().then(|| {
         let we = c.injection_frequency.unwrap_or(we_default);
@@ -387,20 +390,26 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<Note>) {
     );
     let ls = w1.max(w2);
     if !salient {
-        warnings.push(("sensorless", format!(
-            "sensorless: L_q = L_d, no saliency for signal injection (thesis B (4.17)): the estimator has no \
+        warnings.push((
+            "sensorless",
+            format!(
+                "sensorless: L_q = L_d, no saliency for signal injection (thesis B (4.17)): the estimator has no \
              position information below ω_ls = {ls:.1} rad/s"
-        )));
+            ),
+        ));
     }
     let bifurcation = salient.then(|| iq_limit_bifurcation(inp.psi, delta_l));
     if let Some(b) = bifurcation
         && inp.current_max > b
     {
-        warnings.push(("motor.peak_current", format!(
-            "sensorless: the peak current {:.1} A exceeds ψ_m/|ΔL| = {b:.1} A (thesis B (4.66)): above it the \
+        warnings.push((
+            "motor.peak_current",
+            format!(
+                "sensorless: the peak current {:.1} A exceeds ψ_m/|ΔL| = {b:.1} A (thesis B (4.66)): above it the \
              back-EMF estimator has unwanted equilibria; limit |i_q| in sensorless operation",
-            inp.current_max
-        )));
+                inp.current_max
+            ),
+        ));
     }
     if delta_l < 0.0 && inp.current_max >= inp.psi / -delta_l {
         warnings.push(("sensorless", format!(
@@ -658,7 +667,11 @@ mod tests {
             }) => assert!((frequency_limit_rad_s - 583.21).abs() < 0.01),
             other => panic!("{other:?}"),
         }
-        assert!(warnings.iter().any(|(_, w)| w.contains("too small for the carrier rule")));
+        assert!(
+            warnings
+                .iter()
+                .any(|(_, w)| w.contains("too small for the carrier rule"))
+        );
         // A stronger inverse saliency puts ψ/|ΔL| inside the current circle: warned.
         inp.ld = 1.0e-3;
         let (_, warnings) = design(&inp);

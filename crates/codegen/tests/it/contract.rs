@@ -40,11 +40,10 @@ fn line_of(text: &str, key: &str) -> usize {
 
 /// The error at `key` (and only errors: a refused design), with its line checked.
 fn refused_at<'a>(e: &'a Diagnostics, text: &str, key: &str) -> &'a codegen::diagnostic::Diagnostic {
-    let d = e
-        .0
-        .iter()
-        .find(|d| d.key == key)
-        .unwrap_or_else(|| panic!("not refused at `{key}`:\n{e}"));
+    let d =
+        e.0.iter()
+            .find(|d| d.key == key)
+            .unwrap_or_else(|| panic!("not refused at `{key}`:\n{e}"));
     assert_eq!(d.line, line_of(text, key), "{e}");
     assert!(!d.accepted.is_empty(), "{e}");
     d
@@ -75,7 +74,8 @@ fn a_flux_linkage_a_thousand_times_off_is_refused_at_the_flux_linkage_with_the_c
     let d = refused_at(&e, &text, "motor.datasheet.flux_linkage");
     assert!(d.problem.contains("368927.7 V"), "{e}");
     assert!(
-        !e.0.iter().any(|d| d.key == "motor.datasheet.max_speed" || d.key.starts_with("drive.")),
+        !e.0.iter()
+            .any(|d| d.key == "motor.datasheet.max_speed" || d.key.starts_with("drive.")),
         "refused at a key that is not the suspect:\n{e}"
     );
     assert!(
@@ -134,7 +134,10 @@ fn a_peak_current_beyond_the_nucleo_is_refused_at_its_sensing_or_its_rating() {
     rated[2].1 = "\"19 A\"";
     let e = on_board("maxon-ec45-flat-70w", &rated, "nucleo-g474re-ihm08m1").unwrap_err();
     let d = refused_at(&e, &board, "protection.over_current");
-    assert!(d.problem.contains("26.9 A") && d.accepted.contains("17.68 A rms"), "{e}");
+    assert!(
+        d.problem.contains("26.9 A") && d.accepted.contains("17.68 A rms"),
+        "{e}"
+    );
     assert!(!e.0.iter().any(|d| d.key == "sensing.current_gain"), "{e}");
 }
 
@@ -156,7 +159,11 @@ fn the_actuator_trips_at_its_own_limits_on_the_reference_board() {
         assert_eq!(trip.board_ceiling, ceiling);
     }
     assert_eq!(t.over_speed_rad_s.set_by, TripSource::Motor);
-    assert!((t.over_speed_rad_s.value * rpm - 5625.0).abs() < 1e-6, "{:?}", t.over_speed_rad_s);
+    assert!(
+        (t.over_speed_rad_s.value * rpm - 5625.0).abs() < 1e-6,
+        "{:?}",
+        t.over_speed_rad_s
+    );
 }
 
 /// fischer-ti085 (600 V, 61 A rms, 20 000 rpm) on the reference board: the motor's limits
@@ -197,7 +204,11 @@ fn a_weak_identification_fir_is_a_warning_at_its_order() {
     assert!(w.contains("8.0 dB"), "{w}");
     let (_, shipped) = spec("maxon-ec45-flat-70w", &[]);
     let shipped = shipped.unwrap();
-    assert!(!shipped.warnings.iter().any(|w| w.contains("`fir.order`")), "{:#?}", shipped.warnings);
+    assert!(
+        !shipped.warnings.iter().any(|w| w.contains("`fir.order`")),
+        "{:#?}",
+        shipped.warnings
+    );
 }
 
 /// Every warning of every motor, alone and on every board it fits, is located at a key:

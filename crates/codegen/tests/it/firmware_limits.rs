@@ -118,7 +118,10 @@ fn every_firmware_build_failure_is_a_row_of_the_table() {
         let text = std::fs::read_to_string(f).unwrap();
         for failure in failures(&code(&text)) {
             let rel = f.strip_prefix(repo()).unwrap().display().to_string();
-            if !FIRMWARE_LIMITS.iter().any(|l| l.firmware_messages.contains(&failure.as_str())) {
+            if !FIRMWARE_LIMITS
+                .iter()
+                .any(|l| l.firmware_messages.contains(&failure.as_str()))
+            {
                 missing.push(format!("{rel}: {failure:?}"));
             }
             found.push(failure);
@@ -140,11 +143,7 @@ fn every_firmware_build_failure_is_a_row_of_the_table() {
         if l.rule.is_empty() {
             assert!(l.cases.is_empty(), "{}: cases without a rule", l.firmware_item);
         } else {
-            assert!(
-                !l.cases.is_empty(),
-                "{}: a rule needs boundary cases",
-                l.firmware_item
-            );
+            assert!(!l.cases.is_empty(), "{}: a rule needs boundary cases", l.firmware_item);
         }
     }
 }
@@ -188,7 +187,10 @@ fn every_limit_is_refused_at_its_key_and_its_boundary_accepted() {
             edits.push((c.key, c.accepted));
             let (file, text) = edited(c.home, c.base, &edits);
             if let Err(e) = check(c.home, &file, &text) {
-                panic!("{} = {} ({}): accepted by hand, refused:\n{e}", c.key, c.accepted, c.why);
+                panic!(
+                    "{} = {} ({}): accepted by hand, refused:\n{e}",
+                    c.key, c.accepted, c.why
+                );
             }
             edits.pop();
             edits.push((c.key, c.refused));
@@ -196,12 +198,15 @@ fn every_limit_is_refused_at_its_key_and_its_boundary_accepted() {
             let e = check(c.home, &file, &text)
                 .err()
                 .unwrap_or_else(|| panic!("{} = {} ({}): refused by hand, accepted", c.key, c.refused, c.why));
-            let d = e
-                .0
-                .iter()
-                .find(|d| d.key == c.key)
-                .unwrap_or_else(|| panic!("{} = {}: refused, but not at its key:\n{e}", c.key, c.refused));
-            let line = text.lines().position(|x| x.starts_with(c.key.rsplit('.').next().unwrap())).unwrap() + 1;
+            let d =
+                e.0.iter()
+                    .find(|d| d.key == c.key)
+                    .unwrap_or_else(|| panic!("{} = {}: refused, but not at its key:\n{e}", c.key, c.refused));
+            let line = text
+                .lines()
+                .position(|x| x.starts_with(c.key.rsplit('.').next().unwrap()))
+                .unwrap()
+                + 1;
             assert_eq!(d.line, line, "{e}");
             assert!(!d.accepted.is_empty(), "{e}");
             n += 1;
@@ -231,15 +236,18 @@ fn issue_27_unbuildable_values_are_refused_at_their_key() {
     assert!(codegen::board_source("b.toml", &text).is_ok());
     // f_s in [1 kHz, 1.297 kHz): inside the plausible range, beyond the 16-bit ARR.
     let spec = set_toml_key(
-        &set_toml_key(&read("motors/unimotor-142umd300.toml"), "motor.datasheet.max_speed", "\"1000 rpm\""),
+        &set_toml_key(
+            &read("motors/unimotor-142umd300.toml"),
+            "motor.datasheet.max_speed",
+            "\"1000 rpm\"",
+        ),
         "drive.switching_frequency",
         "\"1.2 kHz\"",
     );
     let e = codegen::design_source("m.toml", &spec).unwrap_err();
-    let d = e
-        .0
-        .iter()
-        .find(|d| d.key == "drive.switching_frequency")
-        .unwrap_or_else(|| panic!("{e}"));
+    let d =
+        e.0.iter()
+            .find(|d| d.key == "drive.switching_frequency")
+            .unwrap_or_else(|| panic!("{e}"));
     assert!(d.accepted.contains("at least 1297.03 Hz"), "{e}");
 }

@@ -196,16 +196,22 @@ fn the_largest_bandwidth_check_names_passes_verify() {
     let mut n = 0;
     for stem in motor_test_support::motor_stems() {
         let text = std::fs::read_to_string(motor_test_support::repo().join(format!("motors/{stem}.toml"))).unwrap();
-        let fs = spec::parse(Source { file: &stem, text: &text })
-            .unwrap()
-            .drive
-            .switching_frequency
-            .value;
+        let fs = spec::parse(Source {
+            file: &stem,
+            text: &text,
+        })
+        .unwrap()
+        .drive
+        .switching_frequency
+        .value;
         let alpha = 0.4 * 2.0 * std::f64::consts::PI * fs;
         for method in ["imc", "pole_placement", "imc_active_damping"] {
             let name = format!("{stem} {method}");
-            let Verdict::Refused(problem, Some(best)) = judge(&name, &with_loop(&text, &body(method, alpha, true))) else {
-                problems.push(format!("{name}: α = {alpha:.0} rad/s is not refused naming a bandwidth"));
+            let Verdict::Refused(problem, Some(best)) = judge(&name, &with_loop(&text, &body(method, alpha, true)))
+            else {
+                problems.push(format!(
+                    "{name}: α = {alpha:.0} rad/s is not refused naming a bandwidth"
+                ));
                 continue;
             };
             let Verdict::Accepted(sd) = judge(&name, &with_loop(&text, &body(method, best, true))) else {
@@ -243,7 +249,14 @@ fn explore_decoupling_model_against_verify() {
     use codegen::design::current_loop::at_speed as decoupling;
     for stem in motor_test_support::motor_stems() {
         let text = std::fs::read_to_string(motor_test_support::repo().join(format!("motors/{stem}.toml"))).unwrap();
-        let fs = spec::parse(Source { file: &stem, text: &text }).unwrap().drive.switching_frequency.value;
+        let fs = spec::parse(Source {
+            file: &stem,
+            text: &text,
+        })
+        .unwrap()
+        .drive
+        .switching_frequency
+        .value;
         let ws = 2.0 * std::f64::consts::PI * fs;
         for method in ["imc", "pole_placement", "imc_active_damping"] {
             for frac in [0.01, 0.02, 0.04, 0.06, 0.08, 0.1, 0.13, 0.16, 0.2] {
@@ -273,7 +286,10 @@ fn explore_decoupling_model_against_verify() {
                 let x = decoupling::decoupling(&dr, [&d.current_loop.d, &d.current_loop.q], alpha);
                 let dl = decoupling::dc_link_step(&dr, [&d.current_loop.d, &d.current_loop.q], alpha);
                 let vd = motor_verify::scenarios::dc_link_step(&Setup::new(&s, &d));
-                println!("   dc link: verify last {:.4} peak {:.4}; model last {:.4} peak {:.4} ripple {:.4} kick {:.4}", vd.checks[1].measured, vd.checks[0].measured, dl.last_a, dl.peak_a, dl.ripple_a, dl.kick_a);
+                println!(
+                    "   dc link: verify last {:.4} peak {:.4}; model last {:.4} peak {:.4} ripple {:.4} kick {:.4}",
+                    vd.checks[1].measured, vd.checks[0].measured, dl.last_a, dl.peak_a, dl.ripple_a, dl.kick_a
+                );
                 println!(
                     "{stem} {method} α={alpha:.0} verify {:.3} ({:?}) model {:.3} ({:.4}/{:.4})",
                     v.checks[0].measured, v.checks[0].quantity, x.ratio, x.excursion_a[0], x.excursion_a[1]

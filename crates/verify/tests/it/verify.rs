@@ -436,7 +436,10 @@ fn non_finite_figures_and_samples_fail_the_scenario() {
     assert!(!r.passed());
     assert!(!r.checks[0].pass);
     let last = r.checks.last().unwrap();
-    assert_eq!((last.quantity.as_str(), last.measured), ("simulation stays finite", 2.0));
+    assert_eq!(
+        (last.quantity.as_str(), last.measured),
+        ("simulation stays finite", 2.0)
+    );
     assert_eq!(motor_verify::format_value(f64::NAN, "ms"), "diverged");
     assert_eq!(motor_verify::format_value(f64::NEG_INFINITY, "A"), "diverged");
 }

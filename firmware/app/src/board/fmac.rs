@@ -57,7 +57,11 @@ impl Fmac {
     /// Loads the taps, clears the history and starts the FIR; `false` on a timeout.
     pub fn start_fir<const N: usize>(&mut self, fir: &FmacFir<N>) -> bool {
         const { assert!(2 * N + 2 <= MEMORY, "FIR too long for the FMAC memory") };
-        let d = if 2 * N + 2 * D <= MEMORY { D } else { (MEMORY - 2 * N) / 2 };
+        let d = if 2 * N + 2 * D <= MEMORY {
+            D
+        } else {
+            (MEMORY - 2 * N) / 2
+        };
         self.regs.cr().write(|w| w.reset().set_bit());
         if !wait_for(POLL_LIMIT, || self.regs.cr().read().reset().bit_is_clear()) {
             return false;

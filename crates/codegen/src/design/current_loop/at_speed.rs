@@ -151,7 +151,6 @@ pub fn pi_config(g: &AxisGains) -> PiConfig {
     }
 }
 
-
 /// The decoupling scenario's figures.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Decoupling {

@@ -6,8 +6,8 @@
 //! (2.43)): what an error at `current_loop.bandwidth` names when the requested one does
 //! not meet them.
 
-use super::continuous::{Promise, natural_frequency};
 use super::at_speed::{self, DESIGN_MARGIN, Drive, MIN_DECOUPLING_RATIO};
+use super::continuous::{Promise, natural_frequency};
 use super::{Request, axis_letter, design};
 use crate::spec::Method;
 

@@ -170,7 +170,10 @@ fn trips(board: &Board, d: &Design) -> Trips {
         ),
         over_voltage_v: Trip::new(
             d.scaling.dc_link_voltage.full_scale,
-            format!("scaling.margin·dc_link_voltage = {margin}·{} V", d.drive.dc_link_voltage_v),
+            format!(
+                "scaling.margin·dc_link_voltage = {margin}·{} V",
+                d.drive.dc_link_voltage_v
+            ),
             board.over_voltage_v,
             "protection.over_voltage",
         ),
@@ -202,7 +205,10 @@ pub(in crate::design) fn board(
     let rms_max = |a: f64| a / std::f64::consts::SQRT_2;
     let spec = &d.spec_file;
     if i_fs < peak {
-        let gain_max = board.current_offset_v.min(board.adc_reference_v - board.current_offset_v) / peak;
+        let gain_max = board
+            .current_offset_v
+            .min(board.adc_reference_v - board.current_offset_v)
+            / peak;
         refuse(
             "sensing.current_gain",
             format!(
@@ -248,7 +254,10 @@ pub(in crate::design) fn board(
                 "the board's power stage is rated to {:.1} V (its over-voltage ceiling) but {} ({spec}) runs at U_dc = {udc} V",
                 board.over_voltage_v, d.name
             ),
-            format!("a board rated to at least {udc} V, or a motor DC link up to {:.1} V", board.over_voltage_v),
+            format!(
+                "a board rated to at least {udc} V, or a motor DC link up to {:.1} V",
+                board.over_voltage_v
+            ),
         );
     }
     let n_max = d.motor.max_speed_rad_s;

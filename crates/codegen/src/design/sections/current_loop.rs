@@ -13,8 +13,8 @@ use super::Context;
 use crate::design::current_loop::analysis::{
     AxisGains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE,
 };
-use crate::design::current_loop::continuous::{self, CurrentLoopError, Promise};
 use crate::design::current_loop::at_speed;
+use crate::design::current_loop::continuous::{self, CurrentLoopError, Promise};
 use crate::design::current_loop::{self, Axis, FIRMWARE_LOOP_DELAY_PERIODS, Request, axis_letter, bandwidth, discrete};
 use crate::design::thermal;
 use crate::diagnostic::{Diagnostic, Source};

@@ -58,14 +58,16 @@ pub(in crate::design) fn drive(cx: &mut Context<'_>) -> DriveOut {
         Ok(arr) => arr,
         Err(r) => {
             let p = &spec.drive.switching_frequency;
-            cx.errors.push(cx.src.error(p.span.clone(), &p.key, r.problem, r.accepted));
+            cx.errors
+                .push(cx.src.error(p.span.clone(), &p.key, r.problem, r.accepted));
             0
         }
     };
     if let Some(p) = &spec.drive.dead_time
         && let Err(r) = firmware::dead_time(p.value)
     {
-        cx.errors.push(cx.src.error(p.span.clone(), &p.key, r.problem, r.accepted));
+        cx.errors
+            .push(cx.src.error(p.span.clone(), &p.key, r.problem, r.accepted));
     }
     let (acceleration, rule) = cx.max_acceleration();
     DriveOut {

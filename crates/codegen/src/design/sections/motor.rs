@@ -2,8 +2,8 @@
 //! every redundant pair the spec gives ([`cross_check`]) and the warnings about them.
 
 use std::collections::BTreeMap;
-use std::ops::Range;
 use std::f64::consts::{PI, SQRT_2};
+use std::ops::Range;
 
 use serde::Serialize;
 
@@ -187,17 +187,21 @@ pub(in crate::design) fn cross_checks(m: &Motor) -> Vec<(CrossCheck, String, Ran
         ] {
             if let (Some(t), Some(i)) = (t, i) {
                 let at = (t.key.clone(), t.span.clone());
-                out.push((CrossCheck::new(
-                    &format!("{what} torque [N·m]"),
-                    (t.value, from(t)),
-                    (
-                        torque(i.value),
-                        format!(
-                            "(3.7) at the MTPA point (3.10) of {} = {:.4} A rms with ψ_M = {:.6} Wb",
-                            i.key, i.value, psi.value
+                out.push((
+                    CrossCheck::new(
+                        &format!("{what} torque [N·m]"),
+                        (t.value, from(t)),
+                        (
+                            torque(i.value),
+                            format!(
+                                "(3.7) at the MTPA point (3.10) of {} = {:.4} A rms with ψ_M = {:.6} Wb",
+                                i.key, i.value, psi.value
+                            ),
                         ),
                     ),
-                ), at.0, at.1));
+                    at.0,
+                    at.1,
+                ));
             }
         }
     }

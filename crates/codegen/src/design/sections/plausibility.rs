@@ -136,8 +136,7 @@ pub(in crate::design) fn plausibility(cx: &mut Context<'_>) {
                 .iter()
                 .map(|s| format!("{:.6} Wb from {} ({})", s.flux_wb, s.key, s.written))
                 .collect();
-            let others: Vec<_> =
-                sources.iter().filter(|s| s.key != odd.key).collect();
+            let others: Vec<_> = sources.iter().filter(|s| s.key != odd.key).collect();
             cx.errors.push(cx.src.error(
                 odd.span.clone(),
                 &odd.key,
