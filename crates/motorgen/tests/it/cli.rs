@@ -370,7 +370,7 @@ fn check_and_design_take_board_files() {
         "design",
         "motors/chalmers-hev50.toml",
         "--board",
-        "boards/motorgen-reference.toml",
+        "boards/motorgen-reference-400a.toml",
         "--format",
         "rust",
     ]);

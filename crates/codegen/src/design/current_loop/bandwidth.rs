@@ -91,9 +91,11 @@ fn lowest(axes: &[Request; 2]) -> f64 {
 
 /// The largest bandwidth [rad/s] up to the requested one (the axes share it) whose
 /// sampled loop meets the floors of [`super::analysis`] on both axes and (with a `drive`)
-/// the decoupling figure, by bisection on a logarithmic scale (to 0.1 %); `None` if even
-/// the method's smallest bandwidth does not. (The decoupling ratio falls with α, the
-/// floors hold below their first breach: the accepted set is an interval from below.)
+/// the at-speed figures of [`super::at_speed`] (`verify`'s decoupling and DC-link-step
+/// criteria), by bisection on a logarithmic scale (to 0.1 %); `None` if even the method's
+/// smallest bandwidth does not. (The figures worsen with α, the floors hold below their
+/// first breach: the accepted set is an interval from below; the sweep of
+/// `motor-verify`'s `bandwidth_sweep.rs` runs `verify` at the result.)
 pub fn largest_bandwidth(axes: &[Request; 2], drive: Option<&Drive>) -> Option<f64> {
     let alpha = axes[0].bandwidth_rad_s;
     if breach_at(axes, drive, alpha).is_none() {

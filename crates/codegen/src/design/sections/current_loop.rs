@@ -140,7 +140,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     let promise = Promise::of(&requests[0]);
     let designed_os = promise.overshoot_pct;
     let drive = drive(spec, r, ts, cx.max_electrical_frequency());
-    // The floors on both axes, then the decoupling figure (`verify`'s criterion).
+    // The floors on both axes, then the at-speed figures (`verify`'s decoupling and DC-link-step criteria).
     let floor_breach = gains.as_ref().and_then(|(gd, gq)| {
         [('d', gd), ('q', gq)]
             .iter()
@@ -184,7 +184,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             ),
             match best {
                 Some(a) => format!(
-                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes and the decoupling figure for this motor at f_s = {fs} Hz, or a higher f_s"
+                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes and the at-speed figures `motorgen verify` checks (decoupling, DC-link step) for this motor at f_s = {fs} Hz, or a higher f_s"
                 ),
                 None => "a higher f_s: no bandwidth meets the floors for this motor at this f_s".to_string(),
             },
