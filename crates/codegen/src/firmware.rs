@@ -128,9 +128,33 @@ pub fn max_watchdog_timeout_s() -> f64 {
     256.0 * f64::from(IWDG_MAX_RELOAD) / f64::from(LSI_HZ)
 }
 
+/// The shortest watchdog timeout the IWDG makes \[s\]: prescaler /4 with reload 1, 4 LSI
+/// ticks (125 µs at 32 kHz; RM0440 §41.3). The firmware's computation rounds a shorter
+/// request up to it, so `check` refuses one instead of building a longer timeout than
+/// asked.
+pub fn min_watchdog_timeout_s() -> f64 {
+    4.0 / f64::from(LSI_HZ)
+}
+
 /// IWDG prescaler code and reload for a timeout of `seconds` (the firmware's computation
 /// on the generated `f32` timeout), or why the IWDG cannot make it.
 pub fn watchdog(seconds: f64) -> Result<(u8, u16), Refusal> {
+    let shortest = min_watchdog_timeout_s();
+    if seconds < shortest * (1.0 - 1e-9) {
+        return Err(Refusal {
+            problem: format!(
+                "{seconds} s is {:.2} ticks of the {} kHz LSI; the IWDG's shortest timeout is 4 ticks ({:.0} µs: prescaler /4, reload 1, RM0440 §41.3), so the image would wait longer than asked",
+                seconds * f64::from(LSI_HZ),
+                LSI_HZ / 1000,
+                shortest * 1e6
+            ),
+            accepted: format!(
+                "a timeout from {:.0} µs up to {:.2} s",
+                shortest * 1e6,
+                max_watchdog_timeout_s()
+            ),
+        });
+    }
     if let Some(s) = iwdg_for_timeout(seconds as f32, LSI_HZ) {
         return Ok(s);
     }
@@ -142,7 +166,11 @@ pub fn watchdog(seconds: f64) -> Result<(u8, u16), Refusal> {
             256 * IWDG_MAX_RELOAD,
             max_watchdog_timeout_s()
         ),
-        accepted: format!("a timeout up to {:.2} s", max_watchdog_timeout_s()),
+        accepted: format!(
+            "a timeout from {:.0} µs up to {:.2} s",
+            min_watchdog_timeout_s() * 1e6,
+            max_watchdog_timeout_s()
+        ),
     })
 }
 
@@ -412,17 +440,28 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
     FirmwareLimit {
         firmware_messages: &["watchdog timeout out of range"],
         firmware_item: "firmware/config/src/config.rs: WATCHDOG",
-        limit: "IWDG: prescaler /4 … /256, 12-bit reload: at most 256·4095 LSI ticks (32.76 s at 32 kHz, RM0440 §41.3)",
+        limit: "IWDG: prescaler /4 … /256, 12-bit reload 1 … 4095: 4 … 256·4095 LSI ticks (125 µs … 32.76 s at 32 kHz, RM0440 §41.3)",
         rule: "firmware::watchdog, at watchdog.timeout",
-        cases: &[Case {
-            home: Home::Board,
-            base: "motorgen-reference",
-            key: "watchdog.timeout",
-            accepted: "\"32.76 s\"",
-            refused: "\"32.77 s\"",
-            also: &[],
-            why: "32.76 s·32 kHz = 1 048 319.9 ticks (f32) → ⌈1 048 319/256⌉ = 4095 ≤ 4095; 32.77 s → 1 048 640 ticks → 4097 > 4095",
-        }],
+        cases: &[
+            Case {
+                home: Home::Board,
+                base: "motorgen-reference",
+                key: "watchdog.timeout",
+                accepted: "\"32.76 s\"",
+                refused: "\"32.77 s\"",
+                also: &[],
+                why: "32.76 s·32 kHz = 1 048 319.9 ticks (f32) → ⌈1 048 319/256⌉ = 4095 ≤ 4095; 32.77 s → 1 048 640 ticks → 4097 > 4095",
+            },
+            Case {
+                home: Home::Board,
+                base: "motorgen-reference",
+                key: "watchdog.timeout",
+                accepted: "\"125 µs\"",
+                refused: "\"120 µs\"",
+                also: &[],
+                why: "125 µs·32 kHz = 4 ticks: prescaler /4, reload 1, the IWDG's shortest; 120 µs = 3.84 ticks, which the firmware's rounding would make 125 µs (longer than asked). The reference board's motors run T_s ≤ 50 µs, so 125 µs ≥ 2·T_s",
+            },
+        ],
     },
     FirmwareLimit {
         firmware_messages: &["the generated CAN bit timing does not make the board's bit rate from the FDCAN clock"],
@@ -573,12 +612,19 @@ mod tests {
         assert!(e.accepted.contains("5929 ns"), "{e:?}");
     }
 
-    /// 5 ms at 32 kHz = 160 ticks → /4, 40; 40 s is beyond 32.76 s.
+    /// 5 ms at 32 kHz = 160 ticks → /4, 40; 40 s is beyond 32.76 s; 125 µs = 4 ticks → /4,
+    /// 1, the shortest; 100 µs = 3.2 ticks is shorter than the IWDG makes.
     #[test]
     fn watchdog_by_hand() {
         assert_eq!(watchdog(5e-3), Ok((0, 40)));
         assert!((max_watchdog_timeout_s() - 32.76).abs() < 1e-9);
         assert!(watchdog(40.0).unwrap_err().accepted.contains("32.76 s"));
+        assert_eq!(watchdog(125e-6), Ok((0, 1)));
+        let e = watchdog(100e-6).unwrap_err();
+        assert!(
+            e.problem.contains("3.20 ticks") && e.accepted.contains("from 125 µs"),
+            "{e:?}"
+        );
     }
 
     /// Hand calculations at 170 MHz, aiming at 87.5 %:

@@ -253,3 +253,35 @@ fn every_warning_is_located_at_its_key() {
     }
     assert!(seen > 0, "no warning at all: the test would pass on anything");
 }
+
+/// The image refreshes the watchdog once per control period: a timeout shorter than
+/// 2·T_s resets a healthy drive. The Unimotor slowed to 1000 rpm (12·f_e,max = 1 kHz) at
+/// f_s = 2 kHz has T_s = 500 µs, so on the reference board 0.9 ms is refused at
+/// `watchdog.timeout` and 1.1 ms (35.2 LSI ticks: /4, reload 9) is accepted.
+#[test]
+fn a_watchdog_shorter_than_two_control_periods_is_refused() {
+    let slow = [
+        ("motor.datasheet.max_speed", "\"1000 rpm\""),
+        ("fir.pass_edge", "\"20 Hz\""),
+        ("fir.stop_edge", "\"400 Hz\""),
+        ("drive.switching_frequency", "\"2 kHz\""),
+    ];
+    let motor = slow.iter().fold(read("motors/unimotor-142umd300.toml"), |t, (k, v)| {
+        set_toml_key(&t, k, v)
+    });
+    let board = read("boards/motorgen-reference.toml");
+    for (timeout, ok) in [("\"0.9 ms\"", false), ("\"1.1 ms\"", true)] {
+        let b = set_toml_key(&board, "watchdog.timeout", timeout);
+        let r = codegen::design_with_board("m.toml", &motor, "b.toml", &b);
+        match (r, ok) {
+            (Ok(d), true) => assert!((d.drive.sample_period_s - 500e-6).abs() < 1e-12),
+            (Err(e), false) => {
+                let d = refused_at(&e, &b, "watchdog.timeout");
+                assert!(d.problem.contains("2·T_s = 1000.0 µs"), "{e}");
+                assert!(d.accepted.contains("at least 1000.0 µs"), "{e}");
+            }
+            (Ok(_), false) => panic!("{timeout}: accepted"),
+            (Err(e), true) => panic!("{timeout}: {e}"),
+        }
+    }
+}

@@ -162,7 +162,11 @@ fn every_seed_motor_identifies_over_can() {
             let log = run(&m, setup.bench(0.0), step(axis_q), 0.0);
             let f = write(&dir, &format!("step-{name}.log"), &log);
             files.push(f.display().to_string());
-            identify(&spec, &m.board, &["step", "--axis", name, "--candump", &files[files.len() - 1]]);
+            identify(
+                &spec,
+                &m.board,
+                &["step", "--axis", name, "--candump", &files[files.len() - 1]],
+            );
         }
         // ψ_M on the dynamometer at 8 % of the maximum electrical speed (the routine needs
         // 5 %): without the decoupling feed-forward, which §6.5 switches off, the

@@ -277,6 +277,25 @@ pub(in crate::design) fn board(
             ),
         );
     }
+    // The main loop refreshes the IWDG once the control interrupt has run again
+    // (firmware/app/src/board/mod.rs), about once per T_s: a timeout shorter than two
+    // control periods resets a healthy drive.
+    let ts = d.drive.sample_period_s;
+    if board.watchdog_timeout_s < 2.0 * ts {
+        refuse(
+            "watchdog.timeout",
+            format!(
+                "a watchdog timeout of {:.1} µs is shorter than two control periods of {} ({spec}), 2·T_s = {:.1} µs: the image refreshes the watchdog once per control period, so it would reset a healthy drive",
+                board.watchdog_timeout_s * 1e6,
+                d.name,
+                2.0 * ts * 1e6
+            ),
+            format!(
+                "a timeout of at least {:.1} µs (2·T_s), or a motor switching faster",
+                2.0 * ts * 1e6
+            ),
+        );
+    }
     let can_timing = match firmware::can_bit_rate(firmware::FDCAN_CLOCK_HZ, board.can_bit_rate) {
         Ok(t) => Some(t),
         Err(r) => {
@@ -286,7 +305,6 @@ pub(in crate::design) fn board(
     };
     let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
     let t_conv = sequence_time(board, ADC_CLOCK_HZ);
-    let ts = d.drive.sample_period_s;
     if t_conv > 0.25 * ts {
         warn(
             "sensing.source_resistance.current",

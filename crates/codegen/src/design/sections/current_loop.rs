@@ -184,7 +184,12 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             ),
             match best {
                 Some(a) => format!(
-                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes and the at-speed figures `motorgen verify` checks (decoupling, DC-link step) for this motor at f_s = {fs} Hz, or a higher f_s"
+                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes and the at-speed figures `motorgen verify` checks (decoupling, DC-link step) for this motor at f_s = {fs} Hz{}, or a higher f_s",
+                    // Where the at-speed figures bind, the floors' own limit too.
+                    match bandwidth::largest_bandwidth(&requests, None).map(round_down_3) {
+                        Some(f) if f > a => format!(" (the floors alone allow up to {f:.0} rad/s)"),
+                        _ => String::new(),
+                    }
                 ),
                 None => "a higher f_s: no bandwidth meets the floors for this motor at this f_s".to_string(),
             },
