@@ -146,7 +146,30 @@ fn inputs_hash(motor: &str) -> u64 {
     h
 }
 
-/// `target/firmware/<motor>.elf` for the motor's board ([`crate::wiring::board_for`]: the
+/// The board `motor`'s image is built for: the default board when `motorgen check`
+/// accepts the motor on it, else the first other board in `boards/` that it fits (a
+/// motor whose peak current or DC link the default board cannot measure — the traction
+/// motors on `motorgen-reference-400a`); an error naming every refusal if none fits.
+pub fn board_for(motor: &str) -> Result<String, String> {
+    let read = |file: String| -> Result<(String, String), String> {
+        let text = std::fs::read_to_string(repo().join(&file)).map_err(|e| format!("{file}: {e}"))?;
+        Ok((file, text))
+    };
+    let (spec_file, spec) = read(format!("motors/{motor}.toml"))?;
+    let mut boards = motor_test_support::board_stems();
+    boards.sort_by_key(|b| b != codegen::board::DEFAULT_BOARD);
+    let mut refusals = Vec::new();
+    for b in boards {
+        let (board_file, board_text) = read(format!("boards/{b}.toml"))?;
+        match codegen::design_with_board(&spec_file, &spec, &board_file, &board_text) {
+            Ok(_) => return Ok(b),
+            Err(e) => refusals.push(e.to_string()),
+        }
+    }
+    Err(format!("{motor} fits no board in boards/:\n{}", refusals.join("\n")))
+}
+
+/// `target/firmware/<motor>.elf` for the motor's board ([`board_for`]: the
 /// default board, or `target/firmware/<board>/<motor>.elf` for a motor that only fits
 /// another), built as `motorgen firmware` builds it (`MOTOR=<motor> BOARD=<board> cargo
 /// build --release --target thumbv7em-none-eabihf -p motor-firmware` in `firmware/`, its
@@ -156,7 +179,7 @@ fn inputs_hash(motor: &str) -> u64 {
 pub fn build(motor: &str) -> Result<Image, String> {
     let _guard = BUILD.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let repo = repo();
-    let board = crate::wiring::board_for(motor)?;
+    let board = board_for(motor)?;
     let mut dir = repo.join("target").join("firmware");
     if board != codegen::board::DEFAULT_BOARD {
         dir = dir.join(&board);

@@ -1,4 +1,4 @@
-//! A test rig: one motor's image on its board (`wiring::board_for`) at standstill, with the vehicle
+//! A test rig: one motor's image on its board (`image::board_for`) at standstill, with the vehicle
 //! unit's setpoint frames on the CAN bus.
 
 use codegen::design::Design;

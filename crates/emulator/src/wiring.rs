@@ -12,27 +12,8 @@ use crate::soc::{Analog, Pin, Wiring};
 /// `boards/<default>.toml`).
 pub fn design(motor: &str) -> Result<Design, String> {
     let (spec_file, spec) = read(&format!("motors/{motor}.toml"))?;
-    let (board_file, board_text) = read(&format!("boards/{}.toml", board_for(motor)?))?;
+    let (board_file, board_text) = read(&format!("boards/{}.toml", crate::image::board_for(motor)?))?;
     codegen::design_with_board(&spec_file, &spec, &board_file, &board_text).map_err(|e| e.to_string())
-}
-
-/// The board `motor`'s image is built for: the default board when `motorgen check`
-/// accepts the motor on it, else the first other board in `boards/` that it fits (a
-/// motor whose peak current or DC link the default board cannot measure — the traction
-/// motors on `motorgen-reference-400a`); an error naming every refusal if none fits.
-pub fn board_for(motor: &str) -> Result<String, String> {
-    let (spec_file, spec) = read(&format!("motors/{motor}.toml"))?;
-    let mut boards = motor_test_support::board_stems();
-    boards.sort_by_key(|b| b != codegen::board::DEFAULT_BOARD);
-    let mut refusals = Vec::new();
-    for b in boards {
-        let (board_file, board_text) = read(&format!("boards/{b}.toml"))?;
-        match codegen::design_with_board(&spec_file, &spec, &board_file, &board_text) {
-            Ok(_) => return Ok(b),
-            Err(e) => refusals.push(e.to_string()),
-        }
-    }
-    Err(format!("{motor} fits no board in boards/:\n{}", refusals.join("\n")))
 }
 
 /// `motors/<motor>.toml` parsed: the machine data `motorgen verify`'s plant takes beyond
