@@ -63,11 +63,14 @@ fn edit(text: &str, edits: &[(&str, &str)]) -> String {
     edits.iter().fold(text.to_string(), |t, (k, v)| set_toml_key(&t, k, v))
 }
 
+/// (key, value) edits of one file.
+type Edits = Vec<(&'static str, &'static str)>;
+
 /// The boundary cases' accepted values, grouped per file: each case joins the first group
 /// of its file (home and base) whose keys it does not set otherwise and with which `check`
 /// still accepts the pair; returns (home, base, edits) per group.
-fn boundary_groups() -> Vec<(Home, &'static str, Vec<(&'static str, &'static str)>)> {
-    let mut groups: Vec<(Home, &'static str, Vec<(&'static str, &'static str)>)> = Vec::new();
+fn boundary_groups() -> Vec<(Home, &'static str, Edits)> {
+    let mut groups: Vec<(Home, &'static str, Edits)> = Vec::new();
     for l in FIRMWARE_LIMITS {
         for c in l.cases {
             let mut mine: Vec<(&str, &str)> = c.also.to_vec();

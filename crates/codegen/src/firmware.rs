@@ -211,13 +211,13 @@ pub fn can_bit_timing(kernel_hz: u32, bit_rate: f64) -> Option<CanBitTiming> {
     }
     let rate = bit_rate as u64;
     let clk = u64::from(kernel_hz);
-    if clk % rate != 0 {
+    if !clk.is_multiple_of(rate) {
         return None;
     }
     let per_bit = clk / rate;
     let mut best: Option<(f64, CanBitTiming)> = None;
     for prescaler in 1..=CAN_MAX_PRESCALER {
-        if per_bit % u64::from(prescaler) != 0 {
+        if !per_bit.is_multiple_of(u64::from(prescaler)) {
             continue;
         }
         let n = per_bit / u64::from(prescaler);
@@ -281,7 +281,7 @@ pub fn can_bit_rate(kernel_hz: u32, bit_rate: f64) -> Result<CanBitTiming, Refus
     // Exact rates near the request: kernel/(prescaler·quanta) that are whole bit/s.
     let mut near: Vec<u32> = Vec::new();
     for divisor in 1..=(CAN_MAX_PRESCALER * CAN_MAX_TQ_PER_BIT) {
-        if kernel_hz % divisor != 0 {
+        if !kernel_hz.is_multiple_of(divisor) {
             continue;
         }
         let r = kernel_hz / divisor;

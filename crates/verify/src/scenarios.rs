@@ -5,7 +5,7 @@
 //!   of (5.14)–(5.16)) when the design compensates the delay, within 5 % of the design's
 //!   sampled-loop prediction always, overshoot within the design's floor (designed + 2 %,
 //!   `design::current_loop::analysis`).
-//! * [`decoupling`] — i_q step at speed with and without the feed-forward (5.3): the
+//! * [`decoupling()`] — i_q step at speed with and without the feed-forward (5.3): the
 //!   i_d excursion must shrink at least 3× (thesis A Figs. 5.4 vs 5.6); its operating
 //!   point and criterion are the design's (`codegen::design::current_loop::decoupling`),
 //!   whose bandwidth search judges the same figure on a model of the loop.
