@@ -101,11 +101,16 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         return Err(failed(cx));
     }
     let drive = sections::drive::drive(&mut cx);
+    let errors_before = cx.errors.len();
     let current_loop = sections::current_loop::current_loop(&mut cx);
+    // A refused current loop (unstable, below its floors) has no ramp lag worth judging
+    // the field weakening with: its rule would only add an error of nonsense numbers.
+    let loop_refused = cx.errors.len() > errors_before;
     let angle_observer = sections::angle_observer::angle_observer(&mut cx);
     let fir = sections::fir::fir(&mut cx);
     let adc = sections::adc::adc(&mut cx);
-    let field_weakening = sections::field_weakening::field_weakening(&mut cx, current_loop.as_ref());
+    let field_weakening =
+        sections::field_weakening::field_weakening(&mut cx, current_loop.as_ref().filter(|_| !loop_refused));
     let (true, Some(current_loop), Some(angle_observer), Some(fir)) =
         (cx.errors.is_empty(), current_loop, angle_observer, fir)
     else {

@@ -285,3 +285,14 @@ fn a_watchdog_shorter_than_two_control_periods_is_refused() {
         }
     }
 }
+
+/// A refused current loop is refused once, at its bandwidth: fischer-ti085 at
+/// α = 60 000 rad/s (α·T_s = 3, unstable) used to add a field-weakening error computed
+/// with the unstable loop's "ramp lag" of 1211 s and a 72.5 kV overshoot.
+#[test]
+fn a_refused_current_loop_adds_no_field_weakening_error_of_its_numbers() {
+    let (text, r) = spec("fischer-ti085", &[("current_loop.bandwidth", "\"60000 rad/s\"")]);
+    let e = r.unwrap_err();
+    refused_at(&e, &text, "current_loop.bandwidth");
+    assert_eq!(e.0.len(), 1, "{e}");
+}
