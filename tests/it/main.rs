@@ -3,6 +3,7 @@
 //! golden files, hostile text in the outputs, and the firmware built for each motor.
 
 mod firmware;
+mod firmware_limits;
 mod generated;
 mod golden;
 mod injection;

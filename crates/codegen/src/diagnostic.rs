@@ -21,6 +21,9 @@ pub struct Diagnostic {
     pub accepted: String,
     /// The source line, for the excerpt under the message.
     pub excerpt: String,
+    /// Further observations that bear on it (e.g. the spec's cross-checks that disagree),
+    /// each printed as a `note:` line.
+    pub notes: Vec<String>,
 }
 
 /// Where a spec came from, and its text, for locating byte spans.
@@ -50,7 +53,37 @@ impl<'a> Source<'a> {
             problem: problem.into(),
             accepted: accepted.into(),
             excerpt,
+            notes: Vec::new(),
         }
+    }
+}
+
+impl Source<'_> {
+    /// A warning located at byte `span`: `file:line:column: \`key\`: text` (what every
+    /// command prints on stderr after `warning: `).
+    pub fn warning(&self, span: Range<usize>, key: &str, text: impl std::fmt::Display) -> String {
+        let (line, column, _) = locate(self.text, span.start);
+        if key.is_empty() {
+            format!("{}:{line}:{column}: {text}", self.file)
+        } else {
+            format!("{}:{line}:{column}: `{key}`: {text}", self.file)
+        }
+    }
+
+    /// The span of the header `[table]` in the file, for a warning about a key the table
+    /// lacks (0..0, the file's start, if the file has no such header).
+    pub fn table_span(&self, table: &str) -> Range<usize> {
+        let header = format!("[{table}]");
+        let mut offset = 0;
+        for line in self.text.split_inclusive('\n') {
+            let t = line.trim_start();
+            if t.starts_with(&header) {
+                let at = offset + (line.len() - t.len());
+                return at..at + header.len();
+            }
+            offset += line.len();
+        }
+        0..0
     }
 }
 
@@ -82,7 +115,11 @@ impl fmt::Display for Diagnostic {
             writeln!(f, "{} | {}", self.line, self.excerpt)?;
             writeln!(f, "{:gutter$} | {:>col$}", "", "^", col = self.column)?;
         }
-        write!(f, "  accepted: {}", self.accepted)
+        write!(f, "  accepted: {}", self.accepted)?;
+        for n in &self.notes {
+            write!(f, "\n  note: {n}")?;
+        }
+        Ok(())
     }
 }
 

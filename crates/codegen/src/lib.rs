@@ -8,8 +8,9 @@
 //! scripts share to write generated files.)
 //!
 //! Layers inside (each module may use the ones above it, never one below; checked by
-//! `tests/it/layers.rs`): [`units`], [`diagnostic`], [`escape`] → [`spec`], [`board`]
-//! (parsing) → [`design`] → [`constants`] → [`render`], [`summary`].
+//! `tests/it/layers.rs`): [`units`], [`diagnostic`], [`escape`], [`firmware`] (the image's
+//! clocks and the limits its build enforces) → [`spec`], [`board`] (parsing) → [`design`]
+//! → [`constants`] → [`render`], [`summary`].
 //! This crate depends on no simulation, plotting, CLI, CAN or file-editing crate
 //! (`ARCHITECTURE.md`): verification is `motor-verify`, identification and the CAN
 //! session `motor-commission`, the command line `motorgen`.
@@ -20,6 +21,7 @@ pub mod design;
 pub mod diagnostic;
 pub mod escape;
 pub mod files;
+pub mod firmware;
 pub mod render;
 pub mod spec;
 pub mod summary;

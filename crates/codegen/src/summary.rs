@@ -4,7 +4,8 @@ use std::fmt::Write;
 
 use crate::Design;
 
-/// Renders the headline constants of `d`, one per line with unit and equation.
+/// Renders the headline constants of `d`, one per line with unit and equation. The
+/// design's warnings are not part of it: every command prints them once, on stderr.
 pub fn summary(d: &Design) -> String {
     let mut s = String::new();
     let m = &d.motor;
@@ -234,9 +235,70 @@ pub fn summary(d: &Design) -> String {
                 se.omega_min1_rad_s, se.omega_min2_rad_s, se.id_at_base_current_a, se.omega_ls_rad_s, se.omega_hs_rad_s
             )?;
         }
-        for w in &d.warnings {
-            writeln!(s, "warning: {w}")?;
+        if let Some(b) = &d.board {
+            s.push_str(&board(b, d));
         }
+        Ok(())
+    })();
+    s
+}
+
+/// The board section of a design on a board, for the terminal (`motorgen design --board`,
+/// `check --board`): what the board measures against what the motor needs, the trip levels
+/// the image uses and which limit set each, the CAN bit timing.
+pub fn board(b: &crate::design::BoardOut, d: &Design) -> String {
+    let mut s = String::new();
+    let rpm = 30.0 / std::f64::consts::PI;
+    let t = &b.trips;
+    let c = &b.can_timing;
+    let _ = (|| -> std::fmt::Result {
+        writeln!(s, "board: {} ({})", b.board.name, b.board.file)?;
+        writeln!(
+            s,
+            "  sensing: current ±{:.1} A (the motor's peak current {:.1} A), DC link up to {:.1} V (U_dc = {} V)",
+            b.current_full_scale_a, d.motor.peak_current_a, b.dc_link_full_scale_v, d.drive.dc_link_voltage_v
+        )?;
+        writeln!(
+            s,
+            "  trips the image uses (the lower of the motor's limit and the board's ceiling):"
+        )?;
+        writeln!(
+            s,
+            "    over-current {:.2} A, {}",
+            t.over_current_a.value,
+            t.over_current_a.describe("A", 1.0)
+        )?;
+        writeln!(
+            s,
+            "    over-voltage {:.2} V, {}",
+            t.over_voltage_v.value,
+            t.over_voltage_v.describe("V", 1.0)
+        )?;
+        writeln!(
+            s,
+            "    over-speed {:.0} rpm, {}",
+            t.over_speed_rad_s.value * rpm,
+            t.over_speed_rad_s.describe("rpm", rpm)
+        )?;
+        writeln!(
+            s,
+            "  CAN {} bit/s from {} MHz: prescaler {}, {} quanta (1 + {} + {}), sample point {:.2} %, SJW {}, FDCAN_NBTP = {:#010x}",
+            c.bit_rate,
+            f64::from(c.kernel_clock_hz) / 1e6,
+            c.prescaler,
+            c.tq_per_bit,
+            c.tseg1,
+            c.tseg2,
+            c.sample_point * 100.0,
+            c.sjw,
+            c.nbtp
+        )?;
+        writeln!(
+            s,
+            "  dead time {} ns; conversions {:.2} µs after the trigger",
+            b.dead_time_ns,
+            b.conversion_time_s * 1e6
+        )?;
         Ok(())
     })();
     s

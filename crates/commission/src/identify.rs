@@ -211,6 +211,7 @@ fn plain_error(file: &str, problem: String, accepted: &str) -> Diagnostics {
         problem,
         accepted: accepted.to_string(),
         excerpt: String::new(),
+        notes: Vec::new(),
     }])
 }
 
@@ -510,6 +511,7 @@ impl Request {
                     ),
                     accepted: format!("captures of the routine {}", names.join(" or ")),
                     excerpt: String::new(),
+                    notes: Vec::new(),
                 };
                 errors.extend(origin.locate(wrong.into()).0);
                 continue;

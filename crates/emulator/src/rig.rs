@@ -234,13 +234,22 @@ pub fn first_enabled_period(m: &Machine) -> Option<f64> {
     })
 }
 
-/// Whether `motor` fits the board `board` (its file's ranges): its DC link below the
-/// board's over-voltage trip and inside what the divider measures, and `motorgen
-/// verify`'s current step below the over-current trip. A motor that does not fit trips
-/// the image at once; the scenarios run every motor on every board it fits.
+/// Whether `motor` fits the board `board` (its file's ranges): `motorgen check --board`
+/// accepts the pair (its peak current and DC link inside what the board measures and is
+/// rated for, its top speed below the board's ceiling), its DC link below the board's
+/// over-voltage trip, and `motorgen verify`'s current step below the over-current trip.
+/// A motor that does not fit trips the image at once; the scenarios run every motor on
+/// every board it fits.
 pub fn fits(motor: &str, board: &str) -> Result<bool, String> {
     let b = BoardFile::shipped(board)?;
-    let d = wiring::design(motor, &b.file_name(), &b.text)?;
+    let spec_file = format!("motors/{motor}.toml");
+    let spec_text = std::fs::read_to_string(image::repo().join(&spec_file)).map_err(|e| format!("{spec_file}: {e}"))?;
+    // The spec alone must design (else the motor file is broken, not a misfit).
+    codegen::design_source(&spec_file, &spec_text).map_err(|e| e.to_string())?;
+    // A refusal of the pair (errors at the board's keys) is a misfit.
+    let Ok(d) = codegen::design_with_board(&spec_file, &spec_text, &b.file_name(), &b.text) else {
+        return Ok(false);
+    };
     let spec = wiring::spec(motor)?;
     let out = d.board.as_ref().ok_or("no board")?;
     let udc = d.drive.dc_link_voltage_v;
@@ -268,6 +277,13 @@ pub fn benches() -> Vec<(String, String)> {
         assert!(
             n > 0 || std::env::var_os("EMULATOR_MOTORS").is_some(),
             "no motor fits {board}"
+        );
+    }
+    // A motor no board fits would run no scenario at all.
+    for motor in image::motors() {
+        assert!(
+            out.iter().any(|(m, _)| *m == motor),
+            "{motor} fits no board in boards/ (`motorgen check motors/{motor}.toml --board …` says why)"
         );
     }
     out

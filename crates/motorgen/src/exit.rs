@@ -166,6 +166,7 @@ mod tests {
             problem: "bad".into(),
             accepted: "good".into(),
             excerpt: String::new(),
+            notes: Vec::new(),
         }]);
         let problem = Problem::new("--trip", "bad", "good");
         let iface = || "can0".to_string();

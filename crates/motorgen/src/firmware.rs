@@ -2,9 +2,11 @@
 //! STM32G474 image of one motor or of every motor in `motors/`, on a board of `boards/`
 //! (default `motorgen-reference`).
 //!
-//! Per motor: designs the spec on the board first (a bad spec or board file stops here
-//! with its located diagnostic; what does not fit between them is printed as warnings
-//! on stderr), runs
+//! Per motor: designs the spec on the board first (a bad spec or board file, or a motor
+//! the board does not fit, stops here with its located diagnostic; with `--all`, a sound
+//! spec the board does not fit is left out with a warning naming the board keys, and it
+//! is an error only if no motor fits; the design's warnings are printed once on stderr),
+//! runs
 //! `cargo build --release --target thumbv7em-none-eabihf -p motor-firmware` in
 //! `firmware/` with `MOTOR=<stem>`, `MOTORS_DIR`, `BOARD=<board>` and `BOARDS_DIR` (one
 //! shared target directory, so only the app crate rebuilds per motor), copies the ELF to
@@ -38,6 +40,9 @@ const PACKAGE: &str = "motor-firmware";
 /// The project's flash budget for one image \[bytes\] — a budget, not the chip's limit:
 /// the STM32G474RE has 512 KiB of flash (DS12288 Table 2).
 pub const FLASH_LIMIT: u64 = 64 * 1024;
+/// How cargo prints a `cargo::warning` of `motor-config`'s build script (the design's
+/// warnings for this motor on the board, which `run` has printed already).
+const BUILD_SCRIPT_WARNING: &str = "warning: motor-config@";
 /// Erased-flash byte, for gaps between segments in the `.bin`.
 const ERASED: u8 = 0xFF;
 /// Largest span of load addresses accepted for a `.bin` \[bytes\]: more means a
@@ -48,7 +53,7 @@ const MAX_SPAN: u64 = 16 * 1024 * 1024;
 pub enum Which {
     /// One stem.
     One(String),
-    /// Every `*.toml` in the motors folder.
+    /// Every `*.toml` in the motors folder that fits the board (the others are warned about).
     All,
 }
 
@@ -294,6 +299,11 @@ fn cargo_build(root: &Path, t: &Target<'_>, stem: &str) -> Result<PathBuf, Failu
     let relay = std::thread::spawn(move || {
         let mut seen = String::new();
         for line in BufReader::new(err).lines().map_while(Result::ok) {
+            // The build script's `cargo::warning`s are the design's warnings about the
+            // board, which were printed once before cargo ran.
+            if line.starts_with(BUILD_SCRIPT_WARNING) {
+                continue;
+            }
             errln!("{line}");
             seen.push_str(&line);
             seen.push('\n');
@@ -374,6 +384,7 @@ fn build_one(root: &Path, t: &Target<'_>, stem: &str) -> Result<String, Failure>
 /// runs; every motor is built even if one fails, and the exit code is the gravest failure's.
 pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<(), Failure> {
     let known = stems(motors, "motors").map_err(|e| Failure::new(Exit::Io, format!("error: {e}")))?;
+    let every = matches!(which, Which::All);
     let selected = match which {
         Which::All if known.is_empty() => {
             return Err(Failure::new(
@@ -412,16 +423,31 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<()
         ));
     }
     // Every selected spec must design on the board before cargo runs (located
-    // diagnostics); what does not fit is a warning.
+    // diagnostics, a motor the board does not fit among them). With --all, a motor whose
+    // spec is sound but which does not fit the board is left out with a warning that
+    // names the board keys; a named motor that does not fit is an error.
     let mut designs = Vec::new();
+    let mut built = Vec::new();
     let mut failed = Vec::new();
     for stem in &selected {
-        match super::design_on(&motors.join(format!("{stem}.toml")), Some(&board_file)) {
+        let spec = motors.join(format!("{stem}.toml"));
+        match super::design_on(&spec, Some(&board_file)) {
             Ok(d) => {
-                for w in d.board.iter().flat_map(|b| &b.warnings) {
-                    crate::output::warn(format_args!("{stem} on {board}: {w}"));
-                }
+                crate::warn_design(&d);
                 designs.push(d);
+                built.push(stem.clone());
+            }
+            Err(f) if every && f.exit == Exit::BadInput && super::design(&spec).is_ok() => {
+                let reasons: Vec<String> = f
+                    .message
+                    .lines()
+                    .filter_map(|l| l.strip_prefix("error: "))
+                    .map(|l| format!("\n  {l}"))
+                    .collect();
+                crate::output::warn(format_args!(
+                    "{stem} is not built for {board}: it does not fit the board{}",
+                    reasons.concat()
+                ));
             }
             Err(f) => {
                 failed.push(f.exit);
@@ -432,16 +458,25 @@ pub fn run(which: Which, motors: &Path, board: &str, boards: &Path) -> Result<()
     if let Some(exit) = Exit::gravest(&failed) {
         return Err(Failure::new(exit, "firmware: nothing built (a spec has problems)"));
     }
+    if built.is_empty() {
+        return Err(Failure::new(
+            Exit::BadInput,
+            format!(
+                "error: no motor in {} fits board `{board}` (see the warnings above)\n  accepted: a board whose sensing and ratings cover a motor's peak current, DC link and speed",
+                motors.display()
+            ),
+        ));
+    }
     let target = Target {
         motors: &motors,
         board,
         boards: &boards,
     };
     // One motor: the constants the image is built from, as `motorgen design` prints them.
-    if let [d] = designs.as_slice() {
+    if let (false, [d]) = (every, designs.as_slice()) {
         out!("{}", codegen::summary::summary(d));
     }
-    for stem in &selected {
+    for stem in &built {
         match build_one(&root, &target, stem) {
             Ok(report) => out!("{report}"),
             Err(f) => {

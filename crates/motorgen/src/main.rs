@@ -39,8 +39,8 @@ enum Command {
         /// Directory with replacement templates (for rust, c, markdown).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
-        /// A board file (boards/NAME.toml): adds the `board` constants and the checks
-        /// of the motor on that board.
+        /// A board file, or the stem of one in boards/ (e.g. motorgen-reference): adds the
+        /// `board` constants and the checks of the motor on that board.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
@@ -58,17 +58,23 @@ enum Command {
         /// motor.dbc.j2).
         #[arg(long, value_name = "DIR")]
         templates: Option<PathBuf>,
-        /// A board file: adds its `board` and `can` constants (as `design --board`) and
-        /// writes STEM.dbc.
+        /// A board file or the stem of one in boards/: adds its `board` and `can` constants
+        /// (as `design --board`) and writes STEM.dbc.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
     },
     /// Validate motor specs and board files (a file with a top-level `chip` is a board);
-    /// warnings go to stderr; exit 1 if any has a problem.
+    /// with --board, each motor spec on that board (what the image of the pair needs: the
+    /// board's sensing and ratings, the trips it will use). Warnings go to stderr; exit 1
+    /// if any has a problem.
     Check {
         /// One or more motor specs or board files.
         #[arg(required = true, value_name = "FILE")]
         specs: Vec<PathBuf>,
+        /// A board file, or the stem of one in boards/ (e.g. motorgen-reference): checks
+        /// every motor spec given on it and prints the trip levels its image would use.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
     /// Write a commented starting spec to DIR/STEM.toml, DIR defaulting to motors/
     /// (never overwrites).
@@ -107,6 +113,11 @@ enum Command {
         /// The motor spec.
         #[arg(value_name = "SPEC")]
         spec: PathBuf,
+        /// A board file or the stem of one in boards/: the motor on that board (refused
+        /// where it does not fit), simulated with the board's current and DC-link sensing
+        /// as the image would run.
+        #[arg(long, value_name = "BOARD_FILE")]
+        board: Option<PathBuf>,
     },
     /// Write a self-contained HTML report (verification table, SVG plots, every constant
     /// with formula and provenance) to DIR/STEM.html (exit 3 if a figure fails).
@@ -215,6 +226,15 @@ fn read_input(path: &Path) -> Input {
     }
 }
 
+/// Prints the design's warnings on stderr, once each (each is located at its key:
+/// `file:line:column: `key`: …`). Every command that designs calls it once, whatever the
+/// output format.
+fn warn_design(d: &codegen::Design) {
+    for w in &d.warnings {
+        output::warn(format_args!("{w}"));
+    }
+}
+
 fn design(path: &Path) -> Result<codegen::Design, Failure> {
     let text = read_spec(path)?;
     Ok(codegen::design_source(&path.display().to_string(), &text)?)
@@ -237,14 +257,43 @@ fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failu
 
 /// `motors/` in the working directory, else the one in this repository.
 fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
+    shipped_dir(dir, "motors")
+}
+
+/// `dir` if given, else `folder` (`motors` or `boards`) in the working directory, else the
+/// one in this repository.
+fn shipped_dir(dir: Option<PathBuf>, folder: &str) -> PathBuf {
     dir.unwrap_or_else(|| {
-        let here = PathBuf::from("motors");
+        let here = PathBuf::from(folder);
         if here.is_dir() {
             here
         } else {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("motors")
+            Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(folder)
         }
     })
+}
+
+/// A spec or board argument: the file it names if there is one, else a bare name (no
+/// folder) looked up in `folder` (`motors` or `boards`, as [`shipped_dir`] finds it) with or
+/// without `.toml`: `--board motorgen-reference` is `boards/motorgen-reference.toml`. A name
+/// found nowhere stays as given, and reading it reports the missing file.
+fn locate(path: PathBuf, folder: &str) -> PathBuf {
+    let bare = path.components().count() == 1 && path.parent().is_none_or(|p| p.as_os_str().is_empty());
+    if path.exists() || !bare {
+        return path;
+    }
+    let dir = shipped_dir(None, folder);
+    let mut with_toml = path.clone().into_os_string();
+    with_toml.push(".toml");
+    [dir.join(&path), dir.join(with_toml)]
+        .into_iter()
+        .find(|p| p.is_file())
+        .unwrap_or(path)
+}
+
+/// [`locate`] for an optional board argument.
+fn locate_board(board: Option<PathBuf>) -> Option<PathBuf> {
+    board.map(|b| locate(b, "boards"))
 }
 
 fn main() -> ExitCode {
@@ -264,7 +313,9 @@ fn run(command: Command) -> Result<(), Failure> {
             templates,
             board,
         } => {
+            let (spec, board) = (locate(spec, "motors"), locate_board(board));
             let d = design_on(&spec, board.as_deref())?;
+            warn_design(&d);
             let out = match format.output() {
                 Some(o) => render(&d, o, templates.as_deref())?,
                 None if matches!(format, Format::Json) => serde_json::to_string_pretty(&d)
@@ -282,7 +333,9 @@ fn run(command: Command) -> Result<(), Failure> {
             board,
         } => {
             atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+            let (spec, board) = (locate(spec, "motors"), locate_board(board));
             let d = design_on(&spec, board.as_deref())?;
+            warn_design(&d);
             let stem = spec
                 .file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
@@ -302,26 +355,51 @@ fn run(command: Command) -> Result<(), Failure> {
             }
             Ok(())
         }
-        Command::Check { specs } => {
-            // Every spec is checked; the exit code is the gravest failure's (I/O over bad input).
+        Command::Check { specs, board } => {
+            // Every file is checked; the exit code is the gravest failure's (I/O over bad input).
             let mut failed = Vec::new();
+            let board = locate_board(board);
+            let specs: Vec<PathBuf> = specs.into_iter().map(|p| locate(p, "motors")).collect();
+            let board_file = match &board {
+                Some(b) => match read_spec(b) {
+                    Ok(text) => Some((b.display().to_string(), text)),
+                    Err(f) => {
+                        failed.push(f.exit);
+                        f.report();
+                        None
+                    }
+                },
+                None => None,
+            };
+            let (mut motors, mut boards) = (0, 0);
             for path in &specs {
                 // Read once; a file with a top-level `chip` is a board, anything else a motor.
                 let name = path.display().to_string();
                 let checked = read_spec(path).and_then(|text| {
                     if codegen::board::is_board_file(&text) {
+                        boards += 1;
                         let b = codegen::board_source(&name, &text)?;
                         outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
                         // Stated facts that contradict the board's parts' datasheets.
                         for w in &b.warnings {
                             output::warn(format_args!("{w}"));
                         }
-                    } else {
-                        let d = codegen::design_source(&name, &text)?;
-                        outln!("ok: {name} ({})", d.name);
-                        for w in &d.warnings {
-                            output::warn(format_args!("{name}: {w}"));
+                        return Ok(());
+                    }
+                    motors += 1;
+                    let d = match (&board, &board_file) {
+                        (Some(_), Some((bname, btext))) => codegen::design_with_board(&name, &text, bname, btext)?,
+                        // The board could not be read (reported above): the spec alone.
+                        (Some(_), None) => codegen::design_source(&name, &text)?,
+                        (None, _) => codegen::design_source(&name, &text)?,
+                    };
+                    warn_design(&d);
+                    match &d.board {
+                        Some(b) => {
+                            outln!("ok: {name} ({}) on {} ({})", d.name, b.board.file, b.board.name);
+                            out!("{}", codegen::summary::board(b, &d));
                         }
+                        None => outln!("ok: {name} ({})", d.name),
                     }
                     Ok(())
                 });
@@ -329,6 +407,11 @@ fn run(command: Command) -> Result<(), Failure> {
                     failed.push(f.exit);
                     f.report();
                 }
+            }
+            if board.is_none() && motors > 0 && boards > 0 {
+                output::stderr(format_args!(
+                    "note: motor specs and board files were checked each on its own; `--board FILE` checks the motors on a board\n"
+                ));
             }
             match Exit::gravest(&failed) {
                 None => Ok(()),
@@ -394,7 +477,7 @@ fn run(command: Command) -> Result<(), Failure> {
             });
             firmware::run(which, &motors, &board, &boards)
         }
-        Command::Verify { spec } => verify::run(&spec),
+        Command::Verify { spec, board } => verify::run(&locate(spec, "motors"), locate_board(board).as_deref()),
         Command::Report { spec, out } => report::run(&spec, &out),
         Command::Identify { what } => identify::run(what),
         Command::Capture {

@@ -12,6 +12,7 @@ pub fn run(spec: &Path, out: &Path) -> Result<(), Failure> {
     crate::atomic::check_out_dir(out).map_err(|e| Failure::new(Exit::BadInput, e))?;
     let text = crate::read_spec(spec)?;
     let (design, verification) = motor_verify::verify_source(&spec.display().to_string(), &text)?;
+    crate::warn_design(&design);
     let page = motor_verify::report::report(&design, &verification)
         .map_err(|e| Failure::new(Exit::Io, format!("error: cannot draw the report: {e}")))?;
     let stem = spec

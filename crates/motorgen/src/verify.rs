@@ -1,16 +1,27 @@
-//! `motorgen verify <spec>`: runs the standard scenarios on the firmware's control step
-//! in closed loop with the simulated motor and prints the pass/fail table.
+//! `motorgen verify <spec> [--board <file>]`: runs the standard scenarios on the
+//! firmware's control step in closed loop with the simulated motor and prints the
+//! pass/fail table; on a board, the motor must fit it and the simulation reads currents
+//! and DC link through the board's sensing.
 
 use std::path::Path;
 
 use crate::exit::{Exit, Failure};
 use crate::output::out;
 
-/// Reads, designs and verifies `spec`; prints the table. A bad spec is bad input (with
-/// the located message), a failing scenario a failed verification.
-pub fn run(spec: &Path) -> Result<(), Failure> {
+/// Reads, designs (on `board` if given) and verifies `spec`; prints the design's warnings
+/// (stderr) and the table. A bad spec or a pair that does not fit is bad input (with the
+/// located message), a failing scenario a failed verification.
+pub fn run(spec: &Path, board: Option<&Path>) -> Result<(), Failure> {
     let text = crate::read_spec(spec)?;
-    let (_, v) = motor_verify::verify_source(&spec.display().to_string(), &text)?;
+    let name = spec.display().to_string();
+    let (d, v) = match board {
+        Some(b) => {
+            let board_text = crate::read_spec(b)?;
+            motor_verify::verify_source_on(&name, &text, &b.display().to_string(), &board_text)?
+        }
+        None => motor_verify::verify_source(&name, &text)?,
+    };
+    crate::warn_design(&d);
     out!("{}", v.table());
     if v.passed() {
         Ok(())

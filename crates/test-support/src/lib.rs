@@ -97,6 +97,53 @@ pub fn temporaries(dir: &Path) -> Vec<String> {
         .collect()
 }
 
+/// `text` (a spec or board file) with the value of the dotted `key` set to `value` (TOML
+/// text, e.g. `"\"5929 ns\""` or `0x0DA`): the line `name = …` in the key's `[table]` is
+/// replaced (its trailing comment dropped), or added under the table's header when the
+/// table lacks it. Panics (fails the test) when the table is not in the file.
+pub fn set_toml_key(text: &str, key: &str, value: &str) -> String {
+    let (table, name) = key.rsplit_once('.').unwrap_or(("", key));
+    let lines: Vec<&str> = text.lines().collect();
+    let header = |l: &str| l.trim_start().starts_with('[');
+    let table_of = |l: &str| {
+        let t = l.trim();
+        t.trim_start_matches('[')
+            .split(']')
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_string()
+    };
+    // The table's lines: from after its header to the next header (the top level: from
+    // the start).
+    let start = if table.is_empty() {
+        0
+    } else {
+        lines
+            .iter()
+            .position(|l| header(l) && !l.trim().starts_with("[[") && table_of(l) == table)
+            .unwrap_or_else(|| panic!("no [{table}] in the file for `{key}`"))
+            + 1
+    };
+    let end = lines[start..]
+        .iter()
+        .position(|l| header(l))
+        .map_or(lines.len(), |i| start + i);
+    let mut out: Vec<String> = lines.iter().map(|l| l.to_string()).collect();
+    let found = (start..end).find(|&i| {
+        let t = lines[i].trim_start();
+        t.strip_prefix(name)
+            .is_some_and(|rest| rest.trim_start().starts_with('='))
+    });
+    match found {
+        Some(i) => out[i] = format!("{name} = {value}"),
+        None => out.insert(start, format!("{name} = {value}")),
+    }
+    let mut joined = out.join("\n");
+    joined.push('\n');
+    joined
+}
+
 /// Issue 18's examples on the Fischer spec: (text replaced, replacement, key, range the
 /// refusal names). Each overflowed or underflowed the design before it had a range.
 pub const ISSUE_18_RANGE_EXAMPLES: &[(&str, &str, &str, &str)] = &[
@@ -135,6 +182,28 @@ mod tests {
     fn a_missing_folder_fails() {
         let r = std::panic::catch_unwind(|| stems_in(Path::new("/nonexistent/motors")));
         assert!(r.is_err());
+    }
+
+    #[test]
+    fn sets_a_key_in_its_table() {
+        let text = "name = \"x\"\n[a]\nk = 1 # c\n[a.b]\nk = 2\n";
+        assert_eq!(
+            set_toml_key(text, "a.k", "5"),
+            "name = \"x\"\n[a]\nk = 5\n[a.b]\nk = 2\n"
+        );
+        assert_eq!(
+            set_toml_key(text, "a.b.k", "7"),
+            "name = \"x\"\n[a]\nk = 1 # c\n[a.b]\nk = 7\n"
+        );
+        assert_eq!(
+            set_toml_key(text, "a.j", "3"),
+            "name = \"x\"\n[a]\nj = 3\nk = 1 # c\n[a.b]\nk = 2\n"
+        );
+        assert_eq!(
+            set_toml_key(text, "name", "\"y\""),
+            "name = \"y\"\n[a]\nk = 1 # c\n[a.b]\nk = 2\n"
+        );
+        assert!(std::panic::catch_unwind(|| set_toml_key(text, "c.k", "1")).is_err());
     }
 
     #[test]

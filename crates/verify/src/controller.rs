@@ -6,19 +6,11 @@
 //! Q1.15 full scale instead of a board's ADC codes.
 
 use motor_control::angle::to_radians_f64;
-use motor_control::modulation::centre_aligned_period;
 use motor_control::pi::PiConfig;
 use motor_control::step::{ControllerConfig, ControllerParameters};
 
 use codegen::design::Design;
 use codegen::design::current_loop::AxisGains;
-
-/// TIM1 kernel clock \[Hz\]: the STM32G474's maximum SYSCLK in range-1 boost mode
-/// (170 MHz, DS12288 §3.9; APB2 ×1, RM0440 §7.2.17), the firmware's `hw::TIMER_CLOCK_HZ`;
-/// with centre-aligned PWM an auto-reload of
-/// `TIMER_CLOCK_HZ/(2·f_s)` (4250 at 20 kHz). Only the telemetry compare values use it;
-/// the simulated inverter applies the duties.
-pub const TIMER_CLOCK_HZ: u32 = 170_000_000;
 
 /// Mid-scale code of a bipolar current channel read as a 16-bit (Q1.15 offset-binary) value.
 pub const CURRENT_OFFSET: i32 = 1 << 15;
@@ -38,25 +30,43 @@ fn axis(g: &AxisGains) -> PiConfig {
 /// * sample period, observer speed scaling f_s·π/2^31 (4.20), angle lead k (4.23);
 /// * current ADC: Q1.15 codes around [`CURRENT_OFFSET`] at `CURRENT_PER_LSB`
 ///   (full scale margin·√2·I_peak, (4.16)), three phases; DC link at `DC_LINK_PER_LSB`;
+///   for a design on a board, the board's offset code, amperes per code, phases and DC-link
+///   scale, as the image's `config::PARAMETERS` takes them;
 /// * observer gains K̃_p, K̃_i (4.22) as the Q1.31 integers, error form;
 /// * n_p, n_r, θ_off (4.5) (θ_off = 0 when the spec gives none);
 /// * PI gains, back-calculation, active damping and prefilter per axis;
 /// * feed-forward L_d, L_q, ψ_M (5.3) (ψ_M = 0 when unknown);
-/// * U_dc,min (5.1), PWM auto-reload at [`TIMER_CLOCK_HZ`] (`u16::MAX` where f_s is
-///   too low for the 16-bit register: the firmware build refuses such an f_s, the
-///   simulation only reports compare values with it).
+/// * U_dc,min (5.1), the design's PWM auto-reload (`drive.pwm_period`: TIM1's clock
+///   `codegen::firmware::TIMER_CLOCK_HZ`/(2·f_s); a design never has an f_s the 16-bit
+///   register cannot hold, `check` refuses it). Only the telemetry compare values use
+///   it; the simulated inverter applies the duties.
 pub fn controller_parameters(d: &Design) -> ControllerParameters {
     let cl = &d.current_loop;
     let o = &d.angle_observer;
     let s = &d.scaling;
-    let fs = d.drive.switching_frequency_hz as f32;
+    // On a board, its sensing (the firmware's `config::PARAMETERS`); else the design's
+    // full scales.
+    let (current_offset_code, current_per_lsb, current_phases, dc_link_per_lsb) = match &d.board {
+        Some(b) => (
+            b.current_offset_code,
+            b.amps_per_lsb as f32,
+            b.current_phases,
+            b.dc_link_volts_per_lsb as f32,
+        ),
+        None => (
+            CURRENT_OFFSET,
+            s.phase_current.si_per_lsb as f32,
+            3,
+            s.dc_link_voltage.si_per_lsb as f32,
+        ),
+    };
     ControllerParameters {
         sample_period: d.drive.sample_period_s as f32,
         speed_per_lsb: s.speed.si_per_lsb as f32,
-        current_offset_code: CURRENT_OFFSET,
-        current_per_lsb: s.phase_current.si_per_lsb as f32,
-        current_phases: 3,
-        dc_link_per_lsb: s.dc_link_voltage.si_per_lsb as f32,
+        current_offset_code,
+        current_per_lsb,
+        current_phases,
+        dc_link_per_lsb,
         observer_kp_q31: o.gains.kp_q31,
         observer_ki_q31: o.gains.ki_q31,
         observer_error_form: o.error_form,
@@ -70,7 +80,7 @@ pub fn controller_parameters(d: &Design) -> ControllerParameters {
         lq: cl.feedforward.q_inductance_h as f32,
         psi_m: cl.feedforward.flux_linkage_wb.unwrap_or(0.0) as f32,
         dc_link_min: d.drive.dc_link_voltage_min_v as f32,
-        pwm_period: centre_aligned_period(TIMER_CLOCK_HZ, fs).unwrap_or(u16::MAX),
+        pwm_period: d.drive.pwm_period,
     }
 }
 

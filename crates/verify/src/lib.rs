@@ -188,10 +188,14 @@ impl Verification {
     }
 }
 
-/// `x` with 4 significant digits and its unit.
+/// `x` with 4 significant digits and its unit (in scientific notation from 10⁷ on, where
+/// a simulation running away would otherwise print hundreds of digits); a value that is
+/// not finite (a simulation that diverged) is "diverged", never NaN or inf.
 pub fn format_value(x: f64, unit: &str) -> String {
     let s = if !x.is_finite() {
-        format!("{x}")
+        return "diverged".into();
+    } else if x.abs() >= 1e7 {
+        format!("{x:.3e}")
     } else if x == 0.0 {
         "0".into()
     } else {
@@ -345,8 +349,61 @@ pub fn verify(setup: &Setup<'_>) -> Verification {
         motor: setup.design.name.clone(),
         spec_file: setup.design.spec_file.clone(),
         plant_model: setup.plant_model(),
-        scenarios: Scenario::applicable(setup).iter().map(|s| (s.run)(setup)).collect(),
+        scenarios: Scenario::applicable(setup)
+            .iter()
+            .map(|s| diverged_fails((s.run)(setup)))
+            .collect(),
     }
+}
+
+/// What a simulation that diverged is: a failed scenario with its reason, never a NaN or
+/// an infinity shown as a figure. Every check whose measured or designed value is not
+/// finite fails, and a check "simulation stays finite" is added, counting the non-finite
+/// figures and trace samples (which the table shows as "diverged", [`format_value`]).
+pub fn diverged_fails(mut r: ScenarioResult) -> ScenarioResult {
+    let mut bad = 0usize;
+    for c in &mut r.checks {
+        let finite = c.measured.is_finite() && c.designed.is_none_or(f64::is_finite);
+        if !finite {
+            c.pass = false;
+            bad += 1;
+        }
+    }
+    let samples = r
+        .traces
+        .iter()
+        .flat_map(|t| t.series.iter().flat_map(|s| &s.values).chain(&t.t_ms))
+        .filter(|x| !x.is_finite())
+        .count();
+    if bad + samples > 0 {
+        r.checks.push(Check {
+            quantity: "simulation stays finite".into(),
+            measured: (bad + samples) as f64,
+            designed: Some(0.0),
+            unit: "values",
+            criterion: format!(
+                "every figure and signal finite: the simulation diverged ({bad} figures, {samples} samples not finite)"
+            ),
+            pass: false,
+        });
+    }
+    r
+}
+
+/// Parses and designs `text` (named `file` in messages) on the board `board_text`
+/// (`codegen::design_with_board`: refused where the motor does not fit the board), then
+/// verifies the design with the board's current and DC-link sensing.
+pub fn verify_source_on(
+    file: &str,
+    text: &str,
+    board_file: &str,
+    board_text: &str,
+) -> Result<(Design, Verification), Diagnostics> {
+    let source = Source { file, text };
+    let spec = codegen::spec::parse(source)?;
+    let design = codegen::design_with_board(file, text, board_file, board_text)?;
+    let v = verify(&Setup::new(&spec, &design));
+    Ok((design, v))
 }
 
 /// Parses and designs `text` (named `file` in messages), then verifies the design.

@@ -5,8 +5,10 @@
 //!   of (5.14)–(5.16)) when the design compensates the delay, within 5 % of the design's
 //!   sampled-loop prediction always, overshoot within the design's floor (designed + 2 %,
 //!   `design::current_loop::analysis`).
-//! * [`decoupling`] — i_q step at speed with and without the feed-forward (5.3): the
-//!   i_d excursion must shrink at least 3× (thesis A Figs. 5.4 vs 5.6).
+//! * [`decoupling()`] — i_q step at speed with and without the feed-forward (5.3): the
+//!   i_d excursion must shrink at least 3× (thesis A Figs. 5.4 vs 5.6); its operating
+//!   point and criterion are the design's (`codegen::design::current_loop::decoupling`),
+//!   whose bandwidth search judges the same figure on a model of the loop.
 //! * [`dc_link_step`] — U_dc drops 20 % at speed under load; the 1/U_dc feed-forward
 //!   (5.1) must limit the current error to the one-period kick (criterion below).
 //!
@@ -18,6 +20,9 @@ use super::figures::{designed_rise_time, designed_step};
 use super::{Check, ScenarioResult, Series, Setup, Trace, format_value};
 use codegen::design::Design;
 use codegen::design::current_loop::analysis::{OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
+use codegen::design::current_loop::at_speed::{
+    self as decoupling, KICK_ALLOWANCE, MIN_DECOUPLING_RATIO, SETTLED_SHARE,
+};
 use codegen::spec::Method;
 use motor_sim::bench::Bench;
 use motor_sim::figures::step_figures;
@@ -85,36 +90,41 @@ pub(super) fn samples(s: &Setup<'_>, seconds: f64) -> usize {
 
 /// Current step height \[A\]: a quarter of the current-circle radius √2·I_peak, kept so
 /// that the proportional kick k_p·Δi stays within half the voltage circle (so the
-/// linear design is what is measured, not the voltage limit).
+/// linear design is what is measured, not the voltage limit) — the design's
+/// `current_loop::decoupling::step_amplitude`, which its bandwidth search judges with.
 pub fn step_amplitude(s: &Setup<'_>) -> f64 {
     let d = s.design;
     let kp = d.current_loop.d.kp.max(d.current_loop.q.kp);
-    (0.25 * d.motor.peak_current_a).min(0.5 * d.current_loop.voltage_limit_v / kp)
+    decoupling::step_amplitude(d.motor.peak_current_a, kp, d.current_loop.voltage_limit_v)
 }
 
-/// Slowest pole [rad/s] of the current loop's response to a voltage disturbance: IMC
-/// cancels the plant pole R/L, which then governs disturbances; active damping moves it
-/// to α (thesis B (2.43)); pole placement puts both poles at ω_n with real part ζω_n.
+/// Slowest pole [rad/s] of the current loop's response to a voltage disturbance
+/// (`codegen::design::current_loop::at_speed::disturbance_pole`): R/L for IMC, α for
+/// active damping, ζω_n for pole placement.
 pub fn disturbance_pole(s: &Setup<'_>) -> f64 {
     let d = s.design;
     let cl = &d.current_loop;
-    match cl.method {
-        Method::Imc => d.motor.phase_resistance_ohm / d.motor.d_inductance_h.max(d.motor.q_inductance_h),
-        Method::ImcActiveDamping => cl.bandwidth_rad_s,
-        Method::PolePlacement => cl.damping.unwrap_or(1.0) * cl.natural_frequency_rad_s.unwrap_or(cl.bandwidth_rad_s),
-    }
+    decoupling::disturbance_pole(
+        cl.method,
+        d.motor.phase_resistance_ohm,
+        d.motor.d_inductance_h.max(d.motor.q_inductance_h),
+        cl.bandwidth_rad_s,
+        cl.damping.unwrap_or(1.0),
+        cl.natural_frequency_rad_s.unwrap_or(cl.bandwidth_rad_s),
+    )
 }
 
 /// Electrical speed [rad/s] of the at-speed scenarios: the back EMF ω_e·ψ_M at half the
 /// voltage circle, the coupling ω_e·L_q·Δi at most 30 % of it, not above ω_e,max.
 pub fn operating_speed(s: &Setup<'_>) -> f64 {
     let d = s.design;
-    let v = d.current_loop.voltage_limit_v;
-    let mut w = d.motor.max_electrical_speed_rad_s;
-    if let Some(psi) = d.motor.flux_linkage_wb.filter(|p| *p > 0.0) {
-        w = w.min(0.5 * v / psi);
-    }
-    w.min(0.3 * v / (d.motor.q_inductance_h * step_amplitude(s)))
+    decoupling::operating_speed(
+        d.motor.max_electrical_speed_rad_s,
+        d.motor.flux_linkage_wb,
+        d.motor.q_inductance_h,
+        step_amplitude(s),
+        d.current_loop.voltage_limit_v,
+    )
 }
 
 fn current(id: f64, iq: f64, feed_forward: bool) -> Demand {
@@ -304,7 +314,7 @@ pub fn decoupling(s: &Setup<'_>) -> ScenarioResult {
     let a = step_amplitude(s);
     let we = operating_speed(s);
     let wm = we / f64::from(d.motor.pole_pairs);
-    let n = samples(s, 10.0 / d.current_loop.bandwidth_rad_s);
+    let n = samples(s, decoupling::STEP_SPANS / d.current_loop.bandwidth_rad_s);
     let mut excursion = [0.0; 2];
     let mut traces_i = Vec::new();
     let mut t0 = Vec::new();
@@ -318,7 +328,13 @@ pub fn decoupling(s: &Setup<'_>) -> ScenarioResult {
             let psi = d.motor.flux_linkage_wb.unwrap_or(0.0);
             b.state.current.q.integral = (we * psi / d.current_loop.q.ki) as f32;
         }
-        let (t, i) = run(&mut b, 20, current(0.0, 0.0, ff), n, current(0.0, a, ff));
+        let (t, i) = run(
+            &mut b,
+            decoupling::SETTLE_PERIODS,
+            current(0.0, 0.0, ff),
+            n,
+            current(0.0, a, ff),
+        );
         excursion[usize::from(ff)] = i.iter().map(|x| x[0].abs()).fold(0.0, f64::max);
         traces_i.push(i);
         t0 = t.iter().map(|x| x - t[0]).collect();
@@ -335,7 +351,10 @@ pub fn decoupling(s: &Setup<'_>) -> ScenarioResult {
             None,
             "×",
         )
-        .criterion("≥ 3× smaller with decoupling (thesis A Figs. 5.4 vs 5.6)", ratio >= 3.0),
+        .criterion(
+            format!("≥ {MIN_DECOUPLING_RATIO}× smaller with decoupling (thesis A Figs. 5.4 vs 5.6)"),
+            ratio >= MIN_DECOUPLING_RATIO,
+        ),
     ];
     let col = |k: usize, j: usize| traces_i[k].iter().map(|x| x[j]).collect::<Vec<_>>();
     let traces = vec![trace(
@@ -366,8 +385,9 @@ pub fn decoupling(s: &Setup<'_>) -> ScenarioResult {
     }
 }
 
-/// Relative DC-link rise of [`dc_link_step`] when the design compensates no drop.
-pub const DC_LINK_RISE: f64 = 0.2;
+/// Relative DC-link rise of [`dc_link_step`] when the design compensates no drop (the
+/// design's `at_speed::DC_LINK_RISE`).
+pub const DC_LINK_RISE: f64 = decoupling::DC_LINK_RISE;
 
 /// DC-link step at speed with i_q at the step amplitude: down to U_dc,min, the lowest
 /// voltage the 1/U_dc feed-forward compensates (thesis A §5.1: 600 V → 432 V, the
@@ -394,10 +414,11 @@ pub fn dc_link_step(s: &Setup<'_>) -> ScenarioResult {
     let wm = we / f64::from(m.pole_pairs);
     let u0 = d.drive.dc_link_voltage_v;
     let u_min = d.drive.dc_link_voltage_min_v;
-    let u1 = if u_min < u0 { u_min } else { u0 * (1.0 + DC_LINK_RISE) };
+    let u1 = decoupling::dc_link_after(u0, u_min);
     let rho = (u1 - u0).abs() / u0;
-    let settle = samples(s, 10.0 / disturbance_pole(s) + 10.0 / d.current_loop.bandwidth_rad_s);
-    let n = samples(s, 10.0 / d.current_loop.bandwidth_rad_s);
+    let spans = decoupling::STEP_SPANS;
+    let settle = samples(s, spans / disturbance_pole(s) + spans / d.current_loop.bandwidth_rad_s);
+    let n = samples(s, spans / d.current_loop.bandwidth_rad_s);
     let pre = n / 2;
     let err = |i: &[f64; 2]| (i[0] * i[0] + (i[1] - a) * (i[1] - a)).sqrt();
     let mut peak = [0.0; 2];
@@ -441,14 +462,18 @@ pub fn dc_link_step(s: &Setup<'_>) -> ScenarioResult {
         )
         .criterion(
             format!(
-                "≤ 2·Δi_1 + ripple before the step ({}) — one-period kick of the 1/U_dc feed-forward (5.1)",
+                "≤ {KICK_ALLOWANCE}·Δi_1 + ripple before the step ({}) — one-period kick of the 1/U_dc feed-forward (5.1)",
                 format_value(ripple, "A")
             ),
-            peak[0] <= 2.0 * kick + ripple,
+            peak[0] <= KICK_ALLOWANCE * kick + ripple,
         ),
         check("|i − i_ref| after 10/α", last, Some(0.0), "A").criterion(
-            format!("≤ 1 % of i_q + ripple ({})", format_value(0.01 * a + ripple, "A")),
-            last <= 0.01 * a + ripple,
+            format!(
+                "≤ {} % of i_q + ripple ({})",
+                SETTLED_SHARE * 100.0,
+                format_value(SETTLED_SHARE * a + ripple, "A")
+            ),
+            last <= SETTLED_SHARE * a + ripple,
         ),
     ];
     let traces = vec![trace(

@@ -60,20 +60,25 @@ impl RxFrame {
     }
 }
 
-/// FDCAN_NBTP for the nominal bit timing: prescaler `f_clk/(bitrate·tq_per_bit)`
-/// (must divide exactly), TSEG1 = tq_per_bit − 1 − TSEG2, SJW = TSEG2
-/// (RM0440 §44.4.9: each field holds value − 1). `None` if the clock does not divide.
-pub const fn nominal_bit_timing(clock_hz: u32, bitrate: u32, tq_per_bit: u32, tseg2: u32) -> Option<u32> {
-    let per_bit = bitrate as u64 * tq_per_bit as u64;
-    if per_bit == 0 || !(clock_hz as u64).is_multiple_of(per_bit) || tseg2 == 0 || tq_per_bit < tseg2 + 3 {
+/// The bit rate \[bit/s\] FDCAN_NBTP `nbtp` makes from a `clock_hz` kernel clock, or
+/// `None` if its fields are out of range or the rate is not a whole number: prescaler
+/// NBRP + 1 (1 … 512), bit 1 + (NTSEG1 + 1) + (NTSEG2 + 1) quanta with NTSEG1 ≥ 1 (RM0440
+/// §44.4.9: NTSEG1 1 … 255, NTSEG2 0 … 127), SJW ≤ TSEG2. The generated `board::CAN_NBTP`
+/// is computed by the code generator for the board's bit rate (`motorgen check` refuses a
+/// rate the clock cannot make); the image checks it again with this at compile time.
+pub const fn nbtp_bit_rate(clock_hz: u32, nbtp: u32) -> Option<u32> {
+    let sjw = (nbtp >> 25) + 1;
+    let brp = ((nbtp >> 16) & 0x1FF) + 1;
+    let tseg1 = ((nbtp >> 8) & 0xFF) + 1;
+    let tseg2 = (nbtp & 0x7F) + 1;
+    if nbtp & 0x80 != 0 || tseg1 < 2 || sjw > tseg2 {
         return None;
     }
-    let brp = (clock_hz as u64 / per_bit) as u32;
-    let tseg1 = tq_per_bit - 1 - tseg2;
-    if brp > 512 || tseg1 > 256 || tseg2 > 128 {
+    let per_bit = brp * (1 + tseg1 + tseg2);
+    if !clock_hz.is_multiple_of(per_bit) {
         return None;
     }
-    Some(((tseg2 - 1) << 25) | ((brp - 1) << 16) | ((tseg1 - 1) << 8) | (tseg2 - 1))
+    Some(clock_hz / per_bit)
 }
 
 #[cfg(test)]
@@ -105,13 +110,24 @@ mod tests {
         assert_eq!(ext.len, 8);
     }
 
-    /// 170 MHz, 500 kbit/s, 20 tq: prescaler 17, TSEG1 15, TSEG2 4, SJW 4 →
-    /// (3 << 25) | (16 << 16) | (14 << 8) | 3 = 0x0610_0E03 (hand calculation).
+    /// NBTP 0x2801_9314 (codegen's 500 kbit/s at 170 MHz): NSJW 20, NBRP 1, NTSEG1 147,
+    /// NTSEG2 20 → prescaler 2, 1 + 148 + 21 = 170 quanta → 170 MHz/340 = 500 000 bit/s
+    /// (hand calculation); the old fixed timing 0x0610_0E03 (prescaler 17, 1 + 15 + 4) →
+    /// 170 MHz/340 = 500 000 too; NTSEG2 bit 7 set, a 0-quantum TSEG1 or SJW > TSEG2 → None;
+    /// 170 MHz does not divide by 3·(1 + 15 + 4) = 60 → None.
     #[test]
     fn bit_timing() {
-        assert_eq!(nominal_bit_timing(170_000_000, 500_000, 20, 4), Some(0x0610_0E03));
-        assert_eq!(nominal_bit_timing(170_000_000, 1_000_000, 20, 4), None); // 8.5
-        assert_eq!(nominal_bit_timing(170_000_000, 500_000, 20, 0), None);
+        assert_eq!(nbtp_bit_rate(170_000_000, 0x2801_9314), Some(500_000));
+        assert_eq!(nbtp_bit_rate(170_000_000, 0x0610_0E03), Some(500_000));
+        assert_eq!(nbtp_bit_rate(170_000_000, 0x2801_9394), None);
+        assert_eq!(nbtp_bit_rate(170_000_000, 0x0610_0003), None);
+        assert_eq!(nbtp_bit_rate(170_000_000, 0x0A10_0E03), None);
+        assert_eq!(nbtp_bit_rate(170_000_000, 0x0602_0E03), None);
+        assert_eq!(
+            nbtp_bit_rate(170_000_000, board::CAN_NBTP),
+            Some(board::CAN_BIT_RATE),
+            "the generated timing makes the board's rate"
+        );
     }
 
     /// Fischer: K_t = 3/2·n_p·ψ_M = 6·0.060421 = 0.36252 N·m/A → 10 N·m needs 27.584 A.

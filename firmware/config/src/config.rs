@@ -22,6 +22,14 @@ use crate::timing;
 
 // The board's sampling codes were chosen for the firmware's ADC clock.
 const _: () = assert!(board::ADC_CLOCK_HZ == hw::ADC_CLOCK_HZ);
+// `motorgen check` judged the dead time, the watchdog timeout and the CAN bit timing
+// with these clocks (codegen's `firmware` module): they are the ones this image runs.
+const _: () = assert!(
+    board::TIMER_CLOCK_HZ == hw::TIMER_CLOCK_HZ
+        && board::FDCAN_CLOCK_HZ == hw::FDCAN_CLOCK_HZ
+        && board::LSI_HZ == hw::LSI_HZ,
+    "the generated clocks are the firmware's (board::TIMER_CLOCK_HZ, FDCAN_CLOCK_HZ, LSI_HZ)"
+);
 
 /// TIM1 auto-reload: centre-aligned carrier at f_s from the 170 MHz timer clock
 /// (`motor_control::modulation::centre_aligned_period`; a build error if it does not
@@ -259,12 +267,9 @@ pub const CR2: u32 = registers::cr2(board::TIM1_CR2_IDLE);
 pub const EXCITATION: (usize, u32) = registers::split(board::IO_PINS[1]);
 
 /// IWDG prescaler and reload for the board's watchdog timeout.
-pub const WATCHDOG: (u8, u16) = {
-    let ticks = (board::WATCHDOG_TIMEOUT_S * hw::LSI_HZ as f32) as u32;
-    match timing::iwdg_setting(ticks) {
-        Some(s) => s,
-        None => panic!("watchdog timeout out of range"),
-    }
+pub const WATCHDOG: (u8, u16) = match timing::iwdg_for_timeout(board::WATCHDOG_TIMEOUT_S, hw::LSI_HZ) {
+    Some(s) => s,
+    None => panic!("watchdog timeout out of range"),
 };
 
 /// Trips on the measured values, as codes (see [`crate::adc_frame::Trips`]).

@@ -1,4 +1,4 @@
-//! Facts of the STM32G474 and choices of this firmware (clock tree, bit timing, filter
+//! Facts of the STM32G474 and choices of this firmware (clock tree, filter
 //! codes): the only place in the firmware where numbers that are not generated from the
 //! motor spec or the board file live (`tests/literals.rs` enforces this). None of them is
 //! a motor, tuning or board parameter — those are in `motor::board`, generated from
@@ -19,7 +19,9 @@ pub const ADC_CLOCK_HZ: u32 = SYSCLK_HZ / 4;
 pub const ADC_BITS: u32 = 12;
 /// LSI clock of the independent watchdog \[Hz\] (DS12288 Table 56, typical).
 pub const LSI_HZ: u32 = 32_000;
-/// FDCAN kernel clock \[Hz\]: PCLK1 (RCC_CCIPR.FDCANSEL = 0b10).
+/// FDCAN kernel clock \[Hz\]: PCLK1 (RCC_CCIPR.FDCANSEL = 0b10). The generated
+/// `board::CAN_NBTP` is computed from it (`board::FDCAN_CLOCK_HZ`, checked equal at
+/// compile time).
 pub const FDCAN_CLOCK_HZ: u32 = SYSCLK_HZ;
 
 /// PLL input divider M (HSI16/4 = 4 MHz, within RM0440's 2.66–8 MHz).
@@ -38,10 +40,6 @@ pub const ADC_VREG_STARTUP_US: u32 = 20;
 /// Microseconds per second.
 pub const US_PER_S: u32 = 1_000_000;
 
-/// Time quanta per CAN bit: 1 (sync) + 15 (TSEG1) + 4 (TSEG2), sample point 80 %.
-pub const CAN_TQ_PER_BIT: u32 = 20;
-/// TSEG2 and the resynchronisation jump width \[tq\].
-pub const CAN_TSEG2: u32 = 4;
 /// FDCAN1 message RAM (SRAMCAN) base address (RM0440 §44.3.3).
 pub const FDCAN1_RAM: usize = 0x4000_A400;
 /// Offset of RX FIFO 0 in the message RAM \[bytes\] (fixed layout, RM0440 §44.3.3).

@@ -27,6 +27,7 @@
 //! | [`can_protocol`] | status, command and capture frames as bytes, CRC-32 |
 //! | [`setpoint`] | received setpoint with timeout and ramp to zero |
 //! | [`step`] | the complete control step and its [`step::ControllerConfig`] |
+//! | [`timing`] | TIM1 dead-time and IWDG codes from times (shared with the code generator's checks) |
 //!
 //! Numbers: angles are π-scaled Q1.31 stored integers and wrap; every other integer
 //! quantity saturates; currents and voltages are `f32` (the Cortex-M4F has an FPU).
@@ -67,6 +68,7 @@ pub mod pi;
 pub mod q31;
 pub mod setpoint;
 pub mod step;
+pub mod timing;
 pub mod transforms;
 pub mod trig;
 

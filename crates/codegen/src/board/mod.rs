@@ -28,6 +28,7 @@ use std::ops::Range;
 use serde::Serialize;
 
 use crate::diagnostic::{Diagnostics, Source};
+use crate::firmware;
 use crate::spec::{Param, Provenance, ResolveContext};
 use crate::units::Kind;
 use chip::Chip;
@@ -596,6 +597,12 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
 
     let pw = raw.pwm.get_ref();
     let dead = q(cx, &mut spans, "pwm.dead_time", &pw.dead_time, Kind::Time);
+    // The firmware's limits (`crate::firmware`): what the image's build could not encode.
+    if let Some(d) = &dead
+        && let Err(r) = firmware::dead_time(d.value)
+    {
+        cx.err(d.span.clone(), "pwm.dead_time", r.problem, r.accepted);
+    }
     let pr = raw.protection.get_ref();
     let oc = q(
         cx,
@@ -634,6 +641,11 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
     }
     let c = raw.can.get_ref();
     let bit_rate = q(cx, &mut spans, "can.bit_rate", &c.bit_rate, Kind::BitRate);
+    if let Some(b) = &bit_rate
+        && let Err(r) = firmware::can_bit_rate(firmware::FDCAN_CLOCK_HZ, b.value)
+    {
+        cx.err(b.span.clone(), "can.bit_rate", r.problem, r.accepted);
+    }
     spans.push(("can.setpoint_id".into(), c.setpoint_id.span()));
     let id = cx.integer(
         "can.setpoint_id",
@@ -643,6 +655,11 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         0x7FF - i64::from(FRAMES_AFTER_SETPOINT),
         "a standard (11-bit) identifier 0 … 0x7FA (the drive's status, command and capture frames take the 5 after it), e.g. 0x100",
     );
+    if let Some((i, p)) = &id
+        && let Err(r) = firmware::setpoint_id(*i as u16, FRAMES_AFTER_SETPOINT)
+    {
+        cx.err(p.span.clone(), "can.setpoint_id", r.problem, r.accepted);
+    }
     let period = q(cx, &mut spans, "can.setpoint_period", &c.setpoint_period, Kind::Time);
     let timeout = q(cx, &mut spans, "can.setpoint_timeout", &c.setpoint_timeout, Kind::Time);
     let ramp = q(cx, &mut spans, "can.setpoint_ramp", &c.setpoint_ramp, Kind::Time);
@@ -673,6 +690,11 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         &raw.watchdog.get_ref().timeout,
         Kind::Time,
     );
+    if let Some(w) = &wd
+        && let Err(r) = firmware::watchdog(w.value)
+    {
+        cx.err(w.span.clone(), "watchdog.timeout", r.problem, r.accepted);
+    }
 
     Some(Board {
         file: cx.src.file.to_string(),
@@ -801,6 +823,28 @@ fn pins(cx: &mut ResolveContext<'_>, raw: &RawBoard, chip: &'static Chip) -> Opt
             ok = false;
             continue;
         };
+        // The firmware routes alternate functions on GPIOA … GPIOC only.
+        if let Need::Digital(p, s) = signal.need()
+            && port >= firmware::ROUTED_PORTS
+        {
+            let on_ports: Vec<String> = chip
+                .pins_with(p, s)
+                .into_iter()
+                .filter(|(q, _)| port_and_number(q).is_some_and(|(k, _)| k < firmware::ROUTED_PORTS))
+                .map(|(q, af)| af.map_or(q.to_string(), |af| format!("{q} (AF{af})")))
+                .collect();
+            cx.err(
+                v.span(),
+                &key,
+                format!(
+                    "{pin} is on port {}: the firmware routes its gate, break, excitation and CAN pins on GPIOA … GPIOC only (motor_config::registers::PORTS: clock enables, modes, alternate functions and the fault path's gate writes)",
+                    (b'A' + port) as char
+                ),
+                format!("a pin on port A, B or C with {p}_{s}: {}", on_ports.join(", ")),
+            );
+            ok = false;
+            continue;
+        }
         out.push(PinUse {
             signal,
             pin,

@@ -95,6 +95,39 @@ impl<'a> OnBoard<'a> {
             json: Json::None,
         },
         Decl {
+            name: "TIMER_CLOCK_HZ",
+            value: Custom(|_| {
+                let f = crate::firmware::TIMER_CLOCK_HZ;
+                (intv(f.into(), "u32", "uint32_t"), phys(f64::from(f), "Hz"))
+            }),
+            formula: Lit("TIM1 kernel clock the dead-time and auto-reload limits were checked with: SYSCLK, APB2 ×1"),
+            equation: Lit("RM0440 §7.2.17; DS12288 §3.9"),
+            inputs: Lit("the firmware's clock tree"),
+            json: Json::None,
+        },
+        Decl {
+            name: "FDCAN_CLOCK_HZ",
+            value: Custom(|c| {
+                let f = c.o.can_timing.kernel_clock_hz;
+                (intv(f.into(), "u32", "uint32_t"), phys(f64::from(f), "Hz"))
+            }),
+            formula: Lit("FDCAN kernel clock the bit timing is computed from: PCLK1 (RCC_CCIPR.FDCANSEL = 0b10)"),
+            equation: Lit("RM0440 §7.4.26"),
+            inputs: Lit("the firmware's clock tree"),
+            json: Json::None,
+        },
+        Decl {
+            name: "LSI_HZ",
+            value: Custom(|_| {
+                let f = crate::firmware::LSI_HZ;
+                (intv(f.into(), "u32", "uint32_t"), phys(f64::from(f), "Hz"))
+            }),
+            formula: Lit("LSI clock the watchdog-timeout limit was checked with (typical)"),
+            equation: Lit("DS12288 Table 56"),
+            inputs: Lit("the chip"),
+            json: Json::None,
+        },
+        Decl {
             name: "CURRENT_OFFSET_CODE",
             value: Custom(|c| {
                 let physical = format!("{} V at 0 A", c.b.current.offset_v);
@@ -267,26 +300,38 @@ impl<'a> OnBoard<'a> {
         },
         Decl {
             name: "OVER_CURRENT_A",
-            value: F32(|c| c.b.over_current_a, "A"),
-            formula: Lit("trip when any |i_phase| exceeds it"),
-            equation: Lit("—"),
-            inputs: Of(|c| c.key("protection.over_current")),
-            json: Json::At("/board/board/over_current_a"),
+            value: F32(|c| c.o.trips.over_current_a.value, "A"),
+            formula: Lit(
+                "trip when any |i_phase| exceeds min(margin·√2·I_peak (the motor's full scale), protection.over_current (the board's ceiling))",
+            ),
+            equation: Lit("thesis A Table 4.1"),
+            inputs: Of(|c| c.trip(&c.o.trips.over_current_a, "A", 1.0)),
+            json: Json::At("/board/trips/over_current_a/value"),
         },
         Decl {
             name: "OVER_VOLTAGE_V",
-            value: F32(|c| c.b.over_voltage_v, "V"),
-            formula: Lit("trip when U_dc exceeds it"),
-            equation: Lit("—"),
-            inputs: Of(|c| c.key("protection.over_voltage")),
-            json: Json::At("/board/board/over_voltage_v"),
+            value: F32(|c| c.o.trips.over_voltage_v.value, "V"),
+            formula: Lit(
+                "trip when U_dc exceeds min(margin·U_dc (the motor's full scale), protection.over_voltage (the board's ceiling))",
+            ),
+            equation: Lit("thesis A Table 4.1"),
+            inputs: Of(|c| c.trip(&c.o.trips.over_voltage_v, "V", 1.0)),
+            json: Json::At("/board/trips/over_voltage_v/value"),
         },
         Decl {
             name: "OVER_SPEED_E_RAD_S",
             value: F32(|c| c.o.over_speed_electrical_rad_s, "rad/s"),
-            formula: Lit("n_p·ω_m,trip: trip when |ω_e| exceeds it"),
+            formula: Lit(
+                "n_p·min(margin·n_max (the motor's), protection.over_speed (the board's ceiling)): trip when |ω_e| exceeds it",
+            ),
             equation: Lit("thesis A (2.19)"),
-            inputs: Of(|c| format!("{}, n_p = {}", c.key("protection.over_speed"), c.d.motor.pole_pairs)),
+            inputs: Of(|c| {
+                format!(
+                    "{}; n_p = {}",
+                    c.trip(&c.o.trips.over_speed_rad_s, "rpm", 30.0 / std::f64::consts::PI),
+                    c.d.motor.pole_pairs
+                )
+            }),
             json: Json::At("/board/over_speed_electrical_rad_s"),
         },
         Decl {
@@ -299,6 +344,35 @@ impl<'a> OnBoard<'a> {
             equation: Lit("RM0440 §44.4.9"),
             inputs: Of(|c| c.key("can.bit_rate")),
             json: Json::At("/board/can_bit_rate"),
+        },
+        Decl {
+            name: "CAN_NBTP",
+            value: Custom(|c| {
+                let t = &c.o.can_timing;
+                let physical = format!(
+                    "{:#010x}: prescaler {}, {} quanta = 1 + {} + {}, sample point {:.2} %, SJW {}",
+                    t.nbtp,
+                    t.prescaler,
+                    t.tq_per_bit,
+                    t.tseg1,
+                    t.tseg2,
+                    t.sample_point * 100.0,
+                    t.sjw
+                );
+                (intv(t.nbtp.into(), "u32", "uint32_t"), physical)
+            }),
+            formula: Lit(
+                "f_FDCAN = rate·prescaler·(1 + TSEG1 + TSEG2), sample point nearest 87.5 %, smallest prescaler, SJW = TSEG2; fields value − 1",
+            ),
+            equation: Lit("RM0440 §44.4.9 (FDCAN_NBTP); CiA 601-3"),
+            inputs: Of(|c| {
+                format!(
+                    "{}, FDCAN kernel clock {} Hz",
+                    c.key("can.bit_rate"),
+                    c.o.can_timing.kernel_clock_hz
+                )
+            }),
+            json: Json::At("/board/can_timing/nbtp"),
         },
         Decl {
             name: "SETPOINT_ID",
@@ -360,6 +434,11 @@ impl<'a> OnBoard<'a> {
             json: Json::At("/board/conversion_time_s"),
         },
     ];
+
+    /// A trip's inputs: which limit set it and the other one.
+    fn trip(&self, t: &crate::design::Trip, unit: &str, scale: f64) -> String {
+        format!("{}, {}", t.describe(unit, scale), self.b.file)
+    }
 
     /// The board file's key `k` as an input: `pins.gate_* (boards/x.toml)`.
     fn key(&self, k: &str) -> String {

@@ -21,8 +21,9 @@ use crate::board::Board;
 use crate::design::Design;
 
 /// Standard identifier of the fault report, a choice of the firmware: low (high
-/// priority on the bus), below the drive's other frames on the seed boards.
-pub const FAULT_REPORT_ID: u16 = 0x0E0;
+/// priority on the bus), below the drive's other frames on the seed boards; a board's
+/// setpoint identifier keeps its frames off it (`crate::firmware::setpoint_id`).
+pub use crate::firmware::FAULT_REPORT_ID;
 
 /// The fault report's current unit \[A per LSB\].
 pub const FAULT_CURRENT_PER_LSB: f64 = 0.1;

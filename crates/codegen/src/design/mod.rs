@@ -35,7 +35,7 @@ use crate::spec::Spec;
 use sections::Context;
 pub use sections::adc::AdcOut;
 pub use sections::angle_observer::ObserverOut;
-pub use sections::board::BoardOut;
+pub use sections::board::{BoardOut, Trip, TripSource, Trips};
 pub use sections::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
 pub use sections::drive::DriveOut;
 pub use sections::motor::{MotorOut, Origin};
@@ -94,16 +94,27 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         errors: Vec::new(),
         warnings: Vec::new(),
     };
+    // The motor values against each other and the drive first: a value off by a unit
+    // prefix is refused at its key before it makes the sections below fail confusingly.
+    sections::plausibility::plausibility(&mut cx);
+    if !cx.errors.is_empty() {
+        return Err(failed(cx));
+    }
     let drive = sections::drive::drive(&mut cx);
+    let errors_before = cx.errors.len();
     let current_loop = sections::current_loop::current_loop(&mut cx);
+    // A refused current loop (unstable, below its floors) has no ramp lag worth judging
+    // the field weakening with: its rule would only add an error of nonsense numbers.
+    let loop_refused = cx.errors.len() > errors_before;
     let angle_observer = sections::angle_observer::angle_observer(&mut cx);
     let fir = sections::fir::fir(&mut cx);
     let adc = sections::adc::adc(&mut cx);
-    let field_weakening = sections::field_weakening::field_weakening(&mut cx, current_loop.as_ref());
+    let field_weakening =
+        sections::field_weakening::field_weakening(&mut cx, current_loop.as_ref().filter(|_| !loop_refused));
     let (true, Some(current_loop), Some(angle_observer), Some(fir)) =
         (cx.errors.is_empty(), current_loop, angle_observer, fir)
     else {
-        return Err(Diagnostics(cx.errors));
+        return Err(failed(cx));
     };
     let motor = sections::motor::motor(&mut cx, current_loop.hot.as_ref().map(|h| h.phase_resistance_ohm));
     let per_unit = sections::per_unit::per_unit(spec);
@@ -112,7 +123,10 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
             cx.warnings.extend(notes);
             out
         }
-        Err(e) => return Err(Diagnostics(vec![*e])),
+        Err(e) => {
+            cx.errors.push(*e);
+            return Err(failed(cx));
+        }
     };
     let design = Design {
         schema_version: SCHEMA_VERSION,
@@ -136,12 +150,25 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
     Ok(design)
 }
 
+/// The errors of a design that fails, the first carrying the spec's cross-checks that
+/// disagree as notes (a design that succeeds has them as warnings): a wrong value often
+/// shows in a cross-check before it breaks a rule.
+fn failed(cx: Context<'_>) -> Diagnostics {
+    let notes = sections::plausibility::cross_check_notes(&cx);
+    let mut errors = cx.errors;
+    if let Some(first) = errors.first_mut() {
+        first.notes.extend(notes);
+    }
+    Diagnostics(errors)
+}
+
 /// The motor's `design` on `board` (read from `board_src`): the board section (the
-/// board's constants with this motor, and the checks that need both, as warnings at the
-/// board key, see `sections::board`), added to the design with its warnings; an error
-/// if a board value comes out non-finite with this motor.
+/// board's constants with this motor and the trips the image uses, see `sections::board`),
+/// added to the design with its warnings; errors at the board keys where the motor does
+/// not fit the board (current and DC-link sensing, power-stage ceilings, over-speed), or
+/// where a board value comes out non-finite with this motor.
 pub fn on_board(mut design: Design, board: &Board, board_src: Source<'_>) -> Result<Design, Diagnostics> {
-    let (out, warnings) = sections::board::board(board, board_src.text, &design);
+    let (out, warnings) = sections::board::board(board, board_src, &design).map_err(Diagnostics)?;
     if let Some((path, x)) = finite::first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&out))) {
         return Err(board_src
             .error(

@@ -263,9 +263,13 @@ pub fn iq_limit_resetting(rho: f64, psi: f64, gamma0: f64, speed_max: f64, delta
 /// link, Appendix A).
 pub const MAX_INJECTION_SHARE: f64 = 0.2;
 
-/// The design, with the warnings it raises. ρ above α_c/10 is not checked here
-/// (the caller reports it at the spec key that set it).
-pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
+/// A warning of the design and the spec key it is about (`sensorless.<key>`, or
+/// `sensorless` for the section, or `motor.peak_current` for the peak current).
+pub type Note = (&'static str, String);
+
+/// The design, with the warnings it raises, each with its key. ρ above α_c/10 is not
+/// checked here (the caller reports it at the spec key that set it).
+pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<Note>) {
     let c = &inp.choices;
     let mut warnings = Vec::new();
     let rho_max = inp.current_bandwidth / 10.0;
@@ -309,42 +313,45 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
         })
     };
     if let Some(why @ (NoInjection::SaliencyTooSmall { .. } | NoInjection::SwitchingTooSlow { .. })) = &no_injection {
-        warnings.push(format!(
-            "sensorless: no signal injection by default: {why}; set sensorless.injection_frequency (and \
+        warnings.push((
+            "sensorless.injection_frequency",
+            format!(
+                "sensorless: no signal injection by default: {why}; set sensorless.injection_frequency (and \
              injection_voltage) to inject below 5α_c (thesis B §4.3.5)"
+            ),
         ));
     }
     let injection = no_injection.is_none().then(|| {
         let we = c.injection_frequency.unwrap_or(we_default);
         if we < lo || we > hi {
-            warnings.push(format!(
+            warnings.push(("sensorless.injection_frequency", format!(
                 "sensorless: carrier ω_e = {we:.0} rad/s is outside 5α_c = {lo:.0} … ω_sw/10 = {hi:.0} rad/s \
                  (thesis B (4.34)); below 5α_c use the reference currents in the decoupling terms (thesis B §4.3.5)"
-            ));
+            )));
         }
         let v_min = injection_voltage_min(inp.current_base, we, inp.ld, inp.lq);
         let ve = c.injection_voltage.unwrap_or(v_min);
         if ve < v_min {
-            warnings.push(format!(
+            warnings.push(("sensorless.injection_voltage", format!(
                 "sensorless: carrier amplitude V_e = {ve:.2} V is below I_base·ω_e·L_d·L_q/(10·|ΔL|) = {v_min:.2} V \
                  (thesis B (4.35)): the carrier current stays under 5 % of I_base"
-            ));
+            )));
         }
         if ve > MAX_INJECTION_SHARE * inp.voltage_max * (1.0 + 1e-9) {
-            warnings.push(format!(
+            warnings.push(("sensorless.injection_voltage", format!(
                 "sensorless: the carrier takes V_e = {ve:.1} V = {:.0} % of V_max (thesis B §4.3.1 allows {:.0} %): \
                  less voltage is left for the fundamental currents",
                 100.0 * ve / inp.voltage_max,
                 100.0 * MAX_INJECTION_SHARE
-            ));
+            )));
         }
         let lowpass = c.lowpass.unwrap_or(5.0 * rho);
         if lowpass < 5.0 * rho * (1.0 - 1e-9) || lowpass > 10.0 * rho * (1.0 + 1e-9) {
-            warnings.push(format!(
+            warnings.push(("sensorless.lowpass", format!(
                 "sensorless: low-pass ω_lp = {lowpass:.1} rad/s is outside 5ρ … 10ρ = {:.1} … {:.1} rad/s (thesis B Table 4.1)",
                 5.0 * rho,
                 10.0 * rho
-            ));
+            )));
         }
         // Thesis B §4.5.1: ω_hp = 0.015 pu; "a few Hertz" (§4.3) without a per-unit base.
         let highpass = c
@@ -383,29 +390,35 @@ pub fn design(inp: &Inputs) -> (SensorlessOut, Vec<String>) {
     );
     let ls = w1.max(w2);
     if !salient {
-        warnings.push(format!(
-            "sensorless: L_q = L_d, no saliency for signal injection (thesis B (4.17)): the estimator has no \
+        warnings.push((
+            "sensorless",
+            format!(
+                "sensorless: L_q = L_d, no saliency for signal injection (thesis B (4.17)): the estimator has no \
              position information below ω_ls = {ls:.1} rad/s"
+            ),
         ));
     }
     let bifurcation = salient.then(|| iq_limit_bifurcation(inp.psi, delta_l));
     if let Some(b) = bifurcation
         && inp.current_max > b
     {
-        warnings.push(format!(
-            "sensorless: the peak current {:.1} A exceeds ψ_m/|ΔL| = {b:.1} A (thesis B (4.66)): above it the \
+        warnings.push((
+            "motor.peak_current",
+            format!(
+                "sensorless: the peak current {:.1} A exceeds ψ_m/|ΔL| = {b:.1} A (thesis B (4.66)): above it the \
              back-EMF estimator has unwanted equilibria; limit |i_q| in sensorless operation",
-            inp.current_max
+                inp.current_max
+            ),
         ));
     }
     if delta_l < 0.0 && inp.current_max >= inp.psi / -delta_l {
-        warnings.push(format!(
+        warnings.push(("sensorless", format!(
             "sensorless: inverse saliency (L_d > L_q): ψ_m − ΔL·i_d in the back-EMF error (thesis B (4.51)) vanishes \
              at i_d = ψ_m/ΔL = {:.1} A, inside the current circle (−I_max = {:.1} A): the error is singular if field \
              weakening drives i_d there (thesis B derives (4.51) for ΔL > 0, where i_d < 0 only strengthens the term)",
             inp.psi / delta_l,
             -inp.current_max
-        ));
+        )));
     }
     let out = SensorlessOut {
         rho_rad_s: rho,
@@ -573,14 +586,14 @@ mod tests {
         assert_eq!((out.resetting_lower_rad_s, out.resetting_upper_rad_s), (147.0, 294.0));
         let inj = out.injection.as_ref().unwrap();
         // 500 Hz is below 5α_c = 7350 rad/s: warned (4.34).
-        assert!(warnings.iter().any(|w| w.contains("(4.34)")));
+        assert!(warnings.iter().any(|(_, w)| w.contains("(4.34)")));
         assert_eq!(inj.voltage_v, inj.voltage_min_v);
         assert_eq!(inj.lowpass_rad_s, 5.0 * 147.0);
         assert!((inj.highpass_rad_s - 0.015 * w_base()).abs() < 1e-12);
         // K_e (4.19) with V_e at its minimum (4.35): I_base/40 exactly.
         assert!((inj.gain_ke_a - i_base() / 40.0).abs() < 1e-9);
         // The peak current 1.4 pu is above ψ/ΔL = 1.393 pu: warned (4.66).
-        assert!(warnings.iter().any(|w| w.contains("(4.66)")));
+        assert!(warnings.iter().any(|(_, w)| w.contains("(4.66)")));
         // (4.92) with γ0 = ρ: ρ·ψ/(ω_max·ΔL).
         let lim = out.iq_limit_resetting_a.unwrap();
         assert!((lim - 147.0 * PSI / (2.0 * w_base() * (LQ - LD))).abs() < 1e-9);
@@ -593,10 +606,11 @@ mod tests {
     fn no_default_carrier_when_4_34_and_4_35_cannot_both_hold() {
         let (out, warnings) = design(&chalmers(choices()));
         assert!(out.injection.is_none());
-        let w = warnings
+        let (key, w) = warnings
             .iter()
-            .find(|w| w.contains("no signal injection by default"))
+            .find(|(_, w)| w.contains("no signal injection by default"))
             .unwrap();
+        assert_eq!(*key, "sensorless.injection_frequency");
         assert!(w.contains("4184"), "{w}");
         // A faster switching frequency does not help; a slower current loop does:
         // α_c = 800 rad/s → 5α_c = 4000 rad/s ≤ 4184 rad/s, so ω_e = 4184 rad/s.
@@ -642,7 +656,7 @@ mod tests {
         assert!((out.omega_min2_rad_s - 47.890).abs() < 1e-3, "{}", out.omega_min2_rad_s);
         assert!((out.iq_limit_resetting_a.unwrap() - 43.449).abs() < 1e-3);
         // ψ/|ΔL| = 742.9 A lies outside I_max = 316.8 A: (4.51) is not singular in the circle.
-        assert!(!warnings.iter().any(|w| w.contains("(4.51)")), "{warnings:?}");
+        assert!(!warnings.iter().any(|(_, w)| w.contains("(4.51)")), "{warnings:?}");
         let (out, warnings) = design(&Inputs {
             choices: choices(),
             ..inp.clone()
@@ -653,11 +667,15 @@ mod tests {
             }) => assert!((frequency_limit_rad_s - 583.21).abs() < 0.01),
             other => panic!("{other:?}"),
         }
-        assert!(warnings.iter().any(|w| w.contains("too small for the carrier rule")));
+        assert!(
+            warnings
+                .iter()
+                .any(|(_, w)| w.contains("too small for the carrier rule"))
+        );
         // A stronger inverse saliency puts ψ/|ΔL| inside the current circle: warned.
         inp.ld = 1.0e-3;
         let (_, warnings) = design(&inp);
-        assert!(warnings.iter().any(|w| w.contains("(4.51)")), "{warnings:?}");
+        assert!(warnings.iter().any(|(_, w)| w.contains("(4.51)")), "{warnings:?}");
     }
 
     /// The real reason for no injection: L_q = 130 µH > L_d = 125 µH is salient, but
@@ -671,7 +689,7 @@ mod tests {
         assert!(matches!(out.no_injection, Some(NoInjection::SaliencyTooSmall { .. })));
         let why = out.no_injection.unwrap().to_string();
         assert!(why.contains("3.8 % too small for the carrier rule"), "{why}");
-        assert!(!warnings.iter().any(|w| w.contains("no saliency")), "{warnings:?}");
+        assert!(!warnings.iter().any(|(_, w)| w.contains("no saliency")), "{warnings:?}");
         // The bifurcation and resetting limits exist for any ΔL ≠ 0.
         assert!(out.iq_limit_bifurcation_a.is_some() && out.iq_limit_resetting_a.is_some());
     }
@@ -686,6 +704,6 @@ mod tests {
         assert_eq!(out.no_injection, Some(NoInjection::NoSaliency));
         assert_eq!(out.omega_min1_rad_s, 0.0);
         assert_eq!(out.omega_ls_rad_s, out.omega_min2_rad_s);
-        assert!(warnings.iter().any(|w| w.contains("no saliency")));
+        assert!(warnings.iter().any(|(_, w)| w.contains("no saliency")));
     }
 }

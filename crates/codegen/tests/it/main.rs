@@ -2,6 +2,8 @@
 //! would otherwise be a binary of its own, linking every dependency again).
 
 mod board_files;
+mod contract;
+mod firmware_limits;
 mod fuzz;
 mod motor_data;
 mod spec;

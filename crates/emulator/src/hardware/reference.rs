@@ -23,6 +23,20 @@ const FRONT_END_OHM: f64 = 1_100.0;
 
 /// The hardware.
 pub fn hardware() -> Hardware {
+    // Hall sensors mounted positive for a current out of the leg: 15 mV/A about
+    // mid-supply (sized for thesis A's Fischer TI085, ±110 A).
+    with_sensing("motorgen-reference", 0.015)
+}
+
+/// The same controller with its Hall sensors sized for the seed traction motors:
+/// 3.75 mV/A about mid-supply, ±440 A (sized for the EMRAX 228 HV's 339 A peak at thesis
+/// A's 1.25 headroom, Table 4.1); everything else is the reference board's.
+pub fn hardware_400a() -> Hardware {
+    with_sensing("motorgen-reference-400a", 3.75e-3)
+}
+
+/// The reference controller named `board` with Hall sensors of `sensitivity` \[V/A\].
+fn with_sensing(board: &'static str, sensitivity: f64) -> Hardware {
     let input = |pin, signal, source| AnalogInput {
         pin,
         signal,
@@ -30,7 +44,7 @@ pub fn hardware() -> Hardware {
         source,
     };
     Hardware {
-        board: "motorgen-reference",
+        board,
         chip: "STM32G474RE",
         legs: [
             [in_plus("PA8"), in_plus("PB13")],
@@ -56,9 +70,8 @@ pub fn hardware() -> Hardware {
             input("PA1", Analog::Sin, "resolver SIN front end"),
             input("PA7", Analog::Cos, "resolver COS front end"),
         ],
-        // Hall sensors mounted positive for a current out of the leg: 15 mV/A about
-        // mid-supply (sized for thesis A's Fischer TI085, ±110 A).
-        current_gain_v_per_a: 0.015,
+        // Mounted positive for a current out of the leg, about mid-supply.
+        current_gain_v_per_a: sensitivity,
         current_offset_v: 1.65,
         // 3.3 V at 750 V (1.25 × thesis A's 600 V accumulator).
         dc_link_ratio: 0.0044,

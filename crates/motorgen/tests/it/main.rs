@@ -5,6 +5,7 @@ mod can_round_trip;
 mod cli;
 mod commission;
 mod common;
+mod contract;
 mod firmware_image;
 mod identify;
 mod output;

@@ -370,3 +370,85 @@ fn slow_observer_loses_current_tracking_in_field_weakening() {
     let track = find(&r, "peak |i_dq − i_dq^ref|");
     assert!(!track.pass, "{track:?}");
 }
+
+/// Issue 27: a design `check` now refuses (fischer-ti085 with R = 126 Ω, its 0.126 Ω read
+/// as Ω·10³: L/R = 3.1 µs ≪ T_s = 50 µs, so the plant's sampled model diverges) made
+/// `verify` print "NaN ms" rise times and currents of 1e300 A. A simulation that diverges
+/// is a failed run with its reason; no figure prints as NaN or inf.
+#[test]
+fn a_diverging_simulation_fails_with_its_reason_never_nan() {
+    let (s, mut d) = load(&motor("fischer-ti085"));
+    d.motor.phase_resistance_ohm *= 1000.0;
+    let v = run(&s, &d);
+    let table = v.table();
+    println!("{table}");
+    assert!(!v.passed(), "{table}");
+    for bad in ["NaN", "inf"] {
+        assert!(!table.contains(bad), "{bad} in\n{table}");
+    }
+    let diverged: Vec<&str> = v
+        .scenarios
+        .iter()
+        .filter(|sc| sc.checks.iter().any(|c| c.quantity == "simulation stays finite"))
+        .map(|sc| sc.id)
+        .collect();
+    assert!(!diverged.is_empty(), "no scenario reports its divergence:\n{table}");
+    for sc in &v.scenarios {
+        for c in &sc.checks {
+            assert!(c.pass || !c.criterion.is_empty(), "{}: {c:?}", sc.id);
+            if !c.measured.is_finite() {
+                assert!(!c.pass, "{}: a non-finite figure passes: {c:?}", sc.id);
+            }
+        }
+    }
+}
+
+/// The guard itself, on a hand-made result: a NaN figure and an infinite sample fail the
+/// scenario and are counted; a finite result is left as it was.
+#[test]
+fn non_finite_figures_and_samples_fail_the_scenario() {
+    let check = |measured: f64| motor_verify::Check {
+        quantity: "q-axis rise time 10–90 %".into(),
+        measured,
+        designed: Some(1.5),
+        unit: "ms",
+        criterion: "within 10 % of designed".into(),
+        pass: true,
+    };
+    let result = |measured: f64, sample: f64| motor_verify::ScenarioResult {
+        id: "current_step",
+        title: "step".into(),
+        reference: "hand-made",
+        checks: vec![check(measured)],
+        traces: vec![motor_verify::Trace {
+            title: "i_q".into(),
+            y_label: "A".into(),
+            t_ms: vec![0.0, 0.05],
+            series: vec![motor_verify::Series {
+                label: "i_q".into(),
+                values: vec![0.0, sample],
+            }],
+        }],
+    };
+    let fine = result(1.49, 1.0);
+    assert_eq!(motor_verify::diverged_fails(fine.clone()), fine);
+    let r = motor_verify::diverged_fails(result(f64::NAN, f64::INFINITY));
+    assert!(!r.passed());
+    assert!(!r.checks[0].pass);
+    let last = r.checks.last().unwrap();
+    assert_eq!(
+        (last.quantity.as_str(), last.measured),
+        ("simulation stays finite", 2.0)
+    );
+    assert_eq!(motor_verify::format_value(f64::NAN, "ms"), "diverged");
+    assert_eq!(motor_verify::format_value(f64::NEG_INFINITY, "A"), "diverged");
+}
+
+/// Hand-checked renderings: 4 significant digits below 10⁷, scientific from there.
+#[test]
+fn values_print_with_four_digits_and_never_hundreds() {
+    assert_eq!(motor_verify::format_value(21.97, "ms"), "21.97 ms");
+    assert_eq!(motor_verify::format_value(9_999_999.0, "A"), "9999999 A");
+    assert_eq!(motor_verify::format_value(1.1597e305, "A"), "1.160e305 A");
+    assert_eq!(motor_verify::format_value(-2.5e7, "V"), "-2.500e7 V");
+}

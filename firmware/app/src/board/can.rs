@@ -10,20 +10,17 @@ use stm32g4::stm32g474 as pac;
 
 use super::clocks::{POLL_LIMIT, wait_for};
 use crate::can_commissioning::tx_element;
-use crate::can_frame::{RxFrame, nominal_bit_timing};
+use crate::can_frame::{RxFrame, nbtp_bit_rate};
 use crate::hw;
 use crate::motor::board;
 use motor_control::can_protocol::Frame;
 
-/// FDCAN_NBTP of the bus (a build error if the clock does not divide).
-const NBTP: u32 = match nominal_bit_timing(
-    hw::FDCAN_CLOCK_HZ,
-    board::CAN_BIT_RATE,
-    hw::CAN_TQ_PER_BIT,
-    hw::CAN_TSEG2,
-) {
-    Some(v) => v,
-    None => panic!("the FDCAN clock does not divide into the bit rate"),
+/// FDCAN_NBTP of the bus: the generated `board::CAN_NBTP` (codegen computes it from the
+/// FDCAN kernel clock for the board's bit rate, sample point near 87.5 %), checked here
+/// again: a build error unless it makes exactly the board's rate from this image's clock.
+const NBTP: u32 = match nbtp_bit_rate(hw::FDCAN_CLOCK_HZ, board::CAN_NBTP) {
+    Some(rate) if rate == board::CAN_BIT_RATE => board::CAN_NBTP,
+    _ => panic!("the generated CAN bit timing does not make the board's bit rate from the FDCAN clock"),
 };
 
 /// Number of RX FIFO 0 elements.

@@ -1,8 +1,11 @@
 //! FMAC filter accelerator running the generated identification FIR
 //! (`motor::filter::TAPS_Q15`, thesis A §6.2; RM0440 §18).
 //!
-//! Memory: X2 (coefficients) at 0, N words; X1 (input ring) at N, N + D words;
-//! Y (output ring) at 2N + D, D words. The coefficient load (FUNC 2) writes the N
+//! Memory: X2 (coefficients) at 0, N words; X1 (input ring) at N, N + d words;
+//! Y (output ring) at 2N + d, d words, with d = [`D`] where it fits and 1 for 127 taps
+//! (RM0440 §18.3.8: an N-tap FIR needs at least 2N + 1 of the 256 words, so N ≤ 127;
+//! the extra d1, d2 words only buy throughput, and [`Fmac::push`] moves one sample at a
+//! time). The coefficient load (FUNC 2) writes the N
 //! taps, the X1 load (FUNC 1) N − 1 zeros — the FMAC computes its first output once
 //! N samples are present, so the first output is b_0·x(0) as for an all-zero
 //! history — then FUNC 8 (FIR) runs with the gain R and CLIPEN of the
@@ -18,7 +21,7 @@ use super::clocks::{POLL_LIMIT, wait_for};
 const FUNC_LOAD_X1: u32 = 1;
 const FUNC_LOAD_X2: u32 = 2;
 const FUNC_FIR: u32 = 8;
-/// Extra X1 space and Y length.
+/// Extra X1 space and Y length where the memory has room for them.
 const D: usize = 2;
 /// Words of the FMAC's local memory.
 const MEMORY: usize = 256;
@@ -53,12 +56,17 @@ impl Fmac {
 
     /// Loads the taps, clears the history and starts the FIR; `false` on a timeout.
     pub fn start_fir<const N: usize>(&mut self, fir: &FmacFir<N>) -> bool {
-        const { assert!(2 * N + 2 * D <= MEMORY, "FIR too long for the FMAC memory") };
+        const { assert!(2 * N + 2 <= MEMORY, "FIR too long for the FMAC memory") };
+        let d = if 2 * N + 2 * D <= MEMORY {
+            D
+        } else {
+            (MEMORY - 2 * N) / 2
+        };
         self.regs.cr().write(|w| w.reset().set_bit());
         if !wait_for(POLL_LIMIT, || self.regs.cr().read().reset().bit_is_clear()) {
             return false;
         }
-        let (x2, x1, y) = (0, N, 2 * N + D);
+        let (x2, x1, y) = (0, N, 2 * N + d);
         // SAFETY: base/size fields are 8-bit word addresses inside the 256 words
         // (checked at compile time above).
         unsafe {
@@ -67,10 +75,10 @@ impl Fmac {
                 .write(|w| w.x2_base().bits(x2 as u8).x2_buf_size().bits(N as u8));
             self.regs
                 .x1bufcfg()
-                .write(|w| w.x1_base().bits(x1 as u8).x1_buf_size().bits((N + D) as u8));
+                .write(|w| w.x1_base().bits(x1 as u8).x1_buf_size().bits((N + d) as u8));
             self.regs
                 .ybufcfg()
-                .write(|w| w.y_base().bits(y as u8).y_buf_size().bits(D as u8));
+                .write(|w| w.y_base().bits(y as u8).y_buf_size().bits(d as u8));
         }
         self.start(FUNC_LOAD_X2, N, 0);
         for &b in &fir.taps {

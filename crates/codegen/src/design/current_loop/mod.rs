@@ -9,14 +9,18 @@
 //!    the sampled loop deliver the requested bandwidth;
 //! 3. [`analysis`] — the sampled loop's poles, gain and phase margins, overshoot and rise
 //!    time, and the floors it must meet;
-//! 4. [`bandwidth`] — the largest bandwidth whose sampled loop meets the floors on both
-//!    axes (what an error names).
+//! 4. [`at_speed`] — the loop at speed, on the firmware's own controller: the axes kept
+//!    apart after an i_q step with and without the feed-forward (5.3), and a DC-link step
+//!    under the 1/U_dc feed-forward (5.1) — the figures `motorgen verify` judges there;
+//! 5. [`bandwidth`] — the largest bandwidth whose sampled loop meets the floors on both
+//!    axes and the at-speed figures (what an error names).
 //!
 //! One [`Request`] carries an axis's inputs through all of them; [`design()`] runs the
 //! first three. The spec-facing side (the `current_loop` section of the design, its
 //! checks and messages) is `design::sections::current_loop`.
 
 pub mod analysis;
+pub mod at_speed;
 pub mod bandwidth;
 pub mod continuous;
 pub mod discrete;

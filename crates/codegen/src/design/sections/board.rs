@@ -2,16 +2,17 @@
 //! constants from the board's sensing (the 16-bit left-aligned codes of thesis A (4.16),
 //! Table 4.1; the sequences' timing of RM0440 §21.4.12), the dead time, trips and bus
 //! timing in the units the firmware needs, and the checks that can only be made with
-//! both — a board whose current range is below the motor's peak current, a DC link above
-//! what the divider measures, trips below the motor's ratings, conversions that take too
-//! much of the control period. It runs on the motor's finished design
-//! ([`crate::design::on_board`]).
+//! both. It runs on the motor's finished design ([`crate::design::on_board`]).
 //!
-//! Those are warnings at the board key, not errors: an engineer may well run a large
-//! motor on a small board at reduced current (the firmware trips at the board's levels
-//! and the ADC scaling is the board's, so the image measures correctly); the image for
-//! every motor stays buildable on every board, and `motorgen firmware`/`check` print
-//! what does not fit.
+//! What the pair must satisfy is an error at the board key (the motor's numbers in the
+//! message): the motor's peak current within what the board's current sensing measures
+//! and within its power stage's rating (`protection.over_current`), its DC link within
+//! what the divider measures and within `protection.over_voltage`, its maximum speed
+//! within `protection.over_speed`. A board's `[protection]` values are ceilings: the
+//! image trips at the lower of the motor's limit and the board's ceiling ([`Trips`]), the
+//! motor's limits being the full scales of its design (the spec's `[scaling] margin` over
+//! its peak current, DC link and maximum speed, thesis A Table 4.1). Conversions that
+//! take more than a quarter of the control period are a warning.
 
 use serde::Serialize;
 
@@ -20,6 +21,8 @@ use crate::board::{
     samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle, warning_at,
 };
 use crate::design::Design;
+use crate::diagnostic::{Diagnostic, Source};
+use crate::firmware::{self, CanBitTiming};
 
 /// Left-aligned 16-bit ADC codes per volt at the pin, over V_REF+: the firmware shifts
 /// the 12-bit conversions into Q1.15 offset binary (thesis A (4.16), Table 4.1).
@@ -80,79 +83,257 @@ pub struct BoardOut {
     pub sample_at_carrier_maximum: u8,
     /// 1: the image requires and checks the BOOT0 option bytes.
     pub boot0_option_bytes: u8,
-    /// Over-speed trip as electrical speed n_p·ω_m \[rad/s\].
+    /// The trip levels the image uses: the lower of the motor's limit and the board's
+    /// ceiling, each with which one set it.
+    pub trips: Trips,
+    /// Over-speed trip as electrical speed n_p·ω_m \[rad/s\] (of `trips.over_speed_rad_s`).
     pub over_speed_electrical_rad_s: f64,
     /// CAN nominal bit rate \[bit/s\].
     pub can_bit_rate: u32,
+    /// FDCAN1's nominal bit timing for that rate from the FDCAN kernel clock
+    /// (`firmware::can_bit_timing`, RM0440 §44.4.9).
+    pub can_timing: CanBitTiming,
     /// What does not fit between this board and this motor (also in the design's
     /// warnings), located at the board key.
     pub warnings: Vec<String>,
 }
 
-/// The board with the motor of `d`, and the warnings (each located at its board key).
-pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (BoardOut, Vec<String>) {
+/// Which limit set a trip level.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TripSource {
+    /// The motor's limit (its design's full scale) is the lower.
+    Motor,
+    /// The board's `[protection]` ceiling is the lower (or equal).
+    Board,
+}
+
+/// One trip level of the image.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trip {
+    /// The level the image trips at (SI: A, V, rad/s mechanical): min(motor, board).
+    pub value: f64,
+    /// Which of the two set it.
+    pub set_by: TripSource,
+    /// The motor's limit (SI).
+    pub motor_limit: f64,
+    /// How the motor's limit is computed, with its numbers and keys.
+    pub motor_rule: String,
+    /// The board's ceiling (SI), its `[protection]` value.
+    pub board_ceiling: f64,
+    /// The board key of the ceiling.
+    pub board_key: &'static str,
+}
+
+impl Trip {
+    fn new(motor_limit: f64, motor_rule: String, board_ceiling: f64, board_key: &'static str) -> Trip {
+        let set_by = if motor_limit < board_ceiling {
+            TripSource::Motor
+        } else {
+            TripSource::Board
+        };
+        Trip {
+            value: motor_limit.min(board_ceiling),
+            set_by,
+            motor_limit,
+            motor_rule,
+            board_ceiling,
+            board_key,
+        }
+    }
+
+    /// Who set it, in words: `motor: 1.25·√2·10 A` or `board: protection.over_current`.
+    pub fn describe(&self, unit: &str, scale: f64) -> String {
+        let motor = format!("{:.2} {unit} ({})", self.motor_limit * scale, self.motor_rule);
+        let board = format!("{:.2} {unit} ({})", self.board_ceiling * scale, self.board_key);
+        match self.set_by {
+            TripSource::Motor => format!("set by the motor: {motor}; board ceiling {board}"),
+            TripSource::Board => format!("set by the board: {board}; motor's limit {motor}"),
+        }
+    }
+}
+
+/// The image's trip levels.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Trips {
+    /// |i| of any phase \[A\].
+    pub over_current_a: Trip,
+    /// U_dc \[V\].
+    pub over_voltage_v: Trip,
+    /// Mechanical speed \[rad/s\].
+    pub over_speed_rad_s: Trip,
+}
+
+/// The trip levels of the motor of `d` on `board`: the motor's limits are its design's
+/// full scales, margin·√2·I_peak, margin·U_dc (thesis A Table 4.1) and margin·n_max; the
+/// board's `[protection]` values are ceilings.
+fn trips(board: &Board, d: &Design) -> Trips {
+    let margin = d.scaling.margin;
+    let speed = margin * d.motor.max_speed_rad_s;
+    Trips {
+        over_current_a: Trip::new(
+            d.scaling.phase_current.full_scale,
+            format!(
+                "scaling.margin·√2·peak_current = {margin}·√2·{} A",
+                d.motor.peak_current_a_rms
+            ),
+            board.over_current_a,
+            "protection.over_current",
+        ),
+        over_voltage_v: Trip::new(
+            d.scaling.dc_link_voltage.full_scale,
+            format!(
+                "scaling.margin·dc_link_voltage = {margin}·{} V",
+                d.drive.dc_link_voltage_v
+            ),
+            board.over_voltage_v,
+            "protection.over_voltage",
+        ),
+        over_speed_rad_s: Trip::new(
+            speed,
+            format!("scaling.margin·max_speed = {margin}·{:.0} rpm", d.motor.max_speed_rpm),
+            board.over_speed_rad_s,
+            "protection.over_speed",
+        ),
+    }
+}
+
+/// The board with the motor of `d`, and the warnings (each located at its board key); or
+/// what does not fit between them, each an error at its board key.
+pub(in crate::design) fn board(
+    board: &Board,
+    board_src: Source<'_>,
+    d: &Design,
+) -> Result<(BoardOut, Vec<String>), Vec<Diagnostic>> {
+    let board_text = board_src.text;
+    // The board's own warnings (stated facts its parts' datasheets contradict) travel with
+    // every design on it.
     let mut warnings = board.warnings.clone();
-    let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
+    let mut errors = Vec::new();
+    let mut refuse = |key: &str, problem: String, accepted: String| {
+        errors.push(board_src.error(board.span(key), key, problem, accepted));
+    };
     let i_fs = board.current_full_scale_a();
     let u_fs = board.dc_link_full_scale_v();
     let peak = d.motor.peak_current_a;
-    let gain_key = match board.current.kind {
-        crate::board::SensorKind::Shunt => "current_sensing.amplifier_gain",
-        crate::board::SensorKind::Hall => "current_sensing.sensitivity",
-    };
+    let rms_max = |a: f64| a / std::f64::consts::SQRT_2;
+    let spec = &d.spec_file;
     if i_fs < peak {
-        warn(
+        // The largest |gain| [V/A] at the pin that keeps ±I_peak inside the ADC's range at
+        // this offset, said in the key's own terms.
+        let gain_max = board.current.offset_v.min(board.adc_reference_v - board.current.offset_v) / peak;
+        let (gain_key, gain_accepted) = match (board.current.kind, board.current.shunt_ohm) {
+            (crate::board::SensorKind::Shunt, Some(shunt)) => (
+                "current_sensing.amplifier_gain",
+                format!("an amplifier gain up to {:.2} with this {:.1} mΩ shunt and offset", gain_max / shunt, shunt * 1e3),
+            ),
+            (crate::board::SensorKind::Shunt, None) => (
+                "current_sensing.amplifier_gain",
+                format!("a gain at the pin up to {:.2} mV/A at this offset", gain_max * 1e3),
+            ),
+            (crate::board::SensorKind::Hall, _) => (
+                "current_sensing.sensitivity",
+                format!("a sensitivity up to {:.2} mV/A at this offset", gain_max * 1e3),
+            ),
+        };
+        refuse(
             gain_key,
             format!(
-                "the board measures ±{i_fs:.1} A but {} needs its peak current {peak:.1} A (√2·{:.1} A rms): currents above {i_fs:.1} A read as the ADC rail and trip the drive; size the sensing to the motor or lower its peak current",
+                "the board measures ±{i_fs:.1} A but {} ({spec}) drives its peak current {peak:.1} A (√2·{:.1} A rms, motor.peak_current): currents above {i_fs:.1} A read as the ADC rail",
                 d.name, d.motor.peak_current_a_rms
             ),
+            format!(
+                "current sensing that measures ±{peak:.1} A ({gain_accepted}), or a motor peak_current up to {:.2} A rms",
+                rms_max(i_fs)
+            ),
         );
-    }
-    if board.over_current_a < peak && i_fs >= peak {
-        warn(
+    } else if board.over_current_a < peak {
+        refuse(
             "protection.over_current",
             format!(
-                "the drive trips at {:.1} A, below {}'s peak current {peak:.1} A",
-                board.over_current_a, d.name
+                "the board's power stage is rated to {:.1} A (its over-current ceiling) but {} ({spec}) drives its peak current {peak:.1} A (√2·{:.1} A rms)",
+                board.over_current_a, d.name, d.motor.peak_current_a_rms
+            ),
+            format!(
+                "a board rated to at least {peak:.1} A, or a motor peak_current up to {:.2} A rms",
+                rms_max(board.over_current_a)
             ),
         );
     }
     let udc = d.drive.dc_link_voltage_v;
     if u_fs < udc {
-        warn(
+        refuse(
             "sensing.dc_link_divider",
             format!(
-                "the divider measures up to {u_fs:.1} V but {} runs at U_dc = {udc:.0} V: the DC-link reading saturates (the 1/U_dc feed-forward (5.1) and the over-voltage trip go blind)",
+                "the divider measures up to {u_fs:.1} V but {} ({spec}) runs at U_dc = {udc} V (drive.dc_link_voltage): the DC-link reading would saturate and the 1/U_dc feed-forward (5.1) and the over-voltage trip go blind",
                 d.name
+            ),
+            format!(
+                "a divider that measures {udc} V (ratio up to {:.5}), or a motor DC link up to {u_fs:.1} V",
+                board.adc_reference_v / udc
             ),
         );
     } else if board.over_voltage_v < udc {
-        warn(
+        refuse(
             "protection.over_voltage",
             format!(
-                "the drive trips at {:.0} V, below {}'s DC link {udc:.0} V",
+                "the board's power stage is rated to {:.1} V (its over-voltage ceiling) but {} ({spec}) runs at U_dc = {udc} V",
                 board.over_voltage_v, d.name
+            ),
+            format!(
+                "a board rated to at least {udc} V, or a motor DC link up to {:.1} V",
+                board.over_voltage_v
             ),
         );
     }
     let n_max = d.motor.max_speed_rad_s;
     if board.over_speed_rad_s < n_max {
-        warn(
+        refuse(
             "protection.over_speed",
             format!(
-                "the drive trips at {:.0} rpm, below {}'s maximum speed {:.0} rpm",
+                "the board's over-speed ceiling is {:.0} rpm but {} ({spec}) runs to {:.0} rpm (motor.max_speed): the image would trip in normal operation",
                 board.over_speed_rad_s * 30.0 / std::f64::consts::PI,
                 d.name,
                 d.motor.max_speed_rpm
             ),
+            format!(
+                "an over-speed ceiling of at least {:.0} rpm, or a motor max_speed up to {:.0} rpm",
+                d.motor.max_speed_rpm,
+                board.over_speed_rad_s * 30.0 / std::f64::consts::PI
+            ),
         );
     }
-    let t_conv = sequence_time(board, ADC_CLOCK_HZ);
+    // The main loop refreshes the IWDG once the control interrupt has run again
+    // (firmware/app/src/board/mod.rs), about once per T_s: a timeout shorter than two
+    // control periods resets a healthy drive.
     let ts = d.drive.sample_period_s;
+    if board.watchdog_timeout_s < 2.0 * ts {
+        refuse(
+            "watchdog.timeout",
+            format!(
+                "a watchdog timeout of {:.1} µs is shorter than two control periods of {} ({spec}), 2·T_s = {:.1} µs: the image refreshes the watchdog once per control period, so it would reset a healthy drive",
+                board.watchdog_timeout_s * 1e6,
+                d.name,
+                2.0 * ts * 1e6
+            ),
+            format!(
+                "a timeout of at least {:.1} µs (2·T_s), or a motor switching faster",
+                2.0 * ts * 1e6
+            ),
+        );
+    }
+    let can_timing = match firmware::can_bit_rate(firmware::FDCAN_CLOCK_HZ, board.can_bit_rate) {
+        Ok(t) => Some(t),
+        Err(r) => {
+            refuse("can.bit_rate", r.problem, r.accepted);
+            None
+        }
+    };
+    let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
+    let t_conv = sequence_time(board, ADC_CLOCK_HZ);
     if t_conv > 0.25 * ts {
         warn(
-            "sensing.source_resistance",
+            "sensing.source_resistance.current",
             format!(
                 "the conversions take {:.2} µs after the trigger, {:.0} % of the {:.1} µs control period: the control step starts late",
                 t_conv * 1e6,
@@ -175,8 +356,12 @@ pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (
         Signal::CanRx,
         Signal::CanTx,
     ];
+    let (Some(can_timing), true) = (can_timing, errors.is_empty()) else {
+        return Err(errors);
+    };
     let board_dead = board.dead_time_s;
     let dead_s = d.drive.dead_time_s.map_or(board_dead, |spec| spec.max(board_dead));
+    let trips = trips(board, d);
     let out = BoardOut {
         board: board.clone(),
         current_offset_code: (board.current.offset_v / board.adc_reference_v * CODES_16).round() as i32,
@@ -184,8 +369,7 @@ pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (
         current_full_scale_a: i_fs,
         dc_link_volts_per_lsb: board.adc_reference_v / (board.dc_link_divider * CODES_15),
         dc_link_full_scale_v: u_fs,
-        // Whole nanoseconds, never shorter than asked (the −1e-6 absorbs 500e-9·1e9 = 500.0000000000001).
-        dead_time_ns: (dead_s * 1e9 - 1e-6).ceil() as u32,
+        dead_time_ns: firmware::dead_time_ns(dead_s),
         conversion_time_s: t_conv,
         gate_pins: gates.map(|s| pin_code(board, s)),
         gate_afs: gates.map(|s| pin_af(board, s)),
@@ -209,15 +393,17 @@ pub(in crate::design) fn board(board: &Board, board_text: &str, d: &Design) -> (
         hse_hz: board.hse_hz.map_or(0, |f| f.round() as u32),
         sample_at_carrier_maximum: u8::from(samples_at_carrier_maximum(board)),
         boot0_option_bytes: u8::from(checks_option_bytes(board)),
-        over_speed_electrical_rad_s: board.over_speed_rad_s * f64::from(d.motor.pole_pairs),
-        can_bit_rate: board.can_bit_rate.round() as u32,
+        over_speed_electrical_rad_s: trips.over_speed_rad_s.value * f64::from(d.motor.pole_pairs),
+        trips,
+        can_bit_rate: can_timing.bit_rate,
+        can_timing,
         warnings: Vec::new(),
     };
     let out = BoardOut {
         warnings: warnings.clone(),
         ..out
     };
-    (out, warnings)
+    Ok((out, warnings))
 }
 
 fn pin_code(board: &Board, s: Signal) -> u8 {

@@ -13,6 +13,7 @@ use super::Context;
 use crate::design::current_loop::analysis::{
     AxisGains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE,
 };
+use crate::design::current_loop::at_speed;
 use crate::design::current_loop::continuous::{self, CurrentLoopError, Promise};
 use crate::design::current_loop::{self, Axis, FIRMWARE_LOOP_DELAY_PERIODS, Request, axis_letter, bandwidth, discrete};
 use crate::design::thermal;
@@ -122,11 +123,14 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     let limit = continuous::bandwidth_limit(c.method, fs);
     if c.bandwidth.value >= limit {
         let pct = if c.method == Method::PolePlacement { 17 } else { 30 };
-        cx.warnings.push(format!(
-            "current loop: α = {:.1} rad/s ({:.0} Hz) is not below {pct} % of f_s = {fs} Hz, the guideline of thesis A §5.4.1 (the sampled-loop margins are what the design checks)",
-            c.bandwidth.value,
-            c.bandwidth.value / (2.0 * PI)
-        ));
+        cx.warn_at(
+            &c.bandwidth,
+            format!(
+                "current loop: α = {:.1} rad/s ({:.0} Hz) is not below {pct} % of f_s = {fs} Hz, the guideline of thesis A §5.4.1 (the sampled-loop margins are what the design checks)",
+                c.bandwidth.value,
+                c.bandwidth.value / (2.0 * PI)
+            ),
+        );
     }
     let r = m.phase_resistance.value;
     let requests = requests(spec, r, ts);
@@ -135,12 +139,34 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         .ok();
     let promise = Promise::of(&requests[0]);
     let designed_os = promise.overshoot_pct;
-    if let Some((gd, gq)) = &gains
-        && let Some((axis, breach)) = [('d', gd), ('q', gq)]
+    let drive = drive(spec, r, ts, cx.max_electrical_frequency());
+    // The floors on both axes, then the at-speed figures (`verify`'s decoupling and DC-link-step criteria).
+    let floor_breach = gains.as_ref().and_then(|(gd, gq)| {
+        [('d', gd), ('q', gq)]
             .iter()
             .find_map(|(a, g)| g.sampled.breach(&promise).map(|b| (*a, b)))
-    {
-        let best = bandwidth::largest_bandwidth(&requests).map(round_down_3);
+    });
+    let at_speed_breach = match (&gains, &floor_breach) {
+        (Some((gd, gq)), None) => bandwidth::at_speed_breach(&drive, [gd, gq], c.bandwidth.value),
+        _ => None,
+    };
+    if let Some(breach) = at_speed_breach {
+        let best = bandwidth::largest_bandwidth(&requests, Some(&drive)).map(round_down_3);
+        let b = &c.bandwidth;
+        cx.errors.push(cx.src.error(
+            b.span.clone(),
+            &b.key,
+            format!("at α = {:.1} rad/s (f_s = {fs} Hz) the loop {breach}", b.value),
+            match best {
+                Some(a) => format!(
+                    "a bandwidth up to {a:.0} rad/s, the largest that meets the sampled-loop floors and the at-speed figures for this motor at f_s = {fs} Hz"
+                ),
+                None => "a higher f_s: no bandwidth meets the floors and the at-speed figures for this motor at this f_s".to_string(),
+            },
+        ));
+    }
+    if let Some((axis, breach)) = floor_breach {
+        let best = bandwidth::largest_bandwidth(&requests, Some(&drive)).map(round_down_3);
         let b = &c.bandwidth;
         cx.errors.push(cx.src.error(
             b.span.clone(),
@@ -158,7 +184,12 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             ),
             match best {
                 Some(a) => format!(
-                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes for this motor at f_s = {fs} Hz, or a higher f_s"
+                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes and the at-speed figures `motorgen verify` checks (decoupling, DC-link step) for this motor at f_s = {fs} Hz{}, or a higher f_s",
+                    // Where the at-speed figures bind, the floors' own limit too.
+                    match bandwidth::largest_bandwidth(&requests, None).map(round_down_3) {
+                        Some(f) if f > a => format!(" (the floors alone allow up to {f:.0} rad/s)"),
+                        _ => String::new(),
+                    }
                 ),
                 None => "a higher f_s: no bandwidth meets the floors for this motor at this f_s".to_string(),
             },
@@ -171,7 +202,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         let want = 9f64.ln() / c.bandwidth.value;
         let worst = t[0].min(t[1]);
         if (worst / want - 1.0).abs() > 0.10 {
-            cx.warnings.push(format!(
+            let text = format!(
                 "current loop: sampled at f_s = {fs} Hz with the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
                 worst * 1e3,
                 want * 1e3,
@@ -182,7 +213,8 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
                 } else {
                     "raise f_s or lower the bandwidth"
                 }
-            ));
+            );
+            cx.warn_at(&c.bandwidth, text);
         }
     }
     let hot = hot_variant(cx, r, ts);
@@ -230,6 +262,27 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     })
 }
 
+/// The drive the at-speed figures are judged on (`current_loop::at_speed`).
+fn drive(spec: &Spec, r: f64, ts: f64, max_electrical_frequency: f64) -> at_speed::Drive {
+    let m = &spec.motor;
+    let c = &spec.current_loop;
+    let zeta = c.damping.as_ref().map_or(0.0, |z| z.value);
+    at_speed::Drive {
+        resistance_ohm: r,
+        ld: m.d_inductance.value,
+        lq: m.q_inductance.value,
+        flux_linkage_wb: m.flux_linkage.as_ref().map(|p| p.value),
+        peak_current_a: std::f64::consts::SQRT_2 * m.peak_current.value,
+        voltage_limit_v: spec.drive.dc_link_voltage.value / 3f64.sqrt(),
+        max_electrical_speed: 2.0 * PI * max_electrical_frequency,
+        sample_period_s: ts,
+        dc_link_voltage_v: spec.drive.dc_link_voltage.value,
+        dc_link_voltage_min_v: spec.drive.dc_link_voltage_min.value,
+        method: c.method,
+        damping: zeta,
+    }
+}
+
 /// The spec's current-loop requests for the d and q axes with resistance `r` \[Ω\] at
 /// sample period `ts` \[s\], with the firmware's loop delay.
 fn requests(spec: &Spec, r: f64, ts: f64) -> [Request; 2] {
@@ -259,9 +312,10 @@ fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
             let promise = Promise::of(&requests[0]);
             for (axis, g) in [('d', &d), ('q', &q)] {
                 if let Some(b) = g.sampled.breach(&promise) {
-                    cx.warnings.push(format!(
-                        "hot-resistance variant (R_s = {r_hot:.4} Ω): the sampled {axis}-axis loop is {b}"
-                    ));
+                    cx.warn_at(
+                        &t.max_winding_temperature,
+                        format!("hot-resistance variant (R_s = {r_hot:.4} Ω): the sampled {axis}-axis loop is {b}"),
+                    );
                 }
             }
             Some(HotVariant {
@@ -272,10 +326,11 @@ fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
             })
         }
         Err(_) => {
-            cx.warnings.push(format!(
+            let text = format!(
                 "no hot-resistance variant: the design is infeasible with R_s({} °C) = {r_hot:.4} Ω",
                 t.max_winding_temperature.value
-            ));
+            );
+            cx.warn_at(&t.max_winding_temperature, text);
             None
         }
     }

@@ -1,10 +1,13 @@
-//! The inverter operating point and the sampling rule f_s ≥ 12·f_e,max (thesis A 1.1).
+//! The inverter operating point, the sampling rule f_s ≥ 12·f_e,max (thesis A 1.1) and
+//! the firmware's limits on the drive's values (`crate::firmware`): TIM1's 16-bit
+//! auto-reload for f_s, its dead-time generator for `drive.dead_time`.
 
 use serde::Serialize;
 
 use super::Context;
 use crate::design::acceleration::AccelerationRule;
 use crate::design::{dead_time, sampling};
+use crate::firmware;
 
 /// Inverter operating point.
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -13,6 +16,9 @@ pub struct DriveOut {
     pub switching_frequency_hz: f64,
     /// T_s = 1/f_s \[s\].
     pub sample_period_s: f64,
+    /// TIM1 auto-reload of the centre-aligned carrier, f_TIM/(2·f_s) rounded
+    /// (`firmware::pwm_period`, the firmware's `config::PWM_PERIOD`).
+    pub pwm_period: u16,
     /// 12·f_e,max \[Hz\] (1.1).
     pub min_switching_frequency_hz: f64,
     /// U_dc \[V\].
@@ -48,10 +54,26 @@ pub(in crate::design) fn drive(cx: &mut Context<'_>) -> DriveOut {
             ),
         ));
     }
+    let pwm_period = match firmware::pwm_period(fs) {
+        Ok(arr) => arr,
+        Err(r) => {
+            let p = &spec.drive.switching_frequency;
+            cx.errors
+                .push(cx.src.error(p.span.clone(), &p.key, r.problem, r.accepted));
+            0
+        }
+    };
+    if let Some(p) = &spec.drive.dead_time
+        && let Err(r) = firmware::dead_time(p.value)
+    {
+        cx.errors
+            .push(cx.src.error(p.span.clone(), &p.key, r.problem, r.accepted));
+    }
     let (acceleration, rule) = cx.max_acceleration();
     DriveOut {
         switching_frequency_hz: fs,
         sample_period_s: 1.0 / fs,
+        pwm_period,
         min_switching_frequency_hz: fs_min,
         dc_link_voltage_v: spec.drive.dc_link_voltage.value,
         dc_link_voltage_min_v: spec.drive.dc_link_voltage_min.value,

@@ -16,6 +16,7 @@ pub(super) mod field_weakening;
 pub(super) mod fir;
 pub(super) mod motor;
 pub(super) mod per_unit;
+pub(super) mod plausibility;
 pub(super) mod scaling;
 pub(super) mod sensorless;
 
@@ -51,6 +52,17 @@ impl Context<'_> {
             v(&m.inertia),
             m.max_speed.value,
         )
+    }
+
+    /// A warning located at byte `span` of the spec, at `key`.
+    pub fn warn(&mut self, span: std::ops::Range<usize>, key: &str, text: impl std::fmt::Display) {
+        let w = self.src.warning(span, key, text);
+        self.warnings.push(w);
+    }
+
+    /// A warning at `p`'s key and value.
+    pub fn warn_at(&mut self, p: &crate::spec::Param, text: impl std::fmt::Display) {
+        self.warn(p.span.clone(), &p.key.clone(), text);
     }
 
     /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).

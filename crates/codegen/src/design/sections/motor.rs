@@ -3,6 +3,7 @@
 
 use std::collections::BTreeMap;
 use std::f64::consts::{PI, SQRT_2};
+use std::ops::Range;
 
 use serde::Serialize;
 
@@ -76,13 +77,18 @@ pub struct MotorOut {
 pub(in crate::design) fn motor(cx: &mut Context<'_>, hot_resistance: Option<f64>) -> MotorOut {
     let spec = cx.spec;
     let m = &spec.motor;
-    let checks = cross_checks(m);
-    for c in checks.iter().filter(|c| c.fails()) {
-        cx.warnings.push(format!("cross-check: {c}"));
+    let located = cross_checks(m);
+    for (c, key, span) in located.iter().filter(|(c, _, _)| c.fails()) {
+        cx.warn(span.clone(), key, format!("cross-check: {c}"));
     }
+    let checks = located.into_iter().map(|(c, _, _)| c).collect();
     if m.flux_linkage.is_none() {
-        cx.warnings
-            .push("ψ_M is unknown: the back-EMF feed-forward term and torque → i_q conversion are omitted".into());
+        let span = cx.src.table_span("motor.datasheet");
+        cx.warn(
+            span,
+            "motor.datasheet.flux_linkage",
+            "ψ_M is unknown: the back-EMF feed-forward term and torque → i_q conversion are omitted",
+        );
     }
     let fe_max = cx.max_electrical_frequency();
     let r = m.phase_resistance.value;
@@ -147,16 +153,21 @@ fn provenance(cx: &Context<'_>) -> BTreeMap<&'static str, Origin> {
 
 /// The redundant pairs of `m`: every two forms of ψ_M; with ψ_M, the peak and rated torques
 /// against the MTPA torque (3.7), (3.10) at the peak and rated currents; the rated power
-/// against T_n·ω_m,n; a given rated frequency against the nominal speed (2.19).
-fn cross_checks(m: &Motor) -> Vec<CrossCheck> {
+/// against T_n·ω_m,n; a given rated frequency against the nominal speed (2.19). Each with
+/// the key and span its warning is located at (the pair's second value, the one checked).
+pub(in crate::design) fn cross_checks(m: &Motor) -> Vec<(CrossCheck, String, Range<usize>)> {
     let mut out = Vec::new();
     let from = |p: &Param| p.key.clone();
     for (i, a) in m.flux_sources.iter().enumerate() {
         for b in &m.flux_sources[i + 1..] {
-            out.push(CrossCheck::new(
-                "ψ_M [Wb]",
-                (a.flux_wb, format!("{} ({})", a.key, a.written)),
-                (b.flux_wb, format!("{} ({})", b.key, b.written)),
+            out.push((
+                CrossCheck::new(
+                    "ψ_M [Wb]",
+                    (a.flux_wb, format!("{} ({})", a.key, a.written)),
+                    (b.flux_wb, format!("{} ({})", b.key, b.written)),
+                ),
+                b.key.clone(),
+                b.span.clone(),
             ));
         }
     }
@@ -175,16 +186,21 @@ fn cross_checks(m: &Motor) -> Vec<CrossCheck> {
             (&m.nominal_torque, m.nominal_current.as_ref(), "rated"),
         ] {
             if let (Some(t), Some(i)) = (t, i) {
-                out.push(CrossCheck::new(
-                    &format!("{what} torque [N·m]"),
-                    (t.value, from(t)),
-                    (
-                        torque(i.value),
-                        format!(
-                            "(3.7) at the MTPA point (3.10) of {} = {:.4} A rms with ψ_M = {:.6} Wb",
-                            i.key, i.value, psi.value
+                let at = (t.key.clone(), t.span.clone());
+                out.push((
+                    CrossCheck::new(
+                        &format!("{what} torque [N·m]"),
+                        (t.value, from(t)),
+                        (
+                            torque(i.value),
+                            format!(
+                                "(3.7) at the MTPA point (3.10) of {} = {:.4} A rms with ψ_M = {:.6} Wb",
+                                i.key, i.value, psi.value
+                            ),
                         ),
                     ),
+                    at.0,
+                    at.1,
                 ));
             }
         }
@@ -195,22 +211,30 @@ fn cross_checks(m: &Motor) -> Vec<CrossCheck> {
             .map(|f| (2.0 * PI * f.value / f64::from(m.pole_pairs), format!("{} / n_p", f.key)))
     });
     if let (Some(p), Some(t), Some((w, w_from))) = (&m.rated_power, &m.nominal_torque, speed) {
-        out.push(CrossCheck::new(
-            "rated power [W]",
-            (p.value, from(p)),
-            (t.value * w, format!("T_n·ω_m,n from {} and {w_from}", t.key)),
+        out.push((
+            CrossCheck::new(
+                "rated power [W]",
+                (p.value, from(p)),
+                (t.value * w, format!("T_n·ω_m,n from {} and {w_from}", t.key)),
+            ),
+            p.key.clone(),
+            p.span.clone(),
         ));
     }
     if let (Some(f), Some(n)) = (&m.rated_frequency, &m.nominal_speed)
         && f.source != Provenance::Derived
     {
-        out.push(CrossCheck::new(
-            "rated frequency [Hz]",
-            (f.value, from(f)),
-            (
-                n.value * f64::from(m.pole_pairs) / (2.0 * PI),
-                format!("n_p·ω_m,n/(2π) (2.19) from {}", n.key),
+        out.push((
+            CrossCheck::new(
+                "rated frequency [Hz]",
+                (f.value, from(f)),
+                (
+                    n.value * f64::from(m.pole_pairs) / (2.0 * PI),
+                    format!("n_p·ω_m,n/(2π) (2.19) from {}", n.key),
+                ),
             ),
+            f.key.clone(),
+            f.span.clone(),
         ));
     }
     out

@@ -11,8 +11,9 @@ use crate::design::sensorless;
 use crate::diagnostic::Diagnostic;
 use crate::spec::{DEFAULT_RESISTANCE_ERROR, Param, angle_error_rad};
 
-/// The estimator design and its notes (warnings); `None` without a `[sensorless]`
-/// section. Without ψ_M or I_n the section is an error (the rules need both).
+/// The estimator design and its notes (warnings, each located at its key: the spec's
+/// value where it gives one, else the `[sensorless]` header); `None` without a
+/// `[sensorless]` section. Without ψ_M or I_n the section is an error (the rules need both).
 pub(in crate::design) fn sensorless(
     cx: &Context<'_>,
     per_unit: &PerUnitOut,
@@ -63,6 +64,22 @@ pub(in crate::design) fn sensorless(
         },
     };
     let (out, notes) = sensorless::design(&inp);
+    let notes: Vec<String> = notes
+        .into_iter()
+        .map(|(key, text)| {
+            let given = match key {
+                "sensorless.injection_frequency" => s.injection_frequency.as_ref(),
+                "sensorless.injection_voltage" => s.injection_voltage.as_ref(),
+                "sensorless.lowpass" => s.lowpass.as_ref(),
+                "motor.peak_current" => Some(&m.peak_current),
+                _ => None,
+            };
+            match given {
+                Some(p) => src.warning(p.span.clone(), &p.key, text),
+                None => src.warning(s.span.clone(), key, text),
+            }
+        })
+        .collect();
     if out.rho_rad_s > out.rho_max_rad_s * (1.0 + 1e-9)
         && let Some(p) = s.bandwidth.as_ref().or(s.max_acceleration.as_ref())
     {

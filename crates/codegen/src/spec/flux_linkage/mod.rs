@@ -24,6 +24,9 @@ pub struct FluxSource {
     pub written: String,
     /// ψ_M \[Wb\] by (2.34) or (6.11).
     pub flux_wb: f64,
+    /// Byte span of the value in the file (warnings about it are located there).
+    #[serde(skip)]
+    pub span: Range<usize>,
 }
 
 /// A motor constant in the spec's sections, identified before datasheet.
@@ -92,6 +95,7 @@ impl ResolveContext<'_> {
                 key: p.key.clone(),
                 written: "ψ_M".to_string(),
                 flux_wb: p.value,
+                span: p.span.clone(),
             });
         }
         let mut derived: Vec<(Param, usize)> = Vec::new();
@@ -105,6 +109,7 @@ impl ResolveContext<'_> {
                 key: key.to_string(),
                 written: written.clone(),
                 flux_wb: psi,
+                span: span.clone(),
             });
             derived.push((
                 Param {
