@@ -185,6 +185,8 @@ pub fn estimator_recovery(s: &Setup<'_>) -> ScenarioResult {
             reference: "thesis B §4.6",
             checks: vec![],
             traces: vec![],
+            reached_speed_rpm: None,
+            torque_speed: None,
         },
     }
 }
@@ -282,5 +284,7 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
         reference: "thesis B (4.7), (4.51), (4.76)–(4.83), Figs. 4.17, 4.18, App. D",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }

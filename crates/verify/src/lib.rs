@@ -18,7 +18,7 @@
 //! | [`scenarios`] | the current-loop scenarios and their criteria |
 //! | [`observer`] | the angle-observer scenarios: lock, run-up at the drive's acceleration, type-2 lag |
 //! | [`frequency`] | frequency responses of the discrete designs (for the report) |
-//! | [`field_weakening`] | field weakening to 2× base speed (thesis B Fig. 2.15) |
+//! | [`field_weakening`] | the torque stage (MTPA, field weakening, MTPV) up to `max_speed`, the torque–speed envelope (thesis B §2.3, Fig. 2.15) |
 //! | [`estimator`] | sensorless estimator recovery, cycle slips (thesis B Figs. 4.17, 4.18) |
 //! | [`report`] | the self-contained HTML report with SVG plots (`motorgen report`) |
 //!
@@ -105,6 +105,10 @@ pub struct ScenarioResult {
     pub checks: Vec<Check>,
     /// Signals for the report.
     pub traces: Vec<Trace>,
+    /// The speed the field-weakening ramp reached \[rpm\] (that scenario only).
+    pub reached_speed_rpm: Option<f64>,
+    /// The torque–speed curve with the designed envelope (the field-weakening scenario).
+    pub torque_speed: Option<field_weakening::TorqueSpeed>,
 }
 
 impl ScenarioResult {

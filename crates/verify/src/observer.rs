@@ -134,6 +134,8 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A (4.8)–(4.15), (4.19), (4.22)",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }
 
@@ -310,6 +312,8 @@ pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A §4.4 (4.12)–(4.15), (4.22); thesis B §4.4.2",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }
 
@@ -362,5 +366,7 @@ pub fn ato_type2(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A §4.4 (4.12)–(4.15), (4.22)",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }

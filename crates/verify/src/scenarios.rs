@@ -281,6 +281,8 @@ pub fn current_step(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A (5.8), (5.9), (5.14)–(5.16); thesis B (2.38)–(2.41)",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }
 
@@ -363,6 +365,8 @@ pub fn decoupling(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A (5.3), Figs. 5.4, 5.6",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }
 
@@ -475,5 +479,7 @@ pub fn dc_link_step(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A (5.1), Fig. 5.2, §4.6",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }

@@ -112,21 +112,22 @@ pub fn dq_plane_lines(d: &Design) -> (Vec<Line>, f64) {
     (lines, half)
 }
 
-/// The MTPA curve i_d(i_q) (thesis B (3.10), the field-weakening controller's own,
-/// for |i_q| ≤ i_max) and the (i_d, i_q) samples of the field-weakening run, if the
-/// motor has one.
+/// The MTPA curve i_d(i_q) (thesis B (3.10): the design's table, both signs of i_q, up to
+/// the MTPA point on the current circle) and the (i_d, i_q) samples of the
+/// field-weakening run, if the motor has one.
 pub fn field_weakening_lines(d: &Design, v: &Verification) -> Vec<Line> {
     let mut lines = Vec::new();
-    let Some(fw) = crate::field_weakening::field_weakening_config(d) else {
+    let Some(fw) = &d.field_weakening else {
         return lines;
     };
-    let i_max = d.motor.peak_current_a;
-    let n = 201;
-    let mtpa = (0..n)
-        .map(|k| {
-            let iq = i_max * (2.0 * k as f64 / (n - 1) as f64 - 1.0);
-            (f64::from(fw.mtpa.id(iq as f32)), iq)
-        })
+    let t = &fw.mtpa;
+    let mtpa = t
+        .iq_a
+        .iter()
+        .zip(&t.id_a)
+        .rev()
+        .map(|(&iq, &id)| (id, -iq))
+        .chain(t.iq_a.iter().zip(&t.id_a).map(|(&iq, &id)| (id, iq)))
         .collect();
     lines.push(("MTPA i_d(i_q) (3.10)".to_string(), mtpa));
     let run = v

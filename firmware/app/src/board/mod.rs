@@ -107,7 +107,7 @@ pub fn run() -> ! {
             match can_frame::decode_torque(frame.standard_id, frame.bytes()) {
                 Some(torque) => {
                     commissioning::torque_received(torque);
-                    publish_setpoint(can_frame::torque_to_iq(torque, config::IQ_PER_NM));
+                    publish_setpoint(torque);
                 }
                 None => commissioning::frame_received(frame.standard_id, frame.bytes()),
             }
