@@ -135,6 +135,12 @@ pub struct Soc {
     pub watchdog_reset: Option<f64>,
     /// The control interrupt's handler is running (set by the core).
     pub irq_active: bool,
+    /// The core executed WFI and sleeps until an enabled interrupt is pending (ARMv7-M
+    /// B1.5.18: WFI suspends execution until a wake-up event; an interrupt wakes it even
+    /// while PRIMASK masks it). The harness skips the time in between.
+    pub sleeping: bool,
+    /// Address of a WFI the code hook stopped at (it then resumes after it, asleep).
+    pub wfi_at: Option<u32>,
 }
 
 /// Which block an address belongs to.
@@ -229,6 +235,8 @@ impl Soc {
             tim1_cursor: [0; 2],
             watchdog_reset: None,
             irq_active: false,
+            sleeping: false,
+            wfi_at: None,
         };
         soc.update_clock();
         soc

@@ -118,5 +118,11 @@ pub fn run() -> ! {
             watchdog::refresh(&dp.IWDG);
             last = now;
         }
+        // Sleep until the next interrupt — the control interrupt, every carrier period
+        // (PM0214 §2.5.2, §3.11.12: WFI): the loop's work (one received frame, the
+        // transmissions, the watchdog) is once per period at most. A setpoint frame at
+        // 500 kbit/s takes ≥ 94 µs on the bus, longer than a period at f_s ≥ 10.6 kHz,
+        // and the RX FIFO holds three (RM0440 §44.3.3).
+        cortex_m::asm::wfi();
     }
 }
