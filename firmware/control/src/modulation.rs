@@ -75,8 +75,10 @@ pub fn thpwm<T: Trig + ?Sized>(u: AlphaBeta, u_dc: f32, inv_u_dc: f32, trig: &mu
 /// `period`, each in `0..=period`.
 pub fn compare_values(duties: [f32; 3], period: u16) -> [u16; 3] {
     let p = f32::from(period);
-    // `as u16` saturates (NaN → 0); `min` keeps rounding from exceeding the period.
-    duties.map(|d| ((unit(d) * p + 0.5) as u16).min(period))
+    // `as u16` saturates (NaN and negatives → 0, beyond 65 535 → 65 535) and `min` keeps
+    // the result within the period: the same as saturating the duty to [0, 1] first,
+    // without doing it twice (`duties` already has).
+    duties.map(|d| ((d * p + 0.5) as u16).min(period))
 }
 
 /// The auto-reload of a centre-aligned (up/down) carrier at `switching_hz` from a

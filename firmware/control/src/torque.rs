@@ -161,6 +161,17 @@ impl Default for TorqueState {
     }
 }
 
+/// The smaller of `a` and `b` by one comparison (`f32::min` is a library call on the
+/// Cortex-M4F, whose FPv4 has no VMINNM); `a` if either is NaN.
+fn lesser(a: f32, b: f32) -> f32 {
+    if b < a { b } else { a }
+}
+
+/// The larger of `a` and `b` by one comparison (see [`lesser`]); `a` if either is NaN.
+fn greater(a: f32, b: f32) -> f32 {
+    if b > a { b } else { a }
+}
+
 impl TorqueConfig {
     /// The stage off: every torque gives zero current (ψ_M unknown).
     pub const OFF: Self = Self::from_parameters(&TorqueParameters {
@@ -213,7 +224,7 @@ impl TorqueConfig {
     /// γ (2.60) \[A/(V²·s)\] at electrical speed `omega` and limit `v_max_prime`;
     /// 0 when any factor is not positive and finite.
     pub fn gain(&self, omega: f32, v_max_prime: f32) -> f32 {
-        let w_fw = libm::fabsf(omega).max(self.base_speed);
+        let w_fw = greater(self.base_speed, libm::fabsf(omega));
         let den = 2.0 * w_fw * self.ld * v_max_prime;
         let g = self.bandwidth / den;
         if den > 0.0 && g.is_finite() && g > 0.0 { g } else { 0.0 }
@@ -278,12 +289,12 @@ impl TorqueConfig {
         }
         if self.mtpv && (state.iq_cut > 0.0 || (state.on_mtpv && step < 0.0)) {
             // Mode C: the voltage error moves i_q^ref along the MTPV line.
-            state.iq_cut = (state.iq_cut - step * self.cut_gain).max(0.0).min(i_max);
+            state.iq_cut = lesser(greater(state.iq_cut - step * self.cut_gain, 0.0), i_max);
         } else {
             state.id_ref += step;
         }
         // (2.56): the MTPA curve of the demanded torque above, −I_max below.
-        state.id_ref = state.id_ref.min(self.mtpa_id(t)).max(-i_max);
+        state.id_ref = greater(lesser(state.id_ref, self.mtpa_id(t)), -i_max);
         let mut id = state.id_ref;
         // Mode A: the demanded torque on the constant-torque curve (2.33).
         let flux = self.psi_m - self.delta_l * id;
@@ -295,9 +306,9 @@ impl TorqueConfig {
         // Mode B (2.57): inside the current circle.
         let rest = i_max * i_max - id * id;
         let iq_circle = if rest > 0.0 { trig.sqrt(rest) } else { 0.0 };
-        let mut iq = iq_torque.min(iq_circle);
+        let mut iq = lesser(iq_torque, iq_circle);
         if self.mtpv {
-            iq = (iq - state.iq_cut).max(0.0);
+            iq = greater(iq - state.iq_cut, 0.0);
             let line = self.mtpv_id(trig, iq);
             // In Mode C (i_q lowered) the current moves along the line; otherwise the line is
             // the lower limit of i_d^ref.
