@@ -136,7 +136,7 @@ pub(in crate::design) fn field_weakening(
         };
         let fix = match need {
             Some(n) if n <= ceiling => format!(
-                "{how} {:.1} (α_fw ≥ {n:.0} rad/s), a smaller field_weakening.voltage_fraction (more margin), or a drive.max_acceleration of at most {:.0} rpm/s",
+                "{how} {:.1} (α_fw ≥ {n:.0} rad/s), a smaller field_weakening.voltage_fraction (more margin), or a drive.max_acceleration of at most {:.0} rpm/s (drive.application sets the default)",
                 if rule == BandwidthRule::DefaultSpeedLoop {
                     10.0 * n
                 } else {
@@ -145,7 +145,7 @@ pub(in crate::design) fn field_weakening(
                 a_max * 30.0 / PI
             ),
             _ => format!(
-                "a smaller field_weakening.voltage_fraction (more margin), a faster current loop, or a drive.max_acceleration of at most {:.0} rpm/s",
+                "a smaller field_weakening.voltage_fraction (more margin), a faster current loop, or a drive.max_acceleration of at most {:.0} rpm/s (drive.application sets the default)",
                 a_max * 30.0 / PI
             ),
         };
