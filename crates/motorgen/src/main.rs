@@ -107,6 +107,10 @@ enum Command {
         /// The motor spec.
         #[arg(value_name = "SPEC")]
         spec: PathBuf,
+        /// Output format: the pass/fail table, or every scenario's criteria and verdict as
+        /// JSON (for CI pipelines).
+        #[arg(long, value_enum, default_value_t = verify::VerifyFormat::Text)]
+        format: verify::VerifyFormat,
     },
     /// Write a self-contained HTML report (verification table, SVG plots, every constant
     /// with formula and provenance) to DIR/STEM.html (exit 3 if a figure fails).
@@ -390,7 +394,7 @@ fn run(command: Command) -> Result<(), Failure> {
             });
             firmware::run(which, &motors, &board, &boards)
         }
-        Command::Verify { spec } => verify::run(&spec),
+        Command::Verify { spec, format } => verify::run(&spec, format),
         Command::Report { spec, out } => report::run(&spec, &out),
         Command::Identify { what } => identify::run(what),
         Command::Capture {

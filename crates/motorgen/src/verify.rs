@@ -6,12 +6,29 @@ use std::path::Path;
 use crate::exit::{Exit, Failure};
 use crate::output::out;
 
-/// Reads, designs and verifies `spec`; prints the table. A bad spec is bad input (with
-/// the located message), a failing scenario a failed verification.
-pub fn run(spec: &Path) -> Result<(), Failure> {
+/// How `verify` prints its verdict.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum VerifyFormat {
+    /// The pass/fail table.
+    Text,
+    /// Every scenario with its criteria (name, measured, designed, limit, unit, pass) and
+    /// its verdict, as JSON (`motor_verify::VerificationJson`).
+    Json,
+}
+
+/// Reads, designs and verifies `spec`; prints the table or the JSON verdict. A bad spec is
+/// bad input (with the located message), a failing scenario a failed verification.
+pub fn run(spec: &Path, format: VerifyFormat) -> Result<(), Failure> {
     let text = crate::read_spec(spec)?;
     let (_, v) = motor_verify::verify_source(&spec.display().to_string(), &text)?;
-    out!("{}", v.table());
+    match format {
+        VerifyFormat::Text => out!("{}", v.table()),
+        VerifyFormat::Json => {
+            let json = serde_json::to_string_pretty(&v.json())
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot serialise the verdict: {e}")))?;
+            out!("{json}");
+        }
+    }
     if v.passed() {
         Ok(())
     } else {

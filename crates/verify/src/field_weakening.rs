@@ -391,6 +391,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             quantity: "speed the ramp reached".into(),
             measured: reached,
             designed: Some(rpm(top)),
+            limit: Some(0.999 * rpm(top)),
             unit: "rpm",
             criterion: "≥ motor.max_speed (99.9 %: the imposed ramp's last period)".into(),
             pass: reached >= 0.999 * rpm(top),
@@ -399,6 +400,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             quantity: "peak |v| on the ramp".into(),
             measured: peak_v,
             designed: Some(v_prime),
+            limit: Some(0.5 * (v_prime + v_max_design)),
             unit: "V",
             criterion: format!(
                 "≤ (V'_max + V_max)/2 = {} (V_max = {}: the margin is never used up, Fig. 2.15)",
@@ -411,6 +413,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             quantity: format!("|v| at {}", format_value(rpm(top), "rpm")),
             measured: v_end,
             designed: Some(v_prime),
+            limit: Some(1.02 * v_prime),
             unit: "V",
             criterion: if top_region == Region::Mtpa {
                 "≤ 1.02·V'_max (the envelope is current-limited there)".into()
@@ -423,6 +426,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             quantity: "peak |i|".into(),
             measured: peak_i,
             designed: Some(i_max),
+            limit: Some(1.05 * i_max),
             unit: "A",
             criterion: "≤ 1.05·I_max (current circle 2.50, 2.57)".into(),
             pass: peak_i <= 1.05 * i_max,
@@ -431,6 +435,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             quantity: format!("torque at {}", format_value(rpm(top), "rpm")),
             measured: torque_end,
             designed: Some(t_max),
+            limit: Some(0.95 * t_max),
             unit: "N·m",
             criterion: "≥ 95 % of the envelope there (the most |i| ≤ I_max and |v| ≤ V'_max allow)".into(),
             pass: torque_end >= 0.95 * t_max,
@@ -442,6 +447,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             ),
             measured: if worst.0.is_finite() { 100.0 * worst.0 } else { 100.0 },
             designed: Some(100.0),
+            limit: Some(90.0),
             unit: "%",
             criterion: "≥ 90 % at every envelope speed the ramp passes".into(),
             pass: !worst.0.is_finite() || worst.0 >= 0.9,
@@ -454,6 +460,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             ),
             measured: peak_angle.to_degrees(),
             designed: Some(d.angle_observer.lag_at_max_acceleration_deg),
+            limit: Some(d.angle_observer.max_lag_deg),
             unit: "°",
             criterion: format!(
                 "≤ θ̃ = {}° (the design's field-orientation allowance, thesis B §4.4.2)",
@@ -465,6 +472,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
             quantity: "peak |i_dq − i_dq^ref| during and after the ramp".into(),
             measured: peak_err,
             designed: Some(bound),
+            limit: Some(bound),
             unit: "A",
             criterion: format!(
                 "≤ 2·sin(φ/2)·|i^ref|max ({}, φ = acos 0.95) + |di^ref/dt|max·τ_v ({} · {}) + ripple ({})",

@@ -145,6 +145,34 @@ pub fn field_weakening_lines(d: &Design, v: &Verification) -> Vec<Line> {
     lines
 }
 
+/// The run's torque over speed and the envelope, one line per region (each starting at the
+/// last point of the region before it, so the envelope is drawn unbroken).
+pub fn torque_speed_lines(ts: &crate::field_weakening::TorqueSpeed) -> Vec<Line> {
+    use crate::field_weakening::Region;
+    let e = &ts.envelope;
+    let mut lines = vec![(
+        "simulated run".to_string(),
+        ts.speed_rpm.iter().copied().zip(ts.torque_nm.iter().copied()).collect(),
+    )];
+    for (region, label) in [
+        (Region::Mtpa, "envelope: MTPA (current limit)"),
+        (
+            Region::VoltageLimited,
+            "envelope: voltage-limited, current circle (Mode B)",
+        ),
+        (Region::Mtpv, "envelope: maximum torque per volt"),
+    ] {
+        let pts: Vec<(f64, f64)> = (0..e.region.len())
+            .filter(|&k| e.region[k] == region || (k + 1 < e.region.len() && e.region[k + 1] == region))
+            .map(|k| (e.speed_rpm[k], e.torque_nm[k]))
+            .collect();
+        if pts.len() > 1 {
+            lines.push((label.to_string(), pts));
+        }
+    }
+    lines
+}
+
 /// Electrical speed [rad/s] at which the voltage ellipse passes through (0, i_max):
 /// ω = V_max/√(ψ_M² + (L_q·i_max)²) (thesis B (2.53) with i_d = 0, |i_q| = i_max).
 pub fn corner_speed(d: &Design) -> f64 {
@@ -271,6 +299,17 @@ pub fn plots_of(d: &Design, v: &Verification) -> Result<Vec<Plot>, String> {
         caption,
         svg: plots::plane_chart("dq plane", "i_d [A]", "i_q [A]", &lines, half)?,
     });
+    if let Some(ts) = v.scenarios.iter().find_map(|x| x.torque_speed.as_ref()) {
+        out.push(Plot {
+            id: "torque-speed".into(),
+            section: "field-weakening",
+            caption: format!(
+                "Torque versus speed: the field-weakening run under {} (the image's torque stage on the simulated machine) against the designed envelope, the most torque within |i| ≤ I_max and |v| ≤ V'_max at each speed — current-limited on the MTPA point (3.10), voltage-limited on the current circle (Mode B, (2.57)), maximum torque per volt inside it",
+                format_value(ts.commanded_nm, "N·m")
+            ),
+            svg: plots::line_chart("Torque–speed", "n [rpm]", "T [N·m]", &torque_speed_lines(ts))?,
+        });
+    }
     for (section, id) in [
         ("field-weakening", "field_weakening"),
         ("sensorless", "estimator_recovery"),
