@@ -85,9 +85,12 @@ impl Cordic {
     /// the exponent range.
     pub fn self_test(&mut self) -> bool {
         let close = |a: i32, b: i32| a.abs_diff(b) <= hw::CORDIC_TOLERANCE_LSB;
-        let roots = [2.0f32, 0.5, 3.0e-7, 12_345.678, 8.1e9]
-            .iter()
-            .all(|&x| self.sqrt(x).to_bits() == SoftTrig.sqrt(x).to_bits());
+        // 2, 0.5 and, as bit patterns (no decimal literals in the firmware, literals.rs),
+        // 3.0e-7, 12 345.678 and 8.1e9: small, odd-mantissa and large arguments.
+        let roots = [2.0f32, 0.5]
+            .into_iter()
+            .chain([0x34A1_0FB0u32, 0x4640_E6B6, 0x4FF1_6618].map(f32::from_bits))
+            .all(|x| self.sqrt(x).to_bits() == SoftTrig.sqrt(x).to_bits());
         roots
             && (0..8i32).all(|k| {
                 let theta = (k << 29).wrapping_add(1 << 28);
