@@ -1,6 +1,7 @@
 //! The real image on the emulated G474, one test binary: boot, protection, CAN and the
 //! closed loop, on every motor in `motors/` (README, "Scenarios").
 
+mod at_speed;
 mod boot;
 mod can;
 mod closed_loop;
