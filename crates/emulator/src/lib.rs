@@ -176,7 +176,6 @@ impl Machine {
             if wfi && !soc.irq_active {
                 soc.wfi_at = Some(addr as u32);
                 let _ = uc.emu_stop();
-                return;
             }
         })
         .map_err(uc_err)?;

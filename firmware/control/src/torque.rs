@@ -236,7 +236,8 @@ impl TorqueConfig {
         let last = MTPA_POINTS - 1;
         let x = t * self.mtpa_per_torque;
         let top = self.mtpa_id.get(last).copied().unwrap_or(0.0);
-        if !(x < last as f32) {
+        // Beyond the grid, and NaN (a torque that is no number), the table's end.
+        if x >= last as f32 || x.is_nan() {
             return top;
         }
         // 0 ≤ x < 16: the truncation is the interval, k + 1 ≤ 16.

@@ -5,7 +5,10 @@
 //! `current_step`'s own criteria (`motor_verify::scenarios::current_step_checks`).
 //!
 //! The d-axis step of `current_step` has no counterpart here: over CAN the image takes a
-//! torque, and runs i_d = 0.
+//! torque. Its torque stage (issue 30) puts a torque on the MTPA curve (3.10): on a salient
+//! motor (chalmers-hev50, amk-dd5-ipm) the q-axis step is then the MTPA point's i_q for
+//! the frame's torque (i_d < 0 adds reluctance torque, so less than T/K_t), found here by
+//! bisection along codegen's MTPA point on a circle; on the others T/K_t.
 //!
 //! A design without a torque constant (unimotor-142umd300: no ψ_M in its spec, so
 //! `iq_per_nm` is 0 and `motorgen check` warns) turns every torque into i_q = 0: it
@@ -32,6 +35,28 @@ const SLACK_PERIODS: f64 = 2.0;
 
 /// The rig with the closed-loop drive, booted and settled at zero torque, and the spec
 /// (for `verify`'s `Setup`: the same machine model).
+/// i_q \[A\] of the MTPA point (3.10) that makes `torque` \[N·m\] by (2.33): the circle
+/// radius bisected until `mtpa_corner`'s point makes it (T/K_t without saliency).
+fn mtpa_iq(d: &codegen::design::Design, torque: f64, iq_per_nm: f64) -> f64 {
+    let m = &d.motor;
+    let (psi, dl) = (m.flux_linkage_wb.unwrap_or(0.0), m.q_inductance_h - m.d_inductance_h);
+    if dl == 0.0 || psi <= 0.0 {
+        return torque * iq_per_nm;
+    }
+    let np = f64::from(m.pole_pairs);
+    let point = |i: f64| codegen::design::loss_minimisation::mtpa_corner(psi, dl, i);
+    let made = |i: f64| {
+        let (id, iq) = point(i);
+        1.5 * np * iq * (psi - dl * id)
+    };
+    let (mut lo, mut hi) = (0.0, 2.0 * torque * iq_per_nm);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if made(mid) < torque { lo = mid } else { hi = mid }
+    }
+    point(0.5 * (lo + hi)).1
+}
+
 fn closed_loop(motor: &str) -> (Rig, codegen::spec::Spec) {
     let spec = wiring::spec(motor).unwrap_or_else(|e| panic!("{motor}: {e}"));
     let mut rig = Rig::with_analog(motor, Patches::default(), |d| {
@@ -102,7 +127,7 @@ fn current_step_through_a_can_torque_setpoint_meets_verifys_criteria() {
         let a = step_amplitude(&setup);
         let frame = rig.setpoint(a / iq_per_nm);
         let raw = i16::from_le_bytes([frame.data[0], frame.data[1]]);
-        let target = f64::from(raw) * board.torque_resolution_nm * iq_per_nm;
+        let target = mtpa_iq(&design, f64::from(raw) * board.torque_resolution_nm, iq_per_nm);
         let at = step_torque(
             &mut rig,
             &motor,
