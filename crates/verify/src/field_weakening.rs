@@ -82,7 +82,7 @@ fn largest_iq(m: &MotorModel, w: f64, i_max: f64, v_max: f64, id: f64) -> Option
 /// The largest torque [N·m] at speed `w` with |i| ≤ `i_max` (2.50) and the steady-state
 /// |v| ≤ `v_max` (2.52), on the simulated machine's own L_q(i_q), and its current (i_d,
 /// i_q) \[A\]: a search over i_d ∈ [−I_max, I_max] (401 points, then 401 more within one
-/// step of the best) with the largest feasible i_q at each ([`largest_iq`]).
+/// step of the best) with the largest feasible i_q at each (`largest_iq`).
 pub fn max_torque_point(m: &MotorModel, w: f64, i_max: f64, v_max: f64) -> (f64, f64, f64) {
     let point = |id: f64| largest_iq(m, w, i_max, v_max, id).map(|iq| (torque(m, id, iq), id, iq));
     let best_of = |ids: &mut dyn Iterator<Item = f64>, best: (f64, f64, f64)| {

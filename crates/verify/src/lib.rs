@@ -206,7 +206,7 @@ pub struct CriterionJson {
     pub measured: f64,
     /// The designed value, in `unit`, if the design predicts one.
     pub designed: Option<f64>,
-    /// The criterion's bound ([`Check::limit`]).
+    /// The criterion's bound (`Check::limit`).
     pub limit: Option<f64>,
     /// Unit of `measured`, `designed`, `limit`.
     pub unit: &'static str,
