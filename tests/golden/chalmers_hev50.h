@@ -272,6 +272,15 @@ static const float CHALMERS_HEV50_FIELD_WEAKENING_MTPA_ID_A[CHALMERS_HEV50_FIELD
  *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10). */
 static const float CHALMERS_HEV50_FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.23175603f;
 
+/** 128.614 N·m: T_max = 3/2·n_p·i_q·(ψ_M − ΔL·i_d) at the MTPA point on |i| = I_max: the end of the torque grid of MTPA_ID_BY_TORQUE_A, thesis A (2.33), thesis B (3.10), (2.50).
+ *  Inputs: n_p = 2, the MTPA point (-158.664 A, 274.185 A). */
+static const float CHALMERS_HEV50_FIELD_WEAKENING_MTPA_TORQUE_MAX_NM = 128.61426f;
+
+/** 17 points, -3.71116e-59 A … -158.664 A at 0 … 128.614 N·m: i_d,MTPA at the torques k·T_max/16 (the point of (3.10) making the torque, by bisection on i_q): the firmware's torque stage interpolates it at the demanded torque and solves (2.33) for i_q, thesis B (3.10), (2.56); thesis A (2.33).
+ *  Inputs: ψ_M = 0.104 Wb, L_d = 0.00023 H, L_q = 0.00056 H; 17 points, |i_q| = 0 … 274.185 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0.231756 A at the interval midpoints against (3.10); linear interpolation costs at most 0.078 % of current over the MTPA (least) current at the interval midpoints. */
+#define CHALMERS_HEV50_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A_LEN 17
+static const float CHALMERS_HEV50_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A[CHALMERS_HEV50_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A_LEN] = {-0.0f, -2.065375f, -7.8271947f, -16.29551f, -26.460024f, -37.56153f, -49.106823f, -60.796684f, -72.455666f, -83.98343f, -95.32449f, -106.45014f, -117.347664f, -128.01387f, -138.45123f, -148.66553f, -158.66429f};
+
 /** 7 points, 0 … 1884.96 rad/s: uniform electrical-speed grid (rows of LOSS_MIN_ID_A), thesis B (3.8), (3.9).
  *  Inputs: core losses R_c = 24.5 Ω (spec losses.core_resistance), inverter losses (3.11)–(3.14) of [inverter]; R_s = 0.0079 Ω, ψ_M, L_d, L_q as above; 7 speeds 0 … 1884.96 rad/s (electrical) × the 17 MTPA |i_q| points, bilinear in between; max interpolation error 10.8997 A at the cell centres and edge midpoints against the numeric optimum. */
 #define CHALMERS_HEV50_FIELD_WEAKENING_LOSS_MIN_SPEED_RAD_S_LEN 7

@@ -272,6 +272,15 @@ static const float FISCHER_TI085_FIELD_WEAKENING_MTPA_ID_A[FISCHER_TI085_FIELD_W
  *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10). */
 static const float FISCHER_TI085_FIELD_WEAKENING_MTPA_MAX_INTERPOLATION_ERROR_A = 0.0f;
 
+/** 31.2739 N·m: T_max = 3/2·n_p·i_q·(ψ_M − ΔL·i_d) at the MTPA point on |i| = I_max: the end of the torque grid of MTPA_ID_BY_TORQUE_A, thesis A (2.33), thesis B (3.10), (2.50).
+ *  Inputs: n_p = 4, the MTPA point (0 A, 86.267 A). */
+static const float FISCHER_TI085_FIELD_WEAKENING_MTPA_TORQUE_MAX_NM = 31.273909f;
+
+/** 17 points, 0 A … 0 A at 0 … 31.2739 N·m: i_d,MTPA at the torques k·T_max/16 (the point of (3.10) making the torque, by bisection on i_q): the firmware's torque stage interpolates it at the demanded torque and solves (2.33) for i_q, thesis B (3.10), (2.56); thesis A (2.33).
+ *  Inputs: ψ_M = 0.0604207 Wb, L_d = 0.000393 H, L_q = 0.000393 H; 17 points, |i_q| = 0 … 86.267 A (the MTPA point on |i| = I_max), linear in between, held beyond; max interpolation error 0 A at the interval midpoints against (3.10); linear interpolation costs at most 0.000 % of current over the MTPA (least) current at the interval midpoints. */
+#define FISCHER_TI085_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A_LEN 17
+static const float FISCHER_TI085_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A[FISCHER_TI085_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A_LEN] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+
 /* Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4). */
 
 /** 0 rad/s: ρ: estimator bandwidth, ρ ≤ α_c/10, thesis B (4.74), Table 4.1.

@@ -248,6 +248,15 @@ static const float UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_IQ_A[UNIMOTOR_142UMD3
 #define UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_ID_A_LEN 1
 static const float UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_ID_A[UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_ID_A_LEN] = {0.0f};
 
+/** 0 N·m: T_max of the MTPA table by torque, thesis A (2.33), thesis B (3.10).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+static const float UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_TORQUE_MAX_NM = 0.0f;
+
+/** 0 A: i_d = 0, thesis B (3.10).
+ *  Inputs: ψ_M unknown → 0 (field weakening off). */
+#define UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A_LEN 17
+static const float UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A[UNIMOTOR_142UMD300_FIELD_WEAKENING_MTPA_ID_BY_TORQUE_A_LEN] = {0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f, 0.0f};
+
 /* Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4). */
 
 /** 0 rad/s: ρ: estimator bandwidth, ρ ≤ α_c/10, thesis B (4.74), Table 4.1.

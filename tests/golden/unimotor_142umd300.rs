@@ -251,6 +251,16 @@ pub mod field_weakening {
     ///
     /// Inputs: ψ_M unknown → 0 (field weakening off).
     pub const MTPA_ID_A: [f32; 1] = [0.0];
+    /// 0 N·m: `T_max of the MTPA table by torque`, thesis A (2.33), thesis B (3.10).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const MTPA_TORQUE_MAX_NM: f32 = 0.0;
+    /// 0 A: `i_d = 0`, thesis B (3.10).
+    ///
+    /// Inputs: ψ_M unknown → 0 (field weakening off).
+    pub const MTPA_ID_BY_TORQUE_A: [f32; 17] = [
+        0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0,
+    ];
 }
 
 /// Sensorless estimator: PLL gains, signal injection, transition, resetting term (thesis B ch. 4).

@@ -476,7 +476,13 @@ mod tests {
                         let want = json
                             .pointer(&k.json_path)
                             .unwrap_or_else(|| panic!("{at}: no {} in the JSON design", k.json_path));
-                        let (got, want) = (numbers(&k.value.number), numbers(want));
+                        let got = numbers(&k.value.number);
+                        // A result the design does not have (null) stands for zeros, as many
+                        // as the constant has entries (the 17 MTPA points without ψ_M).
+                        let want = match want {
+                            serde_json::Value::Null => vec![0.0; got.len().max(1)],
+                            w => numbers(w),
+                        };
                         assert_eq!(got.len(), want.len(), "{at}: {got:?} but {} is {want:?}", k.json_path);
                         for (g, w) in got.iter().zip(&want) {
                             if k.value.c_type == "float" {

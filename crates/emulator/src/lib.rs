@@ -166,8 +166,12 @@ impl Machine {
             )
             .map_err(uc_err)?;
         }
-        // Time: one instruction per HCLK cycle; stop at the deadline.
-        uc.add_code_hook(1, 0, |uc: &mut Unicorn<'_, Soc>, addr: u64, _size: u32| {
+        // Time: one instruction per HCLK cycle; stop at the deadline, and at a WFI (Thumb
+        // encoding 0xBF30, ARMv7-M A7.7.261) outside a handler, whose sleep the harness
+        // skips (`run_while`).
+        uc.add_code_hook(1, 0, |uc: &mut Unicorn<'_, Soc>, addr: u64, size: u32| {
+            let mut op = [0u8; 2];
+            let wfi = size == 2 && uc.mem_read(addr, &mut op).is_ok() && u16::from_le_bytes(op) == 0xBF30;
             let soc = uc.get_data_mut();
             if soc.now + soc.cost > soc.deadline || soc.violation.is_some() {
                 let _ = uc.emu_stop();
@@ -176,6 +180,10 @@ impl Machine {
             soc.now += soc.cost;
             soc.instructions += 1;
             soc.pc = addr as u32;
+            if wfi && !soc.irq_active {
+                soc.wfi_at = Some(addr as u32);
+                let _ = uc.emu_stop();
+            }
         })
         .map_err(uc_err)?;
         let vectors: Vec<u32> = image.vectors.clone();
@@ -356,7 +364,14 @@ impl Machine {
             if self.uc.get_data().now >= end {
                 return Ok(false);
             }
+            let entered = self.handled.len() + self.active.len();
             self.take_exceptions()?;
+            let soc = self.uc.get_data_mut();
+            if self.handled.len() + self.active.len() != entered || soc.scs.active_irq().is_some() {
+                // An exception taken, or an interrupt pending that PRIMASK holds off, wakes
+                // a sleeping core (execution goes on after the WFI).
+                soc.sleeping = false;
+            }
             let mut next = self.uc.get_data_mut().next_event();
             // An enabled interrupt held off by PRIMASK is taken as soon as the core
             // clears it (CPSIE, ARMv7-M B1.5.4); the run stops every
@@ -368,10 +383,20 @@ impl Machine {
             }
             let soc = self.uc.get_data_mut();
             soc.deadline = next.min(end).max(soc.now + soc.cost);
+            if soc.sleeping {
+                // Asleep in WFI: nothing runs until the next event (an interrupt, or the
+                // end of this run, after which the test may act and the sleep goes on).
+                soc.now = soc.deadline.min(end).max(soc.now);
+                continue;
+            }
             let pc = self.reg(RegisterARM::PC)?;
             match self.uc.emu_start(u64::from(pc | 1), u64::from(EXC_RETURN & !1), 0, 0) {
                 Ok(()) => {
-                    if self.reg(RegisterARM::PC)? == EXC_RETURN & !1 {
+                    if let Some(at) = self.uc.get_data_mut().wfi_at.take() {
+                        // The WFI (a 16-bit instruction) is done: the core sleeps after it.
+                        self.reg_w(RegisterARM::PC, at + 2)?;
+                        self.uc.get_data_mut().sleeping = true;
+                    } else if self.reg(RegisterARM::PC)? == EXC_RETURN & !1 {
                         self.exit()?;
                     }
                 }

@@ -195,6 +195,12 @@ pub struct Soc {
     bridge_armed: bool,
     /// The switches as last analysed.
     pub switches: Option<[LegSwitches; 3]>,
+    /// The core executed WFI and sleeps until an enabled interrupt is pending (ARMv7-M
+    /// B1.5.18: WFI suspends execution until a wake-up event; an interrupt wakes it even
+    /// while PRIMASK masks it). The harness skips the time in between.
+    pub sleeping: bool,
+    /// Address of a WFI the code hook stopped at (it then resumes after it, asleep).
+    pub wfi_at: Option<u32>,
 }
 
 /// Which block an address belongs to.
@@ -311,6 +317,8 @@ impl Soc {
             sr_in_irq: None,
             bridge_armed: false,
             switches: None,
+            sleeping: false,
+            wfi_at: None,
         };
         soc.update_clock();
         soc

@@ -118,6 +118,10 @@ enum Command {
         /// as the image would run.
         #[arg(long, value_name = "BOARD_FILE")]
         board: Option<PathBuf>,
+        /// Output format: the pass/fail table, or every scenario's criteria and verdict as
+        /// JSON (for CI pipelines).
+        #[arg(long, value_enum, default_value_t = verify::VerifyFormat::Text)]
+        format: verify::VerifyFormat,
     },
     /// Write a self-contained HTML report (verification table, SVG plots, every constant
     /// with formula and provenance) to DIR/STEM.html (exit 3 if a figure fails).
@@ -477,7 +481,9 @@ fn run(command: Command) -> Result<(), Failure> {
             });
             firmware::run(which, &motors, &board, &boards)
         }
-        Command::Verify { spec, board } => verify::run(&locate(spec, "motors"), locate_board(board).as_deref()),
+        Command::Verify { spec, board, format } => {
+            verify::run(&locate(spec, "motors"), locate_board(board).as_deref(), format)
+        }
         Command::Report { spec, out } => report::run(&spec, &out),
         Command::Identify { what } => identify::run(what),
         Command::Capture {

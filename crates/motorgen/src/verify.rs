@@ -8,10 +8,20 @@ use std::path::Path;
 use crate::exit::{Exit, Failure};
 use crate::output::out;
 
+/// How `verify` prints its verdict.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum VerifyFormat {
+    /// The pass/fail table.
+    Text,
+    /// Every scenario with its criteria (name, measured, designed, limit, unit, pass) and
+    /// its verdict, as JSON (`motor_verify::VerificationJson`).
+    Json,
+}
+
 /// Reads, designs (on `board` if given) and verifies `spec`; prints the design's warnings
-/// (stderr) and the table. A bad spec or a pair that does not fit is bad input (with the
-/// located message), a failing scenario a failed verification.
-pub fn run(spec: &Path, board: Option<&Path>) -> Result<(), Failure> {
+/// (stderr) and the table or the JSON verdict. A bad spec or a pair that does not fit is
+/// bad input (with the located message), a failing scenario a failed verification.
+pub fn run(spec: &Path, board: Option<&Path>, format: VerifyFormat) -> Result<(), Failure> {
     let text = crate::read_spec(spec)?;
     let name = spec.display().to_string();
     let (d, v) = match board {
@@ -22,7 +32,14 @@ pub fn run(spec: &Path, board: Option<&Path>) -> Result<(), Failure> {
         None => motor_verify::verify_source(&name, &text)?,
     };
     crate::warn_design(&d);
-    out!("{}", v.table());
+    match format {
+        VerifyFormat::Text => out!("{}", v.table()),
+        VerifyFormat::Json => {
+            let json = serde_json::to_string_pretty(&v.json())
+                .map_err(|e| Failure::new(Exit::Io, format!("error: cannot serialise the verdict: {e}")))?;
+            out!("{json}");
+        }
+    }
     if v.passed() {
         Ok(())
     } else {

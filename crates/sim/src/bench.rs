@@ -27,6 +27,10 @@ pub struct Bench {
     pub plant: Plant,
     /// The DC-link voltage the ADC reports if frozen (a failed sensor), else the actual one.
     pub frozen_dc_link: Option<f64>,
+    /// Amplitude of the demodulated resolver SIN/COS the controller sees, as a fraction of
+    /// Q1.31 full scale (1 here; a board's front end may give less — the trig-identity
+    /// observer's gain scales with it, thesis A (4.10)).
+    pub resolver_amplitude: f64,
 }
 
 /// One recorded period.
@@ -61,6 +65,7 @@ impl Bench {
             state,
             plant,
             frozen_dc_link: None,
+            resolver_amplitude: 1.0,
         }
     }
 
@@ -81,8 +86,8 @@ impl Bench {
                 code(m.phase_currents[2], 2),
             ],
             resolver: ResolverSample {
-                sin: q(m.theta_r.sin()),
-                cos: q(m.theta_r.cos()),
+                sin: q(self.resolver_amplitude * m.theta_r.sin()),
+                cos: q(self.resolver_amplitude * m.theta_r.cos()),
             },
             dc_link: (f64::from(ds.offset) + u_dc / f64::from(ds.volts_per_lsb))
                 .round()

@@ -8,6 +8,7 @@
 use motor_control::angle::to_radians_f64;
 use motor_control::pi::PiConfig;
 use motor_control::step::{ControllerConfig, ControllerParameters};
+use motor_control::torque::{MTPA_POINTS, TorqueParameters};
 
 use codegen::design::Design;
 use codegen::design::current_loop::AxisGains;
@@ -81,6 +82,52 @@ pub fn controller_parameters(d: &Design) -> ControllerParameters {
         psi_m: cl.feedforward.flux_linkage_wb.unwrap_or(0.0) as f32,
         dc_link_min: d.drive.dc_link_voltage_min_v as f32,
         pwm_period: d.drive.pwm_period,
+        torque: torque_parameters(d),
+    }
+}
+
+/// The torque stage's parameters of `d` (`motor_control::torque`), the values the
+/// generated constants carry and the firmware's `motor_config::config::TORQUE` reads:
+/// n_p, ψ_M and L_q as the feed-forward has them (`current_loop::FF_PSI`, `FF_LQ`),
+/// and the field-weakening design's L̂_d, α_fw, ω_base, V'_max/V_max, I_max and MTPA
+/// table by torque (thesis B §2.3, (3.10)); all zero without ψ_M (the stage is off).
+pub fn torque_parameters(d: &Design) -> TorqueParameters {
+    let ff = &d.current_loop.feedforward;
+    let sample_period = d.drive.sample_period_s as f32;
+    let pole_pairs = d.angle_observer.motor_pole_pairs;
+    match &d.field_weakening {
+        Some(fw) => {
+            let mut mtpa_id = [0.0f32; MTPA_POINTS];
+            for (x, &id) in mtpa_id.iter_mut().zip(&fw.mtpa_by_torque.id_a) {
+                *x = id as f32;
+            }
+            TorqueParameters {
+                sample_period,
+                pole_pairs,
+                psi_m: ff.flux_linkage_wb.unwrap_or(0.0) as f32,
+                ld: fw.d_inductance_h as f32,
+                lq: ff.q_inductance_h as f32,
+                bandwidth: fw.bandwidth_rad_s as f32,
+                base_speed: fw.base_speed_rad_s as f32,
+                voltage_fraction: fw.voltage_fraction as f32,
+                current_max: fw.current_max_a as f32,
+                mtpa_torque_max: fw.mtpa_by_torque.torque_nm.last().copied().unwrap_or(0.0) as f32,
+                mtpa_id,
+            }
+        }
+        None => TorqueParameters {
+            sample_period,
+            pole_pairs,
+            psi_m: 0.0,
+            ld: 0.0,
+            lq: ff.q_inductance_h as f32,
+            bandwidth: 0.0,
+            base_speed: 0.0,
+            voltage_fraction: 0.0,
+            current_max: 0.0,
+            mtpa_torque_max: 0.0,
+            mtpa_id: [0.0; MTPA_POINTS],
+        },
     }
 }
 

@@ -185,6 +185,8 @@ pub fn estimator_recovery(s: &Setup<'_>) -> ScenarioResult {
             reference: "thesis B §4.6",
             checks: vec![],
             traces: vec![],
+            reached_speed_rpm: None,
+            torque_speed: None,
         },
     }
 }
@@ -211,6 +213,7 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
             quantity: format!("cycle slips with the resetting term (without: {})", without.slips),
             measured: with.slips as f64,
             designed: Some(0.0),
+            limit: Some(0.0),
             unit: "",
             criterion: "0 (Fig. 4.18)".into(),
             pass: with.slips == 0,
@@ -222,6 +225,7 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
             ),
             measured: t_with * 1e3,
             designed: None,
+            limit: Some(t_without * 1e3),
             unit: "ms",
             criterion: "shorter than without the resetting term (Figs. 4.17 vs 4.18)".into(),
             pass: t_with < t_without,
@@ -230,6 +234,7 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
             quantity: "final angle error".into(),
             measured: final_err.to_degrees(),
             designed: Some(0.0),
+            limit: Some(angle_limit.to_degrees()),
             unit: "°",
             criterion: format!(
                 "≤ θ̃max = {:.0}° (sensorless.max_angle_error, thesis B §4.4.2)",
@@ -282,5 +287,7 @@ pub fn run(s: &Setup<'_>, c: &EstimatorConfig) -> ScenarioResult {
         reference: "thesis B (4.7), (4.51), (4.76)–(4.83), Figs. 4.17, 4.18, App. D",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }

@@ -18,7 +18,7 @@
 //! | [`scenarios`] | the current-loop scenarios and their criteria |
 //! | [`observer`] | the angle-observer scenarios: lock, run-up at the drive's acceleration, type-2 lag |
 //! | [`frequency`] | frequency responses of the discrete designs (for the report) |
-//! | [`field_weakening`] | field weakening to 2× base speed (thesis B Fig. 2.15) |
+//! | [`field_weakening`] | the torque stage (MTPA, field weakening, MTPV) up to `max_speed`, the torque–speed envelope (thesis B §2.3, Fig. 2.15) |
 //! | [`estimator`] | sensorless estimator recovery, cycle slips (thesis B Figs. 4.17, 4.18) |
 //! | [`report`] | the self-contained HTML report with SVG plots (`motorgen report`) |
 //!
@@ -54,6 +54,11 @@ pub struct Check {
     pub measured: f64,
     /// Designed (predicted) value, in `unit`, where the design predicts one.
     pub designed: Option<f64>,
+    /// The criterion's bound, in `unit`: the largest passing value of a "≤" criterion, the
+    /// smallest of a "≥" one, the upper end of a band around the designed value; `None`
+    /// where the criterion is not a bound on the measured value (a count that must be 0 is
+    /// the bound 0).
+    pub limit: Option<f64>,
     /// Display unit of `measured` and `designed`.
     pub unit: &'static str,
     /// The pass criterion in words, e.g. "within 10 % of designed".
@@ -105,6 +110,10 @@ pub struct ScenarioResult {
     pub checks: Vec<Check>,
     /// Signals for the report.
     pub traces: Vec<Trace>,
+    /// The speed the field-weakening ramp reached \[rpm\] (that scenario only).
+    pub reached_speed_rpm: Option<f64>,
+    /// The torque–speed curve with the designed envelope (the field-weakening scenario).
+    pub torque_speed: Option<field_weakening::TorqueSpeed>,
 }
 
 impl ScenarioResult {
@@ -185,6 +194,99 @@ impl Verification {
             if failed == 0 { "" } else { " — FAILED" }
         );
         s
+    }
+}
+
+/// One criterion in [`Verification::json`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CriterionJson {
+    /// What is measured ([`Check::quantity`]).
+    pub name: String,
+    /// The measured value, in `unit` (null if not finite).
+    pub measured: f64,
+    /// The designed value, in `unit`, if the design predicts one.
+    pub designed: Option<f64>,
+    /// The criterion's bound (`Check::limit`).
+    pub limit: Option<f64>,
+    /// Unit of `measured`, `designed`, `limit`.
+    pub unit: &'static str,
+    /// Whether it holds.
+    pub pass: bool,
+    /// The criterion in words.
+    pub criterion: String,
+}
+
+/// One scenario in [`Verification::json`].
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ScenarioJson {
+    /// Its identifier ([`ScenarioResult::id`]).
+    pub name: &'static str,
+    /// Whether every criterion holds.
+    pub passed: bool,
+    /// Title with the operating point.
+    pub title: String,
+    /// Where the criteria come from.
+    pub reference: &'static str,
+    /// The criteria.
+    pub criteria: Vec<CriterionJson>,
+    /// The field-weakening scenario: the speed its ramp reached \[rpm\].
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reached_speed_rpm: Option<f64>,
+}
+
+/// The verdict in the form `motorgen verify --format json` prints.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VerificationJson {
+    /// 1; raised when a key is removed or renamed or changes meaning.
+    pub schema_version: u32,
+    /// Motor name.
+    pub motor: String,
+    /// Spec file.
+    pub spec_file: String,
+    /// The plant's terms.
+    pub plant_model: String,
+    /// Whether every scenario passed.
+    pub passed: bool,
+    /// The scenarios that applied, in order.
+    pub scenarios: Vec<ScenarioJson>,
+}
+
+impl Verification {
+    /// The verdict as data: every scenario with its criteria (name, measured, designed,
+    /// limit, unit, pass) and its verdict; for the field-weakening scenario the speed its
+    /// ramp reached.
+    pub fn json(&self) -> VerificationJson {
+        VerificationJson {
+            schema_version: 1,
+            motor: self.motor.clone(),
+            spec_file: self.spec_file.clone(),
+            plant_model: self.plant_model.clone(),
+            passed: self.passed(),
+            scenarios: self
+                .scenarios
+                .iter()
+                .map(|sc| ScenarioJson {
+                    name: sc.id,
+                    passed: sc.passed(),
+                    title: sc.title.clone(),
+                    reference: sc.reference,
+                    criteria: sc
+                        .checks
+                        .iter()
+                        .map(|c| CriterionJson {
+                            name: c.quantity.clone(),
+                            measured: c.measured,
+                            designed: c.designed,
+                            limit: c.limit,
+                            unit: c.unit,
+                            pass: c.pass,
+                            criterion: c.criterion.clone(),
+                        })
+                        .collect(),
+                    reached_speed_rpm: sc.reached_speed_rpm,
+                })
+                .collect(),
+        }
     }
 }
 
@@ -380,6 +482,7 @@ pub fn diverged_fails(mut r: ScenarioResult) -> ScenarioResult {
             quantity: "simulation stays finite".into(),
             measured: (bad + samples) as f64,
             designed: Some(0.0),
+            limit: Some(0.0),
             unit: "values",
             criterion: format!(
                 "every figure and signal finite: the simulation diverged ({bad} figures, {samples} samples not finite)"

@@ -84,11 +84,14 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
             Some(designed * 1e3),
             "ms",
         )
+        .limit(1.25 * designed * 1e3)
         .criterion(
             "locks within 1.25× the linear design",
             lock.is_some_and(|t| t <= 1.25 * designed),
         ),
-        check("cycle slips", slips, Some(0.0), "").criterion("0", slips == 0.0),
+        check("cycle slips", slips, Some(0.0), "")
+            .limit(0.0)
+            .criterion("0", slips == 0.0),
     ];
     let t: Vec<f64> = (0..n).map(|k| k as f64 * ts).collect();
     let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<_>>();
@@ -134,6 +137,8 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A (4.8)–(4.15), (4.19), (4.22)",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }
 
@@ -241,6 +246,7 @@ pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
             Some(lag_design.to_degrees()),
             "°",
         )
+        .limit((1.1 * lag_design + 2.0 * dead).to_degrees())
         .criterion(
             format!(
                 "within 10 % of designed + 2× the integer dead zone ({}) (type-2 loop: sin Δ = n_r·ω̇_m/K_i)",
@@ -254,6 +260,7 @@ pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
             Some(lag_design.to_degrees() * f64::from(o.motor_pole_pairs) / nr),
             "°",
         )
+        .limit(o.max_lag_deg)
         .criterion(
             format!(
                 "≤ {}° electrical: field orientation (thesis B §4.4.2; the design's allowance)",
@@ -270,6 +277,7 @@ pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
             Some(0.0),
             "°",
         )
+        .limit((2.0 * dead).to_degrees())
         .criterion(
             format!(
                 "zero: ≤ 2× the Q1.31 integral dead zone ({})",
@@ -277,10 +285,12 @@ pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
             ),
             e_ss <= 2.0 * dead,
         ),
-        check("speed error at constant speed", w_err, Some(0.0), "rad/s").criterion(
-            format!("≤ 0.1 % of ω_r,max ({})", format_value(1e-3 * nr * w_max, "rad/s")),
-            w_err.abs() <= 1e-3 * nr * w_max,
-        ),
+        check("speed error at constant speed", w_err, Some(0.0), "rad/s")
+            .limit(1e-3 * nr * w_max)
+            .criterion(
+                format!("≤ 0.1 % of ω_r,max ({})", format_value(1e-3 * nr * w_max, "rad/s")),
+                w_err.abs() <= 1e-3 * nr * w_max,
+            ),
     ];
     let deg = |v: &[f64]| v.iter().map(|x| x.to_degrees()).collect::<Vec<_>>();
     let traces = vec![
@@ -310,6 +320,8 @@ pub fn ato_ramp(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A §4.4 (4.12)–(4.15), (4.22); thesis B §4.4.2",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }
 
@@ -342,6 +354,7 @@ pub fn ato_type2(s: &Setup<'_>) -> ScenarioResult {
             Some(lag_design.to_degrees()),
             "°",
         )
+        .limit(1.1 * lag_design.to_degrees())
         .criterion(
             "within 10 % of designed (type-2 loop: sin Δ = a/K_i)",
             (lag / lag_design - 1.0).abs() <= 0.10,
@@ -362,5 +375,7 @@ pub fn ato_type2(s: &Setup<'_>) -> ScenarioResult {
         reference: "thesis A §4.4 (4.12)–(4.15), (4.22)",
         checks,
         traces,
+        reached_speed_rpm: None,
+        torque_speed: None,
     }
 }

@@ -18,12 +18,6 @@ pub fn decode_torque(standard_id: Option<u16>, data: &[u8]) -> Option<f32> {
     Some(f32::from(raw) * board::TORQUE_PER_LSB_NM)
 }
 
-/// q-axis current reference \[A\] for a torque \[N·m\], i_q = T/K_t (2.34) with the
-/// generated `IQ_PER_NM` (i_d = 0; the setpoint supervision limits it).
-pub fn torque_to_iq(torque_nm: f32, iq_per_nm: f32) -> f32 {
-    torque_nm * iq_per_nm
-}
-
 /// A received classic-CAN frame as the FDCAN stores it in an RX FIFO element
 /// (RM0440 §44.3.3, "Rx FIFO element"): word 0 holds XTD (bit 30) and the standard
 /// identifier (bits 28:18), word 1 the DLC (bits 19:16), words 2–3 the data bytes
@@ -128,12 +122,5 @@ mod tests {
             Some(board::CAN_BIT_RATE),
             "the generated timing makes the board's rate"
         );
-    }
-
-    /// Fischer: K_t = 3/2·n_p·ψ_M = 6·0.060421 = 0.36252 N·m/A → 10 N·m needs 27.584 A.
-    #[test]
-    fn torque_to_current() {
-        let iq_per_nm = 1.0 / (1.5 * 4.0 * 0.060_420_75);
-        assert!((torque_to_iq(10.0, iq_per_nm) - 27.584).abs() < 1e-3);
     }
 }

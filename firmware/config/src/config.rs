@@ -6,12 +6,12 @@
 
 use motor_control::ControllerConfig;
 use motor_control::estimator::{EstimatorConfig, InjectionConfig, ResettingConfig};
-use motor_control::field_weakening::{FieldWeakeningConfig, MtpaCurve};
 use motor_control::fir::FmacFir;
 use motor_control::modulation::centre_aligned_period;
 use motor_control::pi::PiConfig;
 use motor_control::setpoint::SetpointConfig;
 use motor_control::step::ControllerParameters;
+use motor_control::torque::TorqueParameters;
 
 use crate::hw;
 use crate::motor::{
@@ -91,41 +91,31 @@ pub const PARAMETERS: ControllerParameters = ControllerParameters {
     psi_m: cl::FF_PSI,
     dc_link_min: limits::DC_LINK_MIN_V,
     pwm_period: PWM_PERIOD,
+    torque: TORQUE,
+};
+
+/// The torque → current-reference stage of thesis B §2.3 and chapter 3 (MTPA (3.10) by
+/// torque, field weakening (2.55)–(2.60) at the measured DC link, MTPV, current circle),
+/// every field a generated constant: n_p, ψ̂_M and L̂_q of the motor (the feed-forward's),
+/// and the `field_weakening` group's L̂_d, α_fw, ω_base, V'_max/V_max, I_max and MTPA table.
+/// With ψ_M unknown the generated values are 0 and the stage gives zero current.
+pub const TORQUE: TorqueParameters = TorqueParameters {
+    sample_period: limits::SAMPLE_PERIOD_S,
+    pole_pairs: observer::MOTOR_POLE_PAIRS,
+    psi_m: cl::FF_PSI,
+    ld: fw::LD,
+    lq: cl::FF_LQ,
+    bandwidth: fw::BANDWIDTH,
+    base_speed: fw::BASE_SPEED,
+    voltage_fraction: fw::VOLTAGE_FRACTION,
+    current_max: fw::CURRENT_MAX_A,
+    mtpa_torque_max: fw::MTPA_TORQUE_MAX_NM,
+    mtpa_id: fw::MTPA_ID_BY_TORQUE_A,
 };
 
 /// The current-control step ([`ControllerConfig::from_parameters`], the mapping the
 /// code generator's simulation uses as well).
 pub const CONTROLLER: ControllerConfig = ControllerConfig::from_parameters(&PARAMETERS);
-
-/// Points of the generated MTPA table (thesis B (3.10)).
-pub const MTPA_POINTS: usize = fw::MTPA_IQ_A.len();
-
-/// `[|i_q|, i_d]` pairs of the generated MTPA grid and values, for [`MtpaCurve::Table`].
-const fn mtpa_pairs(iq: [f32; MTPA_POINTS], id: [f32; MTPA_POINTS]) -> [[f32; 2]; MTPA_POINTS] {
-    let mut out = [[0.0; 2]; MTPA_POINTS];
-    let mut k = 0;
-    while k < MTPA_POINTS {
-        out[k] = [iq[k], id[k]];
-        k += 1;
-    }
-    out
-}
-
-/// The MTPA table (3.10): the upper limit of i_d^ref (2.56).
-pub const MTPA_TABLE: [[f32; 2]; MTPA_POINTS] = mtpa_pairs(fw::MTPA_IQ_A, fw::MTPA_ID_A);
-
-/// The field-weakening controller of thesis B §2.3 (2.55)–(2.60), every field a generated
-/// constant: α_fw, L̂_d, ω_base, V'_max/V_max, I_max and the MTPA table. With ψ_M unknown
-/// the generated α_fw is 0 (γ = 0) and the table holds i_d^ref = 0.
-pub const FIELD_WEAKENING: FieldWeakeningConfig = FieldWeakeningConfig {
-    sample_period: limits::SAMPLE_PERIOD_S,
-    bandwidth: fw::BANDWIDTH,
-    ld: fw::LD,
-    base_speed: fw::BASE_SPEED,
-    voltage_fraction: fw::VOLTAGE_FRACTION,
-    current_max: fw::CURRENT_MAX_A,
-    mtpa: MtpaCurve::Table(&MTPA_TABLE),
-};
 
 /// The sensorless estimator of thesis B chapter 4, every field a generated constant
 /// (`motor::sensorless`: ρ, Δω1, Δω2, ω_e, V_e, K_e, ω_hp, ω_lp, ω_ls, ω_hs; R̂_s, L̂_d,
@@ -160,19 +150,17 @@ pub const ESTIMATOR: EstimatorConfig = EstimatorConfig {
     },
 };
 
-/// Torque-setpoint supervision in the i_q domain \[A\], ticked every control period:
-/// timeout after the board's `SETPOINT_TIMEOUT_S` without a frame, then a ramp that
-/// takes the peak current (2.51) to zero in `SETPOINT_RAMP_S`; received values are
-/// limited to the peak current.
+/// Torque-setpoint supervision in N·m, ticked every control period: timeout after the
+/// board's `SETPOINT_TIMEOUT_S` without a frame, then a ramp that takes the largest torque
+/// to zero in `SETPOINT_RAMP_S`; received values are limited to ±the largest torque, the
+/// MTPA torque on the current circle (`field_weakening::MTPA_TORQUE_MAX_NM`, thesis A
+/// (2.33), thesis B (3.10): no current within |i| ≤ I_max gives more). With ψ_M unknown
+/// that is 0 and every setpoint is 0 N·m.
 pub const SETPOINT: SetpointConfig = SetpointConfig {
     timeout_ticks: (board::SETPOINT_TIMEOUT_S * limits::SWITCHING_FREQUENCY_HZ) as u32,
-    ramp_step: limits::PEAK_CURRENT_A * limits::SAMPLE_PERIOD_S / board::SETPOINT_RAMP_S,
-    limit: limits::PEAK_CURRENT_A,
+    ramp_step: fw::MTPA_TORQUE_MAX_NM * limits::SAMPLE_PERIOD_S / board::SETPOINT_RAMP_S,
+    limit: fw::MTPA_TORQUE_MAX_NM,
 };
-
-/// q-axis current per torque \[A/(N·m)\] (2.34); 0 when ψ_M is unknown, which makes
-/// every torque setpoint zero.
-pub const IQ_PER_NM: f32 = cl::IQ_PER_NM;
 
 /// TIM1_BDTR.DTG of the board's dead time (the longer of the board's and the spec's).
 pub const DEAD_TIME_DTG: u8 = match timing::dead_time_dtg(board::DEAD_TIME_NS, hw::TIMER_CLOCK_HZ) {
@@ -360,12 +348,13 @@ mod tests {
         assert_eq!(c.dc_link_min, 432.0);
         assert_eq!(c.sample_period, 5e-5);
         assert_eq!(SETPOINT.timeout_ticks, 600);
-        assert!(close(SETPOINT.ramp_step, 2f32.sqrt() * 61.0 * 5e-5 / 0.1, 1e-5));
-        assert!(close(SETPOINT.limit, 2f32.sqrt() * 61.0, 1e-5));
+        // The largest torque, non-salient: K_t·I_max = 3/2·4·0.060421 Wb·√2·61 A
+        // = 0.362525·86.267 = 31.274 N·m (2.33), ramped to zero in 0.1 s.
+        assert!(close(SETPOINT.limit, 31.274, 1e-4));
+        assert!(close(SETPOINT.ramp_step, 31.274 * 5e-5 / 0.1, 1e-4));
         assert_eq!(DEAD_TIME_DTG, 85);
         assert_eq!(WATCHDOG, (0, 40));
         assert_eq!(SMPR[1][1].value, 3 << 21);
-        assert!(close(IQ_PER_NM, motor::current_loop::IQ_PER_NM, 0.0));
         // Thesis A §6.2: order 20 → 21 taps.
         assert_eq!(FILTER_TAPS, 21);
     }
@@ -409,20 +398,29 @@ mod tests {
         assert_eq!(FILTER.gain_shift, 0);
     }
 
-    /// Every motor: the field-weakening configuration is the generated constants, and
-    /// the table reproduces the generated MTPA points (thesis B (3.10)) exactly.
+    /// Every motor: the torque stage is the generated constants (thesis B §2.3, (3.10)),
+    /// and at standstill a torque beyond the MTPA torque on the circle gives the MTPA
+    /// point on the circle: i_d the table's last value, |i| = I_max.
     #[test]
-    fn field_weakening_is_the_generated_constants() {
-        let c = FIELD_WEAKENING;
-        assert_eq!(c.bandwidth, motor::field_weakening::BANDWIDTH);
-        assert_eq!(c.current_max, motor::field_weakening::CURRENT_MAX_A);
-        assert_eq!(c.voltage_fraction, motor::field_weakening::VOLTAGE_FRACTION);
-        for (iq, id) in motor::field_weakening::MTPA_IQ_A
-            .iter()
-            .zip(motor::field_weakening::MTPA_ID_A)
-        {
-            assert_eq!(c.mtpa.id(*iq), id);
-            assert_eq!(c.mtpa.id(-*iq), id);
+    fn torque_stage_is_the_generated_constants() {
+        let c = CONTROLLER.torque;
+        assert_eq!(TORQUE.bandwidth, fw::BANDWIDTH);
+        assert_eq!(TORQUE.current_max, fw::CURRENT_MAX_A);
+        assert_eq!(TORQUE.voltage_fraction, fw::VOLTAGE_FRACTION);
+        assert_eq!(TORQUE.mtpa_id, fw::MTPA_ID_BY_TORQUE_A);
+        assert_eq!(c.mtpa_id, fw::MTPA_ID_BY_TORQUE_A);
+        if fw::MTPA_TORQUE_MAX_NM > 0.0 {
+            let mut st = motor_control::torque::TorqueState::new();
+            let v_max = limits::VOLTAGE_LIMIT_V;
+            let i = c.process(
+                &mut st,
+                &mut motor_control::SoftTrig,
+                2.0 * fw::MTPA_TORQUE_MAX_NM,
+                0.0,
+                v_max,
+            );
+            assert_eq!(i.d, fw::MTPA_ID_BY_TORQUE_A[16]);
+            assert!(close(i.d.hypot(i.q), fw::CURRENT_MAX_A, 1e-5));
         }
     }
 

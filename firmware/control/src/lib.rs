@@ -20,6 +20,7 @@
 //! | [`adc`] | ADC codes → A, V |
 //! | [`pi`] | current PI, active damping, anti-windup (2.47)–(2.49), voltage limit |
 //! | [`feedforward`] | decoupling (5.3), DC link (5.1), torque → i_q (2.34) |
+//! | [`torque`] | torque → current references: MTPA (3.10), field weakening (2.55)–(2.60), MTPV |
 //! | [`modulation`] | THPWM (3.7), (3.8), duties and compare values |
 //! | [`fir`] | FMAC-bit-exact FIR for the identification filter (§6.2) |
 //! | [`commissioning`] | chapter-6 routines as state machines |
@@ -61,7 +62,6 @@ pub mod commissioning_mode;
 pub mod estimator;
 pub mod fast_trig;
 pub mod feedforward;
-pub mod field_weakening;
 pub mod fir;
 pub mod modulation;
 pub mod pi;
@@ -69,6 +69,7 @@ pub mod q31;
 pub mod setpoint;
 pub mod step;
 pub mod timing;
+pub mod torque;
 pub mod transforms;
 pub mod trig;
 

@@ -14,14 +14,15 @@
 //! amplitude a, equal to b ≤ U_dc/2 at a = 0 and to U_dc/2 at a = 6b = U_dc/√3.
 
 use crate::transforms::{AlphaBeta, Uvw, inverse_clarke};
+use crate::trig::Trig;
 
 /// 1/(6√3), the common-mode amplitude per volt of DC link (3.7).
 pub const THIRD_HARMONIC_PER_VOLT: f32 = 0.096_225_045;
 
 /// Common-mode voltage u_NM of (3.7) \[V\] for the αβ voltage `u` and DC-link `u_dc`
 /// \[V\]; 0 for a zero vector (its angle is undefined).
-pub fn common_mode(u: AlphaBeta, u_dc: f32) -> f32 {
-    let mag = libm::sqrtf(u.alpha * u.alpha + u.beta * u.beta);
+pub fn common_mode<T: Trig + ?Sized>(u: AlphaBeta, u_dc: f32, trig: &mut T) -> f32 {
+    let mag = trig.sqrt(u.alpha * u.alpha + u.beta * u.beta);
     if !(mag > 0.0 && mag.is_finite()) {
         return 0.0;
     }
@@ -32,9 +33,9 @@ pub fn common_mode(u: AlphaBeta, u_dc: f32) -> f32 {
 
 /// Phase voltages with third-harmonic injection (3.8) \[V\], referred to the DC-link
 /// midpoint M.
-pub fn phase_voltages(u: AlphaBeta, u_dc: f32) -> Uvw {
+pub fn phase_voltages<T: Trig + ?Sized>(u: AlphaBeta, u_dc: f32, trig: &mut T) -> Uvw {
     let base = inverse_clarke(u);
-    let nm = common_mode(u, u_dc);
+    let nm = common_mode(u, u_dc, trig);
     Uvw {
         u: base.u + nm,
         v: base.v + nm,
@@ -66,16 +67,18 @@ pub fn duties(phase: Uvw, inv_u_dc: f32) -> [f32; 3] {
 /// THPWM duties for the αβ voltage `u` \[V\] at the DC-link voltage `u_dc` \[V\]
 /// (already guarded, see [`crate::feedforward::effective_dc_link`]) with
 /// `inv_u_dc = 1/u_dc`.
-pub fn thpwm(u: AlphaBeta, u_dc: f32, inv_u_dc: f32) -> [f32; 3] {
-    duties(phase_voltages(u, u_dc), inv_u_dc)
+pub fn thpwm<T: Trig + ?Sized>(u: AlphaBeta, u_dc: f32, inv_u_dc: f32, trig: &mut T) -> [f32; 3] {
+    duties(phase_voltages(u, u_dc, trig), inv_u_dc)
 }
 
 /// Timer compare values `round(DC·period)` for centre-aligned PWM with auto-reload
 /// `period`, each in `0..=period`.
 pub fn compare_values(duties: [f32; 3], period: u16) -> [u16; 3] {
     let p = f32::from(period);
-    // `as u16` saturates (NaN → 0); `min` keeps rounding from exceeding the period.
-    duties.map(|d| ((unit(d) * p + 0.5) as u16).min(period))
+    // `as u16` saturates (NaN and negatives → 0, beyond 65 535 → 65 535) and `min` keeps
+    // the result within the period: the same as saturating the duty to [0, 1] first,
+    // without doing it twice (`duties` already has).
+    duties.map(|d| ((d * p + 0.5) as u16).min(period))
 }
 
 /// The auto-reload of a centre-aligned (up/down) carrier at `switching_hz` from a
@@ -95,6 +98,7 @@ pub const fn centre_aligned_period(timer_hz: u32, switching_hz: f32) -> Option<u
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::trig::SoftTrig;
     use core::f64::consts::PI;
     use proptest::prelude::*;
 
@@ -131,7 +135,7 @@ mod tests {
             let (ud, uq) = (mag * phi.cos(), mag * phi.sin());
             let sc = crate::transforms::SinCos { sin: th.sin() as f32, cos: th.cos() as f32 };
             let ab = crate::transforms::inverse_park(crate::transforms::Dq { d: ud as f32, q: uq as f32 }, sc);
-            let d = thpwm(ab, udc as f32, 1.0 / udc as f32);
+            let d = thpwm(ab, udc as f32, 1.0 / udc as f32, &mut SoftTrig);
             let r = reference(ud, uq, th, udc);
             for k in 0..3 {
                 prop_assert!(d[k] >= 0.0 && d[k] <= 1.0);
@@ -146,7 +150,7 @@ mod tests {
         fn line_to_line_voltages(m in 0f64..=0.999, phi in -PI..PI, udc in 50f64..800.0) {
             let mag = m * udc / 3f64.sqrt();
             let ab = AlphaBeta { alpha: (mag * phi.cos()) as f32, beta: (mag * phi.sin()) as f32 };
-            let d = thpwm(ab, udc as f32, 1.0 / udc as f32);
+            let d = thpwm(ab, udc as f32, 1.0 / udc as f32, &mut SoftTrig);
             let ph = inverse_clarke(ab);
             let want = [ph.u - ph.v, ph.v - ph.w, ph.w - ph.u];
             let got = [d[0] - d[1], d[1] - d[2], d[2] - d[0]];
@@ -161,7 +165,7 @@ mod tests {
         /// non-finite inputs.
         #[test]
         fn saturates(alpha in proptest::num::f32::ANY, beta in proptest::num::f32::ANY) {
-            let d = thpwm(AlphaBeta { alpha, beta }, 600.0, 1.0 / 600.0);
+            let d = thpwm(AlphaBeta { alpha, beta }, 600.0, 1.0 / 600.0, &mut SoftTrig);
             for x in d {
                 prop_assert!((0.0..=1.0).contains(&x));
             }
@@ -188,6 +192,7 @@ mod tests {
                 },
                 udc,
                 1.0 / udc,
+                &mut SoftTrig,
             );
             hi = hi.max(d[0].max(d[1]).max(d[2]));
             lo = lo.min(d[0].min(d[1]).min(d[2]));

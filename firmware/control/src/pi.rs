@@ -29,6 +29,7 @@
 //! loop is stable for `T_s·k_i/k_p < 2`.
 
 use crate::transforms::Dq;
+use crate::trig::Trig;
 
 /// PI gains of one axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -102,16 +103,18 @@ pub struct CurrentPiState {
 
 /// Limits the dq voltage to the circle `√(u_d² + u_q²) ≤ v_max` (2.51).
 ///
-/// A non-finite or non-positive `v_max`, or a non-finite input, gives zero volts.
-pub fn limit_voltage(v: Dq, v_max: f32, mode: VoltageLimit) -> Dq {
+/// A non-finite or non-positive `v_max`, or a non-finite input, gives zero volts. The
+/// proportional limit compares squares and takes the square root ([`Trig::sqrt`]) only
+/// when it scales.
+pub fn limit_voltage<T: Trig + ?Sized>(v: Dq, v_max: f32, mode: VoltageLimit, trig: &mut T) -> Dq {
     if !(v_max > 0.0 && v_max.is_finite() && v.d.is_finite() && v.q.is_finite()) {
         return Dq::default();
     }
     match mode {
         VoltageLimit::Proportional => {
-            let mag = libm::sqrtf(v.d * v.d + v.q * v.q);
-            if mag > v_max {
-                let k = v_max / mag;
+            let squared = v.d * v.d + v.q * v.q;
+            if squared > v_max * v_max {
+                let k = v_max / trig.sqrt(squared);
                 Dq { d: v.d * k, q: v.q * k }
             } else {
                 v
@@ -120,7 +123,7 @@ pub fn limit_voltage(v: Dq, v_max: f32, mode: VoltageLimit) -> Dq {
         VoltageLimit::DAxisPriority => {
             // min/max rather than `f32::clamp`, which asserts its bounds are ordered.
             let d = v.d.max(-v_max).min(v_max);
-            let q_max = libm::sqrtf((v_max * v_max - d * d).max(0.0));
+            let q_max = trig.sqrt((v_max * v_max - d * d).max(0.0));
             Dq {
                 d,
                 q: v.q.max(-q_max).min(q_max),
@@ -154,8 +157,10 @@ impl CurrentPiConfig {
     /// * `ts`: sample period T_s \[s\].
     ///
     /// Returns the limited voltage ū_dq \[V\]. If anything non-finite appears (e.g. a
-    /// NaN measurement) the state is reset and zero volts are returned.
-    pub fn process(
+    /// NaN measurement) the state is reset and zero volts are returned. `trig` supplies
+    /// the square root of the voltage limit.
+    #[allow(clippy::too_many_arguments)]
+    pub fn process<T: Trig + ?Sized>(
         &self,
         state: &mut CurrentPiState,
         reference: Dq,
@@ -163,11 +168,12 @@ impl CurrentPiConfig {
         feed_forward: Dq,
         v_max: f32,
         ts: f32,
+        trig: &mut T,
     ) -> Dq {
         let (ed, vd) = self.d.unlimited(&mut state.d, reference.d, measured.d, feed_forward.d);
         let (eq, vq) = self.q.unlimited(&mut state.q, reference.q, measured.q, feed_forward.q);
         let v = Dq { d: vd, q: vq };
-        let u = limit_voltage(v, v_max, self.limit);
+        let u = limit_voltage(v, v_max, self.limit, trig);
         if !(v.d.is_finite() && v.q.is_finite()) {
             *state = CurrentPiState::default();
             return Dq::default();
@@ -181,6 +187,7 @@ impl CurrentPiConfig {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::trig::SoftTrig;
 
     /// f64 reference of the same equations, one axis, no limit active.
     #[test]
@@ -215,6 +222,7 @@ mod tests {
                 },
                 1e3,
                 ts as f32,
+                &mut SoftTrig,
             );
             let vd = 0.5 * (rd - md) + 120.0 * id_int + fd - 0.2 * md;
             let vq = 0.7 * (rq - mq) + 90.0 * iq_int + fq;
@@ -230,16 +238,25 @@ mod tests {
     #[test]
     fn limit_modes() {
         let v = Dq { d: 30.0, q: 40.0 };
-        let p = limit_voltage(v, 10.0, VoltageLimit::Proportional);
+        let p = limit_voltage(v, 10.0, VoltageLimit::Proportional, &mut SoftTrig);
         assert!((p.d - 6.0).abs() < 1e-5 && (p.q - 8.0).abs() < 1e-5);
-        let d = limit_voltage(v, 10.0, VoltageLimit::DAxisPriority);
+        let d = limit_voltage(v, 10.0, VoltageLimit::DAxisPriority, &mut SoftTrig);
         assert!((d.d - 10.0).abs() < 1e-6 && d.q.abs() < 1e-3);
-        let d = limit_voltage(Dq { d: 6.0, q: 40.0 }, 10.0, VoltageLimit::DAxisPriority);
+        let d = limit_voltage(Dq { d: 6.0, q: 40.0 }, 10.0, VoltageLimit::DAxisPriority, &mut SoftTrig);
         assert!((d.d - 6.0).abs() < 1e-6 && (d.q - 8.0).abs() < 1e-5);
-        assert_eq!(limit_voltage(v, f32::NAN, VoltageLimit::Proportional), Dq::default());
-        assert_eq!(limit_voltage(v, -1.0, VoltageLimit::DAxisPriority), Dq::default());
+        assert_eq!(
+            limit_voltage(v, f32::NAN, VoltageLimit::Proportional, &mut SoftTrig),
+            Dq::default()
+        );
+        assert_eq!(
+            limit_voltage(v, -1.0, VoltageLimit::DAxisPriority, &mut SoftTrig),
+            Dq::default()
+        );
         let inside = Dq { d: 3.0, q: -4.0 };
-        assert_eq!(limit_voltage(inside, 5.0, VoltageLimit::Proportional), inside);
+        assert_eq!(
+            limit_voltage(inside, 5.0, VoltageLimit::Proportional, &mut SoftTrig),
+            inside
+        );
     }
 
     /// Windup scenario: current steps on a first-order plant `L di/dt = u − R·i`
@@ -268,6 +285,7 @@ mod tests {
                     Dq::default(),
                     v_max,
                     ts,
+                    &mut SoftTrig,
                 );
                 i = a * i + (1.0 - a) * u.d / r;
                 peak = peak.max(i);
@@ -309,6 +327,7 @@ mod tests {
             Dq::default(),
             10.0,
             50e-6,
+            &mut SoftTrig,
         );
         assert_eq!(u, Dq::default());
         assert_eq!(st, CurrentPiState::default());

@@ -5,7 +5,8 @@
 //! 2. resolver SIN/COS → angle tracking observer θ̂_r, ω̂_r (4.19), (4.22);
 //! 3. θ_e = n_p/n_r·(θ̂_r − θ_off) (4.5), ω_e = n_p/n_r·ω̂_r;
 //! 4. Clarke (2.7) and Park (2.8) at θ_e → i_d, i_q;
-//! 5. PI per axis with active damping, decoupling/back-EMF feed-forward (5.3),
+//! 5. a torque demand → current references (MTPA, field weakening, MTPV:
+//!    [`crate::torque`]); PI per axis with active damping, decoupling/back-EMF feed-forward (5.3),
 //!    voltage-circle limit V_max = margin·U_dc/√3 (2.51) and back-calculation
 //!    anti-windup (2.47)–(2.49);
 //! 6. inverse Park at the lead angle θ_e + k·ω_e^i (4.23), k = 1.5 samples;
@@ -24,7 +25,8 @@ use crate::ato::{AtoConfig, AtoState, ResolverSample};
 use crate::feedforward::{FeedForwardConfig, dc_link_gain, effective_dc_link};
 use crate::modulation::{compare_values, thpwm};
 use crate::pi::{CurrentPiConfig, CurrentPiState, VoltageLimit, limit_voltage};
-use crate::transforms::{AlphaBeta, Dq, INV_SQRT_3, SinCos, inverse_park, park};
+use crate::torque::{TorqueConfig, TorqueState};
+use crate::transforms::{AlphaBeta, Dq, INV_SQRT_3, inverse_park, park};
 use crate::trig::Trig;
 
 /// Everything the current-control step needs; plain data so a code generator can
@@ -58,9 +60,12 @@ pub struct ControllerConfig {
     pub voltage_margin: f32,
     /// PWM timer auto-reload (centre-aligned period) for the compare values \[ticks\].
     pub pwm_period: u16,
+    /// The torque → current-reference stage of [`Demand::Torque`] (MTPA, field
+    /// weakening, MTPV; [`crate::torque`]).
+    pub torque: TorqueConfig,
 }
 
-/// State of the step: observer, resolver turn counter, current controllers.
+/// State of the step: observer, resolver turn counter, current controllers, torque stage.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ControllerState {
     /// Angle tracking observer.
@@ -69,6 +74,8 @@ pub struct ControllerState {
     pub turns: ResolverTurns,
     /// Current PI integrators and reference filters.
     pub current: CurrentPiState,
+    /// The torque stage's integrators and voltage feedback (reset by any other demand).
+    pub torque: TorqueState,
 }
 
 impl ControllerState {
@@ -87,6 +94,7 @@ impl ControllerState {
                     reference: 0.0,
                 },
             },
+            torque: TorqueState::new(),
         }
     }
 }
@@ -116,6 +124,10 @@ pub enum Demand {
         /// Add the decoupling/back-EMF feed-forward (5.3).
         feed_forward: bool,
     },
+    /// A torque \[N·m\]: the torque stage ([`crate::torque`]: MTPA, field weakening at the
+    /// measured DC link, MTPV, current circle) sets the current references, then as
+    /// `Current` with the feed-forward (5.3).
+    Torque(f32),
     /// Open-loop voltage in the rotor frame \[V\] (blocked-rotor step, 6.2).
     VoltageDq(Dq),
     /// Open-loop voltage in the stator frame \[V\] (alignment 6.3, rotation 6.4).
@@ -177,7 +189,7 @@ impl ControllerConfig {
     /// dq output before the inverse Park transform, outside the PI (the injected carrier
     /// of thesis B Appendix D, `ud = ud + udhf`); `StepOutput::u_dq` excludes it, as the
     /// estimator's back-EMF error (4.38), (4.39) wants; it applies to `Demand::Current`
-    /// only. `theta_r`/`omega_r` of the output are 0 and the observer state is untouched.
+    /// and `Demand::Torque` only. `theta_r`/`omega_r` of the output are 0 and the observer state is untouched.
     #[allow(clippy::too_many_arguments)]
     pub fn process_at_angle<T: Trig>(
         &self,
@@ -205,11 +217,21 @@ impl ControllerConfig {
 
         // 6. (angle for the output) lead by k samples of rotation.
         let theta_lead = lead(theta_e, omega_e_i, self.angle_lead);
-        let mut sc_lead = || -> SinCos { trig.sin_cos(theta_lead).to_f32() };
 
-        // 5. Voltage demand.
+        // 5. Voltage demand; a torque first becomes current references (the torque stage).
+        let demand = if let Demand::Torque(torque) = demand {
+            let i = self.torque.process(&mut state.torque, trig, torque, omega_e, v_max);
+            Demand::Current {
+                id: i.d,
+                iq: i.q,
+                feed_forward: true,
+            }
+        } else {
+            state.torque = TorqueState::new();
+            demand
+        };
         let (u_dq, u_ab) = match demand {
-            Demand::Off => {
+            Demand::Off | Demand::Torque(_) => {
                 state.current = CurrentPiState::default();
                 (Dq::default(), AlphaBeta::default())
             }
@@ -226,31 +248,34 @@ impl ControllerConfig {
                     ff,
                     v_max,
                     self.sample_period,
+                    trig,
                 );
+                // The torque stage's voltage feedback (2.55): the applied PI output.
+                state.torque.voltage = u;
                 let applied = Dq {
                     d: u.d + added.d,
                     q: u.q + added.q,
                 };
-                (u, inverse_park(applied, sc_lead()))
+                (u, inverse_park(applied, trig.sin_cos(theta_lead).to_f32()))
             }
             Demand::VoltageDq(v) => {
                 state.current = CurrentPiState::default();
-                let u = limit_voltage(v, v_max, VoltageLimit::Proportional);
-                (u, inverse_park(u, sc_lead()))
+                let u = limit_voltage(v, v_max, VoltageLimit::Proportional, trig);
+                (u, inverse_park(u, trig.sin_cos(theta_lead).to_f32()))
             }
             Demand::VoltageAlphaBeta(v) => {
                 state.current = CurrentPiState::default();
-                let lim = limit_voltage(Dq { d: v.alpha, q: v.beta }, v_max, VoltageLimit::Proportional);
+                let lim = limit_voltage(Dq { d: v.alpha, q: v.beta }, v_max, VoltageLimit::Proportional, trig);
                 let u_ab = AlphaBeta {
                     alpha: lim.d,
                     beta: lim.q,
                 };
-                (park(u_ab, sc_lead()), u_ab)
+                (park(u_ab, trig.sin_cos(theta_lead).to_f32()), u_ab)
             }
         };
 
         // 7. Modulation.
-        let duties = thpwm(u_ab, u_dc_eff, inv_u_dc);
+        let duties = thpwm(u_ab, u_dc_eff, inv_u_dc, trig);
         StepOutput {
             duties,
             compare: compare_values(duties, self.pwm_period),
@@ -314,6 +339,7 @@ mod tests {
         dc_link_min: 432.0,
         voltage_margin: 1.0,
         pwm_period: 4250,
+        torque: TorqueConfig::OFF,
     };
 
     proptest! {

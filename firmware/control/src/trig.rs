@@ -49,6 +49,13 @@ pub trait Trig {
     /// `atan2(y, x)/π` as a Q1.31 angle (the CORDIC "phase" function); `y`, `x`
     /// are Q1.31 (only their ratio matters). Returns 0 for `(0, 0)`.
     fn atan2(&mut self, y: i32, x: i32) -> i32;
+    /// √x, correctly rounded as IEEE 754 requires of a square root (NaN for x < 0):
+    /// `libm`'s software square root here; the board overrides it with the FPU's
+    /// VSQRT.F32 (PM0214 §3.10, the Cortex-M4F's IEEE 754 square root), which gives the
+    /// same bits — so the image and the host simulation compute the same numbers.
+    fn sqrt(&mut self, x: f32) -> f32 {
+        libm::sqrtf(x)
+    }
 }
 
 /// Portable software implementation of [`Trig`] (no CORDIC needed).

@@ -24,11 +24,11 @@ use motor_control::angle::ResolverToElectrical;
 use motor_control::ato::{AtoConfig, AtoState, ObserverError, ResolverSample};
 use motor_control::estimator::{EstimatorConfig, EstimatorInput, EstimatorState, InjectionConfig, ResettingConfig};
 use motor_control::feedforward::{FeedForwardConfig, dc_link_gain, effective_dc_link};
-use motor_control::field_weakening::{FieldWeakeningConfig, FieldWeakeningInput, FieldWeakeningState, MtpaCurve};
 use motor_control::fir::{FirState, FmacFir};
 use motor_control::modulation::{compare_values, thpwm};
 use motor_control::pi::{CurrentPiConfig, CurrentPiState, PiConfig, VoltageLimit};
 use motor_control::step::{AdcSample, ControllerConfig, ControllerState, Demand};
+use motor_control::torque::{MTPA_POINTS, TorqueConfig, TorqueParameters, TorqueState};
 use motor_control::transforms::{AlphaBeta, Dq, Uvw, clarke, clarke_uv, inverse_clarke, inverse_park, park};
 use motor_control::trig::{SoftTrig, atan2_q31, sin_cos_q31};
 
@@ -314,7 +314,15 @@ fn pi(name: &'static str, config: CurrentPiConfig) -> Summary {
             q: rng.range_f32(-100.0, 300.0),
         };
         let v_max = rng.range_f32(20.0, 400.0);
-        let u = config.process(&mut state, reference, measured, feed_forward, v_max, 5.0e-5);
+        let u = config.process(
+            &mut state,
+            reference,
+            measured,
+            feed_forward,
+            v_max,
+            5.0e-5,
+            &mut SoftTrig,
+        );
         h.f32(u.d);
         if config.limit == VoltageLimit::DAxisPriority {
             // DAxisPriority clamps u_q with `f32::max`/`f32::min` against ±q_max,
@@ -338,6 +346,30 @@ fn pi(name: &'static str, config: CurrentPiConfig) -> Summary {
 const FIR_TAPS: [i16; 21] = [
     0, -16, -117, -288, -349, 0, 991, 2592, 4430, 5906, 6470, 5906, 4430, 2592, 991, 0, -349, -288, -117, -16, 0,
 ];
+
+/// The torque stage of the `torque_stage` vector and of [`controller`]: thesis B motor
+/// (Table B.2) with L_d = 0.40 mH so that ψ_M = 0.104 Wb < L_d·I_max and the MTPV path
+/// runs; the MTPA table is a monotone stand-in (the vectors test bit-exactness, not the
+/// curve).
+fn torque_stage() -> TorqueConfig {
+    let mut mtpa_id = [0.0f32; MTPA_POINTS];
+    for (k, x) in mtpa_id.iter_mut().enumerate() {
+        *x = -4.0 * (k * k) as f32 / 16.0;
+    }
+    TorqueConfig::from_parameters(&TorqueParameters {
+        sample_period: 1e-4,
+        pole_pairs: 2,
+        psi_m: 0.104,
+        ld: 0.40e-3,
+        lq: 0.56e-3,
+        bandwidth: 147.0,
+        base_speed: 1256.6,
+        voltage_fraction: 0.9,
+        current_max: 316.8,
+        mtpa_torque_max: 120.0,
+        mtpa_id,
+    })
+}
 
 /// Controller for [`step`]: Fischer TI085-like motor (4 pole pairs, L = 0.393 mH,
 /// ψ_M = 0.058 Wb), f_s = 20 kHz, 12-bit current ADC at 0.25 A/LSB, DC link
@@ -377,6 +409,7 @@ fn controller() -> ControllerConfig {
         dc_link_min: 432.0,
         voltage_margin: 0.95,
         pwm_period: 4250,
+        torque: torque_stage(),
     }
 }
 
@@ -473,7 +506,7 @@ pub fn run_all() -> [Summary; FUNCTIONS] {
                 beta: rng.range_f32(-0.75, 0.75) * u_dc,
             };
             let eff = effective_dc_link(u_dc, 432.0);
-            let duties = thpwm(u, eff, dc_link_gain(u_dc, 432.0));
+            let duties = thpwm(u, eff, dc_link_gain(u_dc, 432.0), &mut SoftTrig);
             for d in duties {
                 h.f32(d);
             }
@@ -517,7 +550,8 @@ pub fn run_all() -> [Summary; FUNCTIONS] {
                     dc_link: rng.range_u16(2000, 1200),
                 };
                 // A phase of 1024 samples per demand kind.
-                let demand = match (n / 1024) % 4 {
+                let demand = match (n / 1024) % 5 {
+                    4 => Demand::Torque(rng.range_f32(-150.0, 150.0)),
                     0 => Demand::Current {
                         id: -10.0,
                         iq: rng.range_f32(0.0, 60.0),
@@ -549,36 +583,25 @@ pub fn run_all() -> [Summary; FUNCTIONS] {
             })
         },
         {
-            // Thesis B motor, α_fw = 147 rad/s, V'_max = 0.9·V_max, I_max = 1.4 pu.
-            let config = FieldWeakeningConfig {
-                sample_period: 1e-4,
-                bandwidth: 147.0,
-                ld: 0.23e-3,
-                base_speed: 1256.6,
-                voltage_fraction: 0.9,
-                current_max: 316.8,
-                mtpa: MtpaCurve::Analytic {
-                    psi_m: 0.104,
-                    delta_l: 0.33e-3,
-                },
-            };
-            let mut state = FieldWeakeningState::default();
-            run("field_weakening", move |rng, h| {
-                let input = FieldWeakeningInput {
-                    iq_demand: amps(rng),
-                    omega: rng.range_f32(-4000.0, 4000.0),
-                    voltage: Dq {
-                        d: rng.range_f32(-200.0, 200.0),
-                        q: rng.range_f32(-200.0, 200.0),
-                    },
-                    voltage_max: rng.range_f32(150.0, 200.0),
-                    iq_limit: rng.range_f32(0.0, 400.0),
+            // Thesis B motor with L_d = 0.40 mH (ψ_M < L_d·I_max: the MTPV path runs too),
+            // α_fw = 147 rad/s, V'_max = 0.9·V_max, I_max = 1.4 pu.
+            let config = torque_stage();
+            let mut state = TorqueState::new();
+            let mut trig = SoftTrig;
+            run("torque_stage", move |rng, h| {
+                state.voltage = Dq {
+                    d: rng.range_f32(-200.0, 200.0),
+                    q: rng.range_f32(-200.0, 200.0),
                 };
-                let (id, iq) = config.process(&mut state, input);
-                h.f32(id);
-                // i_q^ref is clamped with f32::min/max (±0 left to the platform).
-                h.f32_unsigned_zero(iq);
-                h.f32(state.id_ref);
+                let torque = rng.range_f32(-150.0, 150.0);
+                let omega = rng.range_f32(-4000.0, 4000.0);
+                let v_max = rng.range_f32(150.0, 200.0);
+                let i = config.process(&mut state, &mut trig, torque, omega, v_max);
+                // i_d^ref and |i_q^ref| pass through f32::min/max (±0 left to the platform).
+                h.f32_unsigned_zero(i.d);
+                h.f32_unsigned_zero(i.q);
+                h.f32_unsigned_zero(state.id_ref);
+                h.f32_unsigned_zero(state.iq_cut);
             })
         },
         {

@@ -12,6 +12,9 @@ use crate::design::Design;
 use crate::design::field_weakening::{BandwidthRule, FieldWeakeningOut};
 use crate::design::loss_minimisation::LossTable;
 
+// MTPA_TORQUE_MAX_NM points at the last of the 17 grid torques (`…/torque_nm/16`).
+const _: () = assert!(crate::design::field_weakening::MTPA_POINTS == 17);
+
 const TITLE: &str = "Field weakening (thesis B §2.3) and MTPA / loss-minimising i_d tables (chapter 3)";
 
 /// Field weakening off (ψ_M unknown): the thesis rules cannot be evaluated.
@@ -72,6 +75,27 @@ impl Off {
         Decl {
             name: "MTPA_ID_A",
             value: Custom(|_| (f32_array(&[0.0]), "[0 A]".into())),
+            formula: Lit("i_d = 0"),
+            equation: Lit("thesis B (3.10)"),
+            inputs: Lit(Off::WHY),
+            json: Json::At("/field_weakening"),
+        },
+        Decl {
+            name: "MTPA_TORQUE_MAX_NM",
+            value: F32(|_| 0.0, "N·m"),
+            formula: Lit("T_max of the MTPA table by torque"),
+            equation: Lit("thesis A (2.33), thesis B (3.10)"),
+            inputs: Lit(Off::WHY),
+            json: Json::At("/field_weakening"),
+        },
+        Decl {
+            name: "MTPA_ID_BY_TORQUE_A",
+            value: Custom(|_| {
+                (
+                    f32_array(&[0.0; crate::design::field_weakening::MTPA_POINTS]),
+                    "0 A".into(),
+                )
+            }),
             formula: Lit("i_d = 0"),
             equation: Lit("thesis B (3.10)"),
             inputs: Lit(Off::WHY),
@@ -232,6 +256,49 @@ impl<'a> On<'a> {
             equation: Lit("thesis B (3.10)"),
             inputs: Of(|c| c.mtpa.clone()),
             json: Json::At("/field_weakening/mtpa/max_interpolation_error_a"),
+        },
+        Decl {
+            name: "MTPA_TORQUE_MAX_NM",
+            value: F32(|c| *c.fw.mtpa_by_torque.torque_nm.last().unwrap_or(&0.0), "N·m"),
+            formula: Lit(
+                "T_max = 3/2·n_p·i_q·(ψ_M − ΔL·i_d) at the MTPA point on |i| = I_max: the end of the torque grid of MTPA_ID_BY_TORQUE_A",
+            ),
+            equation: Lit("thesis A (2.33), thesis B (3.10), (2.50)"),
+            inputs: Of(|c| {
+                format!(
+                    "n_p = {}, the MTPA point ({}, {})",
+                    c.d.motor.pole_pairs,
+                    phys(c.fw.id_mtpa_at_current_max_a, "A"),
+                    phys(c.fw.iq_mode_b_at_mtpa_a, "A")
+                )
+            }),
+            json: Json::At("/field_weakening/mtpa_by_torque/torque_nm/16"),
+        },
+        Decl {
+            name: "MTPA_ID_BY_TORQUE_A",
+            value: Custom(|c| {
+                let id = &c.fw.mtpa_by_torque.id_a;
+                let physical = format!(
+                    "{} points, {} … {} at 0 … {}",
+                    id.len(),
+                    phys(id[0], "A"),
+                    phys(*id.last().unwrap_or(&0.0), "A"),
+                    phys(*c.fw.mtpa_by_torque.torque_nm.last().unwrap_or(&0.0), "N·m")
+                );
+                (f32_array(id), physical)
+            }),
+            formula: Lit(
+                "i_d,MTPA at the torques k·T_max/16 (the point of (3.10) making the torque, by bisection on i_q): the firmware's torque stage interpolates it at the demanded torque and solves (2.33) for i_q",
+            ),
+            equation: Lit("thesis B (3.10), (2.56); thesis A (2.33)"),
+            inputs: Of(|c| {
+                format!(
+                    "{}; linear interpolation costs at most {:.3} % of current over the MTPA (least) current at the interval midpoints",
+                    c.mtpa,
+                    100.0 * c.fw.mtpa_by_torque.max_current_excess
+                )
+            }),
+            json: Json::At("/field_weakening/mtpa_by_torque/id_a"),
         },
     ];
 

@@ -3,22 +3,40 @@
 //! estimator are judged (`motorgen verify` ramps the shaft at it; the observer's lag at
 //! it is a design rule, [`super::angle_observer::ramp_lag`]).
 //!
-//! In order of precedence:
+//! `[drive] max_acceleration` (e.g. `"3000 rpm/s"`) is what the application allows (a
+//! vehicle's traction limit through its gear, a servo's load inertia). Without it the
+//! default follows `[drive] application`, what the drive moves:
 //!
-//! 1. `[drive] max_acceleration` (e.g. `"3000 rpm/s"`): what the application allows (a
-//!    vehicle's traction limit through its gear, a servo's load inertia);
-//! 2. `peak_torque / inertia` from `[motor.datasheet]` when both are given: the motor's
-//!    own rotor at its peak torque, i.e. unloaded on a bench — the fastest the shaft can
-//!    turn up (thesis A (2.17): J·dω_m/dt + b·ω_m = T_e − T_load);
-//! 3. the maximum speed reached in [`DEFAULT_RUN_UP_S`] = 10 s: a traction drive, the
-//!    application of both theses, whose shaft carries the vehicle's inertia ("very large",
-//!    thesis B §2.1.5). A faster drive must say so with the key; the design prints which
-//!    rule it used.
+//! * `"traction"` (also when the key is absent): the maximum speed reached in
+//!   [`TRACTION_RUN_UP_S`] = 10 s — a vehicle, the application of both theses, whose
+//!   shaft carries the vehicle's inertia ("very large", thesis B §2.1.5);
+//! * `"servo"`: with `peak_torque` and `inertia` in `[motor.datasheet]`, the peak torque
+//!   accelerating the rotor and a load of [`SERVO_LOAD_RATIO`] = 10 times its inertia
+//!   (thesis A (2.17): J·dω_m/dt = T_e with J = 11·J_rotor), ten to one being the
+//!   load-to-motor inertia ratio servo sizing guides take as the limit for good tuning
+//!   (KEB America, "4 Key Factors to Consider When Sizing Servo Motors", 2023: inertia
+//!   matching); without them the maximum speed in [`SERVO_RUN_UP_S`] = 0.1 s;
+//! * `"robot"`: the maximum speed in [`ROBOT_RUN_UP_S`] = 0.1 s — a legged robot's joint
+//!   actuator, which reaches its top speed within a leg's swing (assumption: half of a
+//!   0.2 s swing phase).
+//!
+//! The bare rotor's acceleration (peak torque/rotor inertia, no load) is no default: it is
+//! the fastest the shaft can ever turn up, a bench case no application runs, and it made
+//! an ordinary servo spec fail the field-weakening rule. The design prints the value and
+//! the rule, naming the key that sets it.
 
 use serde::Serialize;
 
-/// Run-up time from standstill to the maximum speed of the default acceleration \[s\].
-pub const DEFAULT_RUN_UP_S: f64 = 10.0;
+use crate::spec::Application;
+
+/// Run-up time from standstill to the maximum speed of the traction default \[s\].
+pub const TRACTION_RUN_UP_S: f64 = 10.0;
+/// Load inertia of the servo default, in rotor inertias.
+pub const SERVO_LOAD_RATIO: f64 = 10.0;
+/// Run-up time of the servo default without peak torque and inertia \[s\].
+pub const SERVO_RUN_UP_S: f64 = 0.1;
+/// Run-up time of the robot default \[s\].
+pub const ROBOT_RUN_UP_S: f64 = 0.1;
 
 /// Where the acceleration came from.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -26,10 +44,14 @@ pub const DEFAULT_RUN_UP_S: f64 = 10.0;
 pub enum AccelerationRule {
     /// `drive.max_acceleration`.
     Spec,
-    /// `motor.datasheet.peak_torque / motor.datasheet.inertia`.
-    PeakTorqueOverInertia,
-    /// `motor.max_speed / DEFAULT_RUN_UP_S`.
-    Default,
+    /// Traction (`drive.application = "traction"` or absent): `motor.max_speed` in 10 s.
+    Traction,
+    /// Servo with peak torque and inertia: T_peak/(J·(1 + 10)).
+    ServoLoad,
+    /// Servo without them: `motor.max_speed` in 0.1 s.
+    ServoRunUp,
+    /// Robot actuator: `motor.max_speed` in 0.1 s.
+    Robot,
 }
 
 impl AccelerationRule {
@@ -37,28 +59,40 @@ impl AccelerationRule {
     pub fn describe(self) -> &'static str {
         match self {
             Self::Spec => "drive.max_acceleration",
-            Self::PeakTorqueOverInertia => {
-                "peak torque / rotor inertia (motor.datasheet.peak_torque, inertia: the unloaded motor)"
+            Self::Traction => {
+                "default of drive.application = \"traction\" (the default application): motor.max_speed in 10 s, a vehicle; drive.max_acceleration or drive.application sets another"
             }
-            Self::Default => {
-                "default: motor.max_speed in 10 s, a traction drive (set drive.max_acceleration for a faster one)"
+            Self::ServoLoad => {
+                "default of drive.application = \"servo\": motor.datasheet.peak_torque into the rotor inertia and a load of 10× it; drive.max_acceleration sets another"
+            }
+            Self::ServoRunUp => {
+                "default of drive.application = \"servo\" without peak_torque and inertia: motor.max_speed in 0.1 s; drive.max_acceleration sets another"
+            }
+            Self::Robot => {
+                "default of drive.application = \"robot\": motor.max_speed in 0.1 s; drive.max_acceleration sets another"
             }
         }
     }
 }
 
 /// The largest shaft acceleration [rad/s², mechanical] and its rule, from the spec's
-/// `key` [rad/s²], `peak_torque` [N·m], `inertia` [kg·m²] and `max_speed` [rad/s].
+/// `key` [rad/s²], `application`, `peak_torque` [N·m], `inertia` [kg·m²] and `max_speed`
+/// [rad/s].
 pub fn max_acceleration(
     key: Option<f64>,
+    application: Option<Application>,
     peak_torque: Option<f64>,
     inertia: Option<f64>,
     max_speed: f64,
 ) -> (f64, AccelerationRule) {
-    match (key, peak_torque, inertia) {
-        (Some(a), _, _) => (a, AccelerationRule::Spec),
-        (None, Some(t), Some(j)) => (t / j, AccelerationRule::PeakTorqueOverInertia),
-        _ => (max_speed / DEFAULT_RUN_UP_S, AccelerationRule::Default),
+    if let Some(a) = key {
+        return (a, AccelerationRule::Spec);
+    }
+    match (application.unwrap_or(Application::Traction), peak_torque, inertia) {
+        (Application::Traction, _, _) => (max_speed / TRACTION_RUN_UP_S, AccelerationRule::Traction),
+        (Application::Servo, Some(t), Some(j)) => (t / (j * (1.0 + SERVO_LOAD_RATIO)), AccelerationRule::ServoLoad),
+        (Application::Servo, _, _) => (max_speed / SERVO_RUN_UP_S, AccelerationRule::ServoRunUp),
+        (Application::Robot, _, _) => (max_speed / ROBOT_RUN_UP_S, AccelerationRule::Robot),
     }
 }
 
@@ -66,19 +100,30 @@ pub fn max_acceleration(
 mod tests {
     use super::*;
 
-    /// EMRAX 228 technical data (motors/emrax-228-hv.toml): 230 N·m / 0.0383 kg·m² =
-    /// 6005.2 rad/s² = 57 346 rpm/s; the key wins over it; without either, Fischer's
-    /// 20 000 rpm in 10 s = 2000 rpm/s = 209.44 rad/s².
+    /// By hand: the key wins; traction (also unset): Fischer's 20 000 rpm = 2094.4 rad/s
+    /// in 10 s = 209.44 rad/s²; servo with the EMRAX 228's 230 N·m and 0.0383 kg·m²:
+    /// 230/(11·0.0383) = 545.93 rad/s² (the bare rotor's 6005 rad/s² is no default any
+    /// more); servo without them: 2094.4/0.1 = 20 944 rad/s²; robot: the Mini Cheetah's
+    /// 240 rad/s in 0.1 s = 2400 rad/s².
     #[test]
-    fn precedence_and_hand_values() {
-        let (a, rule) = max_acceleration(None, Some(230.0), Some(0.0383), 680.7);
-        assert!((a - 6005.22).abs() < 0.01, "{a}");
-        assert_eq!(rule, AccelerationRule::PeakTorqueOverInertia);
-        let (a, rule) = max_acceleration(Some(314.16), Some(230.0), Some(0.0383), 680.7);
-        assert_eq!((a, rule), (314.16, AccelerationRule::Spec));
+    fn rules_and_hand_values() {
         let w = 20_000.0 * std::f64::consts::PI / 30.0;
-        let (a, rule) = max_acceleration(None, Some(29.1), None, w);
-        assert!((a - 209.44).abs() < 0.01, "{a}");
-        assert_eq!(rule, AccelerationRule::Default);
+        assert_eq!(
+            max_acceleration(Some(314.16), Some(Application::Servo), Some(230.0), Some(0.0383), w),
+            (314.16, AccelerationRule::Spec)
+        );
+        for app in [None, Some(Application::Traction)] {
+            let (a, rule) = max_acceleration(None, app, Some(230.0), Some(0.0383), w);
+            assert!((a - 209.44).abs() < 0.01 && rule == AccelerationRule::Traction, "{a}");
+        }
+        let (a, rule) = max_acceleration(None, Some(Application::Servo), Some(230.0), Some(0.0383), w);
+        assert!((a - 545.93).abs() < 0.01 && rule == AccelerationRule::ServoLoad, "{a}");
+        let (a, rule) = max_acceleration(None, Some(Application::Servo), Some(230.0), None, w);
+        assert!(
+            (a - 20_943.95).abs() < 0.01 && rule == AccelerationRule::ServoRunUp,
+            "{a}"
+        );
+        let (a, rule) = max_acceleration(None, Some(Application::Robot), None, None, 240.0);
+        assert!((a - 2400.0).abs() < 1e-9 && rule == AccelerationRule::Robot, "{a}");
     }
 }

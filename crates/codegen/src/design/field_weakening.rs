@@ -20,8 +20,9 @@ pub const DECADE: f64 = 10.0;
 /// Largest α_fw/α_c accepted as "α_fw ≪ α_c" (2.61): twice the thesis's α_c/10.
 pub const MAX_BANDWIDTH_FRACTION: f64 = 0.2;
 /// Points of the MTPA (and loss-minimising) |i_q| grid, 0 … the i_q of the MTPA point on
-/// the current circle.
-pub const MTPA_POINTS: usize = 17;
+/// the current circle; also of the MTPA table by torque the firmware's torque stage reads
+/// (`motor_control::torque::MTPA_POINTS`, the same number).
+pub const MTPA_POINTS: usize = motor_control::torque::MTPA_POINTS;
 /// Speeds of the loss-minimising table, 0 … [`LOSS_TABLE_TOP_SPEED`]·ω_base.
 pub const LOSS_SPEED_POINTS: usize = 7;
 /// Top of the loss-minimising table's speed grid in ω_base: thesis B Fig. 3.3 (0 … 1.5 pu;
@@ -161,6 +162,44 @@ pub struct MtpaTable {
     pub max_interpolation_error_a: f64,
 }
 
+/// The MTPA curve (3.10) by torque: the firmware's torque stage looks i_d,MTPA up at the
+/// demanded torque (`motor_control::torque`), on a grid uniform in torque so that the
+/// lookup is one multiplication.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct MtpaByTorque {
+    /// Torque grid \[N·m\], uniform from 0 to the torque of the MTPA point on the current
+    /// circle (thesis A (2.33) at the corner of (3.10) and (2.50)).
+    pub torque_nm: Vec<f64>,
+    /// i_d,MTPA \[A\] at the grid torques (3.10), found by bisection on i_q along the curve.
+    pub id_a: Vec<f64>,
+    /// i_q \[A\] of those points.
+    pub iq_a: Vec<f64>,
+    /// Largest relative excess of |i| over the MTPA (least) current for the torque when
+    /// i_d is interpolated linearly between the grid torques and i_q makes the torque
+    /// (what the firmware does), over the interval midpoints \[-\].
+    pub max_current_excess: f64,
+}
+
+/// Maximum torque per volt: where the largest torque within |i| ≤ I_max and |v| ≤ V'_max
+/// leaves the current circle for its inside (possible when ψ_M < L_d·I_max: the MTPV line
+/// ends at i_d = −ψ_M/L_d, inside the circle). The firmware's torque stage then holds the
+/// current on the line (`motor_control::torque`, Mode C).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Mtpv {
+    /// The speed where the optimum leaves the circle, R_s included \[rad/s, electrical\]
+    /// ([`circle_speed_limit`]'s Karush–Kuhn–Tucker walk); null if it does not within the
+    /// walk (R_s).
+    pub entry_speed_rad_s: Option<f64>,
+    /// The line's end at i_q = 0: i_d = −ψ_M/L_d \[A\] (zero stator flux: torque is possible
+    /// at any speed).
+    pub line_end_id_a: f64,
+    /// Where the line (R_s neglected) meets the current circle, (i_d, i_q) \[A\].
+    pub circle_point_a: [f64; 2],
+    /// L̂_d/L̂_q: the gain of the i_q integrator along the line relative to γ (2.60), which
+    /// keeps the pole at −α_fw (|v| answers i_q with ω·L_q where (2.60) assumes ω·L_d).
+    pub gain_ratio: f64,
+}
+
 /// The loss-minimising table and what it includes.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LossMinimisation {
@@ -212,6 +251,13 @@ pub struct FieldWeakeningOut {
     /// Predicted rise of |v| above V'_max at the drive's largest acceleration \[V\]
     /// ([`voltage_overshoot`]); null when the current loop is not designed.
     pub voltage_overshoot_at_max_acceleration_v: Option<f64>,
+    /// The MTPA curve by torque, the firmware's table.
+    pub mtpa_by_torque: MtpaByTorque,
+    /// Maximum torque per volt, when the line enters the current circle (ψ_M < L_d·I_max).
+    pub mtpv: Option<Mtpv>,
+    /// Without MTPV: the speed above which no current on the circle meets V'_max, where
+    /// no torque is possible any more ([`top_speed_on_circle`]) [rad/s, electrical].
+    pub torque_speed_limit_rad_s: Option<f64>,
 }
 
 /// α_fw [rad/s], the rule, and α_s if a speed-loop rule was used.
@@ -305,6 +351,108 @@ pub fn circle_speed_limit(inp: &Inputs) -> Option<(f64, CircleLimit)> {
     best.map(|b| (b, CircleLimit::Voltage))
 }
 
+/// The largest corner speed [rad/s, electrical] on the current circle's path of
+/// (2.55)–(2.57), from the MTPA corner (3.10) to i_d = −I_max (4000 steps of i_d, each point
+/// at its own [`corner_speed`], R_s included): without maximum torque per volt, the speed
+/// above which no current within |i| ≤ I_max meets V'_max with any torque. `None` if no
+/// point of the circle is feasible.
+pub fn top_speed_on_circle(inp: &Inputs) -> Option<f64> {
+    const STEPS: u32 = 4000;
+    let m = &inp.model;
+    let v = inp.voltage_fraction * inp.voltage_max;
+    let (id0, _) = loss_minimisation::mtpa_corner(m.psi, m.lq - m.ld, m.i_max);
+    (0..=STEPS)
+        .filter_map(|k| {
+            let id = id0 + (-m.i_max - id0) * f64::from(k) / f64::from(STEPS);
+            corner_speed(m, id, mode_b_iq(m.i_max, id), v)
+        })
+        .reduce(f64::max)
+}
+
+/// i_d \[A\] of the maximum-torque-per-volt line at |i_q| = `iq` \[A\], R_s neglected: for
+/// a stator flux |ψ_s| the torque (2.33) with ψ_d = ψ_M + L_d·i_d, ψ_q = L_q·i_q is largest
+/// where a·ψ_d² − c·ψ_d − a·ψ_q² = 0 (a = 1/L_d − 1/L_q, c = ψ_M/L_d; stationarity of
+/// ψ_q·(c − a·ψ_d) on the circle ψ_d² + ψ_q² = |ψ_s|²), i.e.
+/// ψ_d = −2a·ψ_q²/(c + √(c² + 4a²·ψ_q²)), the root continuous at a = 0 (non-salient:
+/// ψ_d = 0, i_d = −ψ_M/L_d); Morimoto et al. (IEEE Trans. Ind. Appl. 26(5), 1990), Sul,
+/// *Control of Electric Machine Drive Systems* §6.4. The firmware evaluates the same
+/// expression (`motor_control::torque::TorqueConfig::mtpv_id`).
+pub fn mtpv_id(m: &LossModel, iq: f64) -> f64 {
+    let (a, c) = (1.0 / m.ld - 1.0 / m.lq, m.psi / m.ld);
+    let pq = m.lq * iq;
+    let pd = -2.0 * a * pq * pq / (c + (c * c + 4.0 * a * a * pq * pq).sqrt());
+    (pd - m.psi) / m.ld
+}
+
+/// The MTPV design when the line enters the circle (ψ_M < L_d·I_max): where it meets the
+/// circle (bisection on i_q of [`mtpv_id`]² + i_q² = I_max²), its end −ψ_M/L_d, the speed
+/// where the optimum leaves the circle ([`circle_speed_limit`]) and the gain ratio L_d/L_q.
+pub fn mtpv(inp: &Inputs) -> Option<Mtpv> {
+    let m = &inp.model;
+    if m.psi >= m.ld * m.i_max {
+        return None;
+    }
+    let (mut lo, mut hi) = (0.0, m.i_max);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if mtpv_id(m, mid).powi(2) + mid * mid < m.i_max * m.i_max {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    let entry = circle_speed_limit(inp).and_then(|(w, why)| (why == CircleLimit::MaxTorquePerVolt).then_some(w));
+    Some(Mtpv {
+        entry_speed_rad_s: entry,
+        line_end_id_a: -m.psi / m.ld,
+        circle_point_a: [mtpv_id(m, lo), lo],
+        gain_ratio: m.ld / m.lq,
+    })
+}
+
+/// The MTPA curve (3.10) on a torque grid of [`MTPA_POINTS`] from 0 to the torque of the
+/// MTPA point on the circle: each grid torque's point by bisection on i_q along the curve
+/// (the torque grows with i_q along it for either sign of ΔL), and the current excess of
+/// linear interpolation in i_d at the interval midpoints (see [`MtpaByTorque`]).
+pub fn mtpa_by_torque(m: &LossModel) -> MtpaByTorque {
+    let dl = m.lq - m.ld;
+    let (id_c, iq_c) = loss_minimisation::mtpa_corner(m.psi, dl, m.i_max);
+    let t_max = m.torque(id_c, iq_c);
+    let point = |t: f64| {
+        let (mut lo, mut hi) = (0.0, iq_c);
+        for _ in 0..100 {
+            let mid = 0.5 * (lo + hi);
+            if m.torque(loss_minimisation::mtpa_id(m.psi, dl, mid), mid) < t {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let iq = 0.5 * (lo + hi);
+        (loss_minimisation::mtpa_id(m.psi, dl, iq), iq)
+    };
+    let torque_nm = loss_minimisation::grid(t_max, MTPA_POINTS);
+    let points: Vec<(f64, f64)> = torque_nm.iter().map(|&t| point(t)).collect();
+    let k_t = 1.5 * f64::from(m.pole_pairs);
+    let max_current_excess = torque_nm
+        .windows(2)
+        .zip(points.windows(2))
+        .map(|(t, p)| {
+            let tm = 0.5 * (t[0] + t[1]);
+            let id = 0.5 * (p[0].0 + p[1].0);
+            let iq = tm / (k_t * (m.psi - dl * id));
+            let (ie, qe) = point(tm);
+            id.hypot(iq) / ie.hypot(qe) - 1.0
+        })
+        .fold(0.0, f64::max);
+    MtpaByTorque {
+        torque_nm,
+        id_a: points.iter().map(|p| p.0 + 0.0).collect(),
+        iq_a: points.iter().map(|p| p.1).collect(),
+        max_current_excess,
+    }
+}
+
 /// ω_base of (2.60): the per-unit base 2π·f_n (thesis B App. A) when known, else the
 /// corner speed of the full-current MTPA point at V'_max, R_s included
 /// ([`full_current_corner_speed`]); `None` when neither exists.
@@ -355,6 +503,13 @@ pub fn design(inp: &Inputs) -> Option<FieldWeakeningOut> {
         },
         loss_minimisation,
         voltage_overshoot_at_max_acceleration_v: None,
+        mtpa_by_torque: mtpa_by_torque(m),
+        mtpv: mtpv(inp),
+        torque_speed_limit_rad_s: if m.psi < m.ld * m.i_max {
+            None
+        } else {
+            top_speed_on_circle(inp)
+        },
     })
 }
 

@@ -1,7 +1,7 @@
 //! `[drive]`: the inverter operating point (switching frequency, DC-link voltage range, dead
 //! time) and the largest shaft acceleration the drive must follow.
 
-use super::raw::RawSpec;
+use super::raw::{Application, RawSpec};
 use super::resolve::ResolveContext;
 use super::{Param, Provenance};
 use crate::units::Kind;
@@ -18,8 +18,10 @@ pub struct Drive {
     /// Dead time \[s\], if given.
     pub dead_time: Option<Param>,
     /// Largest shaft acceleration |dω_m/dt| [rad/s², mechanical], if given
-    /// (`design::acceleration` falls back to peak torque/inertia, then a default).
+    /// (`design::acceleration` otherwise takes the application's default).
     pub max_acceleration: Option<Param>,
+    /// What the drive moves (`drive.application`), `None` when not given (traction).
+    pub application: Option<Application>,
 }
 
 impl ResolveContext<'_> {
@@ -78,6 +80,7 @@ impl ResolveContext<'_> {
             dc_link_voltage_min,
             dead_time,
             max_acceleration,
+            application: d.application.as_ref().map(|a| *a.get_ref()),
         })
     }
 }

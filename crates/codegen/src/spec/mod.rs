@@ -41,7 +41,7 @@ pub use inverter::InverterSpec;
 pub use motor::{Harmonics, Motor};
 use raw::RawSpec;
 pub(crate) use raw::Val;
-pub use raw::{Amplitude, Between, Connection, Method, ObserverError, SpeedAxis};
+pub use raw::{Amplitude, Application, Between, Connection, Method, ObserverError, SpeedAxis};
 pub(crate) use resolve::ResolveContext;
 pub use resolver::Resolver;
 pub use sensorless::{DEFAULT_ANGLE_ERROR_DEG, DEFAULT_RESISTANCE_ERROR, SensorlessSpec, angle_error_rad};

@@ -214,6 +214,22 @@ pub struct RawDrive {
     /// Largest shaft acceleration the drive must follow (mechanical).
     #[serde(default)]
     pub max_acceleration: Option<Val>,
+    /// What the drive moves, for the default of `max_acceleration`.
+    #[serde(default)]
+    pub application: Option<Spanned<Application>>,
+}
+
+/// What the drive moves: chooses the default largest acceleration
+/// (`design::acceleration`).
+#[derive(Debug, Clone, Copy, Deserialize, serde::Serialize, PartialEq, Eq)]
+#[serde(rename_all = "snake_case")]
+pub enum Application {
+    /// A vehicle (both theses): the top speed in 10 s.
+    Traction,
+    /// A servo axis: peak torque into the rotor and a load of ten times its inertia.
+    Servo,
+    /// A robot joint actuator: the top speed in 0.1 s.
+    Robot,
 }
 
 /// Current-loop tuning method.

@@ -17,13 +17,30 @@ fn from_q31(x: u32) -> f64 {
 }
 
 /// CORDIC in 32-bit mode (ARGSIZE = RESSIZE = 0, Q1.31).
-#[derive(Debug, Default)]
+#[derive(Debug)]
 pub struct Cordic {
     csr: u32,
     args: Vec<u32>,
+    /// ARG2 as last written: a one-argument calculation (NARGS = 0) uses it (RM0440
+    /// §17.4.2, CORDIC_WDATA: with NARGS = 0 only ARG1 is written; embassy-stm32's driver
+    /// sets ARG2 = +1 by a two-argument calculation before switching to one argument).
+    /// +1 (0x7FFF_FFFF) after reset.
+    arg2: u32,
     results: Vec<u32>,
     /// Calculations done.
     pub calculations: u64,
+}
+
+impl Default for Cordic {
+    fn default() -> Self {
+        Self {
+            csr: 0,
+            args: Vec::new(),
+            arg2: 0x7FFF_FFFF,
+            results: Vec::new(),
+            calculations: 0,
+        }
+    }
 }
 
 impl Cordic {
@@ -76,10 +93,13 @@ impl Cordic {
 
     /// One calculation (RM0440 §17.3.2, Table 117–122): cosine: ARG1 = θ/π, ARG2 = m,
     /// RES1 = m·cos θ, RES2 = m·sin θ; phase: ARG1 = x, ARG2 = y, RES1 = atan2(y, x)/π,
-    /// RES2 = √(x² + y²). With one argument, ARG2 defaults to +1 (0x7FFF_FFFF).
+    /// RES2 = √(x² + y²). With one argument, ARG2 is the last one written (+1 after reset).
     fn calculate(&mut self) -> Result<(), Broken> {
         let a1 = from_q31(self.args[0]);
-        let a2 = self.args.get(1).map_or(1.0, |&a| from_q31(a));
+        if let Some(&a) = self.args.get(1) {
+            self.arg2 = a;
+        }
+        let a2 = from_q31(self.arg2);
         self.args.clear();
         let (r1, r2) = match self.csr & 0xF {
             0 => {

@@ -7,7 +7,10 @@
 //! (`motor_verify::scenarios::current_step_checks`).
 //!
 //! The d-axis step of `current_step` has no counterpart here: over CAN the image takes a
-//! torque, and runs i_d = 0.
+//! torque. Its torque stage (issue 30) puts a torque on the MTPA curve (3.10): on a salient
+//! motor (chalmers-hev50, amk-dd5-ipm) the q-axis step is then the MTPA point's i_q for
+//! the frame's torque (i_d < 0 adds reluctance torque, so less than T/K_t), found here by
+//! bisection along codegen's MTPA point on a circle; on the others T/K_t.
 //!
 //! A design without a torque constant (unimotor-142umd300: no ψ_M in its spec, so
 //! `iq_per_nm` is 0 and `motorgen check` warns) turns every torque into i_q = 0: it
@@ -44,6 +47,32 @@ impl Outcome {
     pub fn failed(&self) -> Vec<String> {
         self.checks.iter().filter(|c| !c.1).map(|c| c.0.clone()).collect()
     }
+}
+
+/// i_q \[A\] of the MTPA point (3.10) that makes `torque` \[N·m\] by (2.33): the circle
+/// radius bisected until `mtpa_corner`'s point makes it (T/K_t without saliency).
+fn mtpa_iq(d: &codegen::design::Design, torque: f64, iq_per_nm: f64) -> f64 {
+    let m = &d.motor;
+    let (psi, dl) = (m.flux_linkage_wb.unwrap_or(0.0), m.q_inductance_h - m.d_inductance_h);
+    if dl == 0.0 || psi <= 0.0 {
+        return torque * iq_per_nm;
+    }
+    let np = f64::from(m.pole_pairs);
+    let point = |i: f64| codegen::design::loss_minimisation::mtpa_corner(psi, dl, i);
+    let made = |i: f64| {
+        let (id, iq) = point(i);
+        1.5 * np * iq * (psi - dl * id)
+    };
+    let (mut lo, mut hi) = (0.0, 2.0 * torque * iq_per_nm);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if made(mid) < torque {
+            lo = mid
+        } else {
+            hi = mid
+        }
+    }
+    point(0.5 * (lo + hi)).1
 }
 
 /// The rig with the closed-loop drive, booted and settled at zero torque, and the spec
@@ -127,7 +156,7 @@ pub fn current_step_on(bench: Bench) -> Result<Option<Outcome>, String> {
     let a = step_amplitude(&setup);
     let frame = rig.setpoint(a / iq_per_nm);
     let raw = i16::from_le_bytes([frame.data[0], frame.data[1]]);
-    let target = f64::from(raw) * board.torque_resolution_nm * iq_per_nm;
+    let target = mtpa_iq(&design, f64::from(raw) * board.torque_resolution_nm, iq_per_nm);
     let at = step_torque(&mut rig, f64::from(raw) * board.torque_resolution_nm, n as f64 + 10.0)?;
     let drive = rig.analog_as::<Drive>().unwrap();
     let s = &drive.samples;

@@ -2,6 +2,7 @@
 //! closed loop, on every motor in `motors/` (README, "Scenarios").
 
 mod boards;
+mod at_speed;
 mod boot;
 mod can;
 mod closed_loop;

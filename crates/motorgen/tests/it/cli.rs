@@ -402,3 +402,41 @@ fn check_and_design_take_board_files() {
         "{stdout}"
     );
 }
+
+/// `verify --format json` on the salient IPM motor (the one whose whole 0–20 000 rpm
+/// envelope the field-weakening ramp crosses): the verdict as data, every scenario with its
+/// criteria, and the field-weakening ramp's `reached_speed_rpm` at least the spec's
+/// `max_speed = "20000 rpm"` (motors/amk-dd5-ipm.toml) — what a user's CI gates on. The
+/// other motors' reached speeds are checked by motor-verify's
+/// `every_seed_motor_passes_its_scenarios`.
+#[test]
+fn verify_json_gives_every_criterion_and_the_reached_speed() {
+    let out = motorgen(&["verify", "motors/amk-dd5-ipm.toml", "--format", "json"]);
+    assert_eq!(out.status.code(), Some(0), "{}", String::from_utf8_lossy(&out.stderr));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    assert_eq!(json["passed"], true);
+    let scenarios = json["scenarios"].as_array().unwrap();
+    assert!(scenarios.len() >= 7, "{scenarios:?}");
+    for sc in scenarios {
+        assert_eq!(sc["passed"], true, "{sc}");
+        let criteria = sc["criteria"].as_array().unwrap();
+        assert!(!criteria.is_empty(), "{sc}");
+        for c in criteria {
+            for key in ["name", "measured", "designed", "limit", "unit", "pass", "criterion"] {
+                assert!(c.get(key).is_some(), "{key} missing in {c}");
+            }
+            assert_eq!(c["pass"], true, "{c}");
+        }
+    }
+    let fw = scenarios.iter().find(|s| s["name"] == "field_weakening").unwrap();
+    let reached = fw["reached_speed_rpm"].as_f64().unwrap();
+    assert!(reached >= 20000.0, "{reached}");
+    // Only the field-weakening scenario has a ramp speed.
+    assert!(
+        scenarios
+            .iter()
+            .filter(|s| s.get("reached_speed_rpm").is_some())
+            .count()
+            == 1
+    );
+}

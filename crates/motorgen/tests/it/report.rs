@@ -108,6 +108,7 @@ const PLOTS: &[&str] = &[
 
 /// The plots of the field-weakening scenario (motors with ψ_M).
 const FIELD_WEAKENING_PLOTS: &[&str] = &[
+    "torque-speed",
     "field-weakening-0",
     "field-weakening-1",
     "field-weakening-2",

@@ -112,21 +112,22 @@ pub fn dq_plane_lines(d: &Design) -> (Vec<Line>, f64) {
     (lines, half)
 }
 
-/// The MTPA curve i_d(i_q) (thesis B (3.10), the field-weakening controller's own,
-/// for |i_q| ≤ i_max) and the (i_d, i_q) samples of the field-weakening run, if the
-/// motor has one.
+/// The MTPA curve i_d(i_q) (thesis B (3.10): the design's table, both signs of i_q, up to
+/// the MTPA point on the current circle) and the (i_d, i_q) samples of the
+/// field-weakening run, if the motor has one.
 pub fn field_weakening_lines(d: &Design, v: &Verification) -> Vec<Line> {
     let mut lines = Vec::new();
-    let Some(fw) = crate::field_weakening::field_weakening_config(d) else {
+    let Some(fw) = &d.field_weakening else {
         return lines;
     };
-    let i_max = d.motor.peak_current_a;
-    let n = 201;
-    let mtpa = (0..n)
-        .map(|k| {
-            let iq = i_max * (2.0 * k as f64 / (n - 1) as f64 - 1.0);
-            (f64::from(fw.mtpa.id(iq as f32)), iq)
-        })
+    let t = &fw.mtpa;
+    let mtpa = t
+        .iq_a
+        .iter()
+        .zip(&t.id_a)
+        .rev()
+        .map(|(&iq, &id)| (id, -iq))
+        .chain(t.iq_a.iter().zip(&t.id_a).map(|(&iq, &id)| (id, iq)))
         .collect();
     lines.push(("MTPA i_d(i_q) (3.10)".to_string(), mtpa));
     let run = v
@@ -139,6 +140,34 @@ pub fn field_weakening_lines(d: &Design, v: &Verification) -> Vec<Line> {
         if let (Some(id), Some(iq)) = (col("i_d simulated"), col("i_q simulated")) {
             let pts = id.iter().zip(iq).map(|(a, b)| (*a, *b)).collect();
             lines.push(("field-weakening run (simulated i_d, i_q)".to_string(), pts));
+        }
+    }
+    lines
+}
+
+/// The run's torque over speed and the envelope, one line per region (each starting at the
+/// last point of the region before it, so the envelope is drawn unbroken).
+pub fn torque_speed_lines(ts: &crate::field_weakening::TorqueSpeed) -> Vec<Line> {
+    use crate::field_weakening::Region;
+    let e = &ts.envelope;
+    let mut lines = vec![(
+        "simulated run".to_string(),
+        ts.speed_rpm.iter().copied().zip(ts.torque_nm.iter().copied()).collect(),
+    )];
+    for (region, label) in [
+        (Region::Mtpa, "envelope: MTPA (current limit)"),
+        (
+            Region::VoltageLimited,
+            "envelope: voltage-limited, current circle (Mode B)",
+        ),
+        (Region::Mtpv, "envelope: maximum torque per volt"),
+    ] {
+        let pts: Vec<(f64, f64)> = (0..e.region.len())
+            .filter(|&k| e.region[k] == region || (k + 1 < e.region.len() && e.region[k + 1] == region))
+            .map(|k| (e.speed_rpm[k], e.torque_nm[k]))
+            .collect();
+        if pts.len() > 1 {
+            lines.push((label.to_string(), pts));
         }
     }
     lines
@@ -270,6 +299,17 @@ pub fn plots_of(d: &Design, v: &Verification) -> Result<Vec<Plot>, String> {
         caption,
         svg: plots::plane_chart("dq plane", "i_d [A]", "i_q [A]", &lines, half)?,
     });
+    if let Some(ts) = v.scenarios.iter().find_map(|x| x.torque_speed.as_ref()) {
+        out.push(Plot {
+            id: "torque-speed".into(),
+            section: "field-weakening",
+            caption: format!(
+                "Torque versus speed: the field-weakening run under {} (the image's torque stage on the simulated machine) against the designed envelope, the most torque within |i| ≤ I_max and |v| ≤ V'_max at each speed — current-limited on the MTPA point (3.10), voltage-limited on the current circle (Mode B, (2.57)), maximum torque per volt inside it",
+                format_value(ts.commanded_nm, "N·m")
+            ),
+            svg: plots::line_chart("Torque–speed", "n [rpm]", "T [N·m]", &torque_speed_lines(ts))?,
+        });
+    }
     for (section, id) in [
         ("field-weakening", "field_weakening"),
         ("sensorless", "estimator_recovery"),

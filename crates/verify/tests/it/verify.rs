@@ -49,6 +49,26 @@ fn every_seed_motor_passes_its_scenarios() {
         let want: Vec<&str> = Scenario::applicable(&Setup::new(&s, &d)).iter().map(|x| x.id).collect();
         assert_eq!(ids, want, "{name}");
         println!("{}", v.table());
+        // The field-weakening ramp reaches the spec's own `max_speed = "… rpm"` (read from
+        // the file's text, not from the design) wherever there is a ψ_M.
+        if let Some(fw) = v
+            .scenarios
+            .iter()
+            .find(|x| x.id == "field_weakening" && !x.checks.is_empty())
+        {
+            let text = std::fs::read_to_string(&path).unwrap();
+            let max_rpm: f64 = text
+                .lines()
+                .find_map(|l| l.trim().strip_prefix("max_speed = \""))
+                .and_then(|r| r.split(" rpm\"").next())
+                .and_then(|n| n.parse().ok())
+                .unwrap_or_else(|| panic!("{name}: no max_speed in rpm"));
+            let reached = fw.reached_speed_rpm.unwrap();
+            assert!(
+                reached >= max_rpm,
+                "{name}: the ramp reached {reached} of {max_rpm} rpm"
+            );
+        }
         for sc in &v.scenarios {
             assert!(!sc.checks.is_empty(), "{name}: {} has no checks", sc.id);
             for c in &sc.checks {
@@ -188,13 +208,13 @@ fn mis_scaled_observer_gain_fails_the_ramp() {
 /// top speed. The working controller passes both (every seed motor it applies to).
 #[test]
 fn field_weakening_without_gain_exceeds_the_voltage_margin() {
-    use motor_verify::field_weakening::{field_weakening_config, run as fw_run};
+    use motor_verify::field_weakening::field_weakening as fw_run;
     for stem in ["chalmers-hev50", "fischer-ti085"] {
         let (s, d) = load(&motor(stem));
         let setup = Setup::new(&s, &d);
-        let good = field_weakening_config(&d).unwrap();
-        let broken = motor_verify::field_weakening::FieldWeakeningConfig { bandwidth: 0.0, ..good };
-        let r = fw_run(&setup, Some(broken));
+        let mut broken = setup.clone();
+        broken.cfg.torque.bandwidth = 0.0;
+        let r = fw_run(&broken);
         let peak = r.checks.iter().find(|c| c.quantity.starts_with("peak |v|")).unwrap();
         assert!(!peak.pass, "{stem}: {peak:?}");
         // The current loop saturates: |v| reaches V_max = U_dc/√3 (to f32 rounding).
@@ -202,7 +222,7 @@ fn field_weakening_without_gain_exceeds_the_voltage_margin() {
             (peak.measured / d.current_loop.voltage_limit_v - 1.0).abs() < 1e-3,
             "{stem}: {peak:?}"
         );
-        assert!(fw_run(&setup, Some(good)).passed(), "{stem}");
+        assert!(fw_run(&setup).passed(), "{stem}");
     }
 }
 
@@ -343,6 +363,98 @@ fn controller_config_is_the_generated_constants() {
     }
 }
 
+/// The generated array constant `group::name` as f32 values.
+fn array(groups: &[codegen::constants::Group], group: &str, name: &str) -> Vec<f32> {
+    let c: &Constant = groups
+        .iter()
+        .find(|g| g.name == group)
+        .and_then(|g| g.constants.iter().find(|c| c.name == name))
+        .unwrap_or_else(|| panic!("no constant {group}::{name}"));
+    let values = c
+        .value
+        .number
+        .as_array()
+        .unwrap_or_else(|| panic!("{group}::{name} is no array"));
+    values.iter().map(|v| v.as_f64().unwrap() as f32).collect()
+}
+
+/// verify and the image run the same torque stage with the same configuration. The
+/// image's control interrupt (`firmware/app/src/board/control.rs`) runs
+/// `CONTROLLER.process` with `Demand::Torque`, and `CONTROLLER` is
+/// `ControllerConfig::from_parameters` of `motor_config::config::PARAMETERS`, whose `torque`
+/// is `TORQUE`, the generated constants named below (`firmware/config/src/config.rs`;
+/// the source lines are checked here, so a change of that mapping fails this test).
+/// verify's bench runs `ControllerConfig::process` with `Demand::Torque` too
+/// (`field_weakening::run`), with [`controller_config`] of the design: its torque stage
+/// equals, field for field, the one `from_parameters` makes of those generated constants.
+#[test]
+fn verify_and_the_image_run_the_same_torque_stage() {
+    use motor_control::step::{ControllerConfig, ControllerParameters};
+    use motor_control::torque::{TorqueConfig, TorqueParameters};
+    let repo = motor_test_support::repo();
+    let read = |p: &str| std::fs::read_to_string(repo.join(p)).unwrap();
+    let control = read("firmware/app/src/board/control.rs");
+    assert!(control.contains("Demand::Torque(torque)"), "the interrupt's demand");
+    assert!(
+        control.contains("CONTROLLER.process(&mut self.state"),
+        "the interrupt's step"
+    );
+    let config = read("firmware/config/src/config.rs");
+    for line in [
+        "pub const CONTROLLER: ControllerConfig = ControllerConfig::from_parameters(&PARAMETERS);",
+        "pub const TORQUE: TorqueParameters = TorqueParameters {",
+        "torque: TORQUE,",
+        "sample_period: limits::SAMPLE_PERIOD_S,",
+        "pole_pairs: observer::MOTOR_POLE_PAIRS,",
+        "psi_m: cl::FF_PSI,",
+        "ld: fw::LD,",
+        "lq: cl::FF_LQ,",
+        "bandwidth: fw::BANDWIDTH,",
+        "base_speed: fw::BASE_SPEED,",
+        "voltage_fraction: fw::VOLTAGE_FRACTION,",
+        "current_max: fw::CURRENT_MAX_A,",
+        "mtpa_torque_max: fw::MTPA_TORQUE_MAX_NM,",
+        "mtpa_id: fw::MTPA_ID_BY_TORQUE_A,",
+    ] {
+        assert!(config.contains(line), "firmware/config/src/config.rs: no `{line}`");
+    }
+    let bench = read("crates/verify/src/field_weakening.rs");
+    assert!(bench.contains("b.step(Demand::Torque("), "verify's bench demand");
+    for path in motors() {
+        let name = stem(&path);
+        let (_, d) = load(&path);
+        let g = constants(&d);
+        let f = |group: &str, n: &str| number(&g, group, n) as f32;
+        let mut mtpa_id = [0.0f32; motor_control::torque::MTPA_POINTS];
+        let table = array(&g, "field_weakening", "MTPA_ID_BY_TORQUE_A");
+        assert_eq!(table.len(), mtpa_id.len(), "{name}");
+        mtpa_id.copy_from_slice(&table);
+        let generated = TorqueParameters {
+            sample_period: f("limits", "SAMPLE_PERIOD_S"),
+            pole_pairs: number(&g, "observer", "MOTOR_POLE_PAIRS") as u32,
+            psi_m: f("current_loop", "FF_PSI"),
+            ld: f("field_weakening", "LD"),
+            lq: f("current_loop", "FF_LQ"),
+            bandwidth: f("field_weakening", "BANDWIDTH"),
+            base_speed: f("field_weakening", "BASE_SPEED"),
+            voltage_fraction: f("field_weakening", "VOLTAGE_FRACTION"),
+            current_max: f("field_weakening", "CURRENT_MAX_A"),
+            mtpa_torque_max: f("field_weakening", "MTPA_TORQUE_MAX_NM"),
+            mtpa_id,
+        };
+        let params: ControllerParameters = motor_verify::controller::controller_parameters(&d);
+        assert_eq!(params.torque, generated, "{name}: the torque parameters");
+        let cfg: ControllerConfig = controller_config(&d);
+        assert_eq!(
+            cfg.torque,
+            TorqueConfig::from_parameters(&generated),
+            "{name}: the torque stage"
+        );
+        // The stage is on wherever there is a ψ_M (and off, every torque → 0 A, without).
+        assert_eq!(cfg.torque.current_max > 0.0, d.field_weakening.is_some(), "{name}");
+    }
+}
+
 /// A too-slow angle observer in field weakening (Fischer, ω_n = 40 rad/s instead of 70):
 /// the controller's frame lags and the current vector turns off its reference. Hand
 /// calculation at the default acceleration 2000 rpm/s = 209.44 rad/s² (n_r = 1): K_i =
@@ -353,9 +465,9 @@ fn controller_config_is_the_generated_constants() {
 #[test]
 fn slow_observer_loses_current_tracking_in_field_weakening() {
     use codegen::design::angle_observer::design as observer;
-    use motor_verify::field_weakening::{field_weakening_config, run as fw_run};
+    use motor_verify::field_weakening::field_weakening as fw_run;
     let (s, mut d) = load(&motor("fischer-ti085"));
-    let good = fw_run(&Setup::new(&s, &d), field_weakening_config(&d));
+    let good = fw_run(&Setup::new(&s, &d));
     let find = |r: &motor_verify::ScenarioResult, q: &str| {
         r.checks.iter().find(|c| c.quantity.starts_with(q)).cloned().unwrap()
     };
@@ -364,7 +476,7 @@ fn slow_observer_loses_current_tracking_in_field_weakening() {
     let g = observer(40.0, 1.0, 20e3, d.angle_observer.error).unwrap();
     d.angle_observer.gains.kp_q31 = g.kp_q31;
     d.angle_observer.gains.ki_q31 = g.ki_q31;
-    let r = fw_run(&Setup::new(&s, &d), field_weakening_config(&d));
+    let r = fw_run(&Setup::new(&s, &d));
     let angle = find(&r, "peak electrical angle error");
     assert!(!angle.pass && (angle.measured - 30.1).abs() < 3.0, "{angle:?}");
     let track = find(&r, "peak |i_dq − i_dq^ref|");
@@ -411,6 +523,7 @@ fn non_finite_figures_and_samples_fail_the_scenario() {
         quantity: "q-axis rise time 10–90 %".into(),
         measured,
         designed: Some(1.5),
+        limit: Some(0.15),
         unit: "ms",
         criterion: "within 10 % of designed".into(),
         pass: true,
@@ -429,6 +542,8 @@ fn non_finite_figures_and_samples_fail_the_scenario() {
                 values: vec![0.0, sample],
             }],
         }],
+        reached_speed_rpm: None,
+        torque_speed: None,
     };
     let fine = result(1.49, 1.0);
     assert_eq!(motor_verify::diverged_fails(fine.clone()), fine);

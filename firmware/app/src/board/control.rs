@@ -7,14 +7,16 @@
 //! converter's rail, the DC link beyond the over-voltage level, the last period's
 //! electrical speed beyond the over-speed level); advance the setpoint supervision with
 //! the value the main loop received over CAN ([`crate::config::SETPOINT`]: timeout, ramp
-//! to zero); run the step; write `StepOutput::compare` to CCR1..3; then set MOE only if
+//! to zero); run the step with the torque as [`Demand::Torque`] — the control core's torque
+//! stage (MTPA, field weakening at the measured DC link, MTPV, current circle;
+//! `motor_control::torque`, the function `motorgen verify` runs) turns it into current
+//! references inside the step; write `StepOutput::compare` to CCR1..3; then set MOE only if
 //! nothing tripped, the setpoint is alive or still ramping down, and the break flag —
 //! read again now, not at the start of the interrupt (defect 6) — is clear
 //! (`motor_config::bringup::finish_period`). A tripped drive stays off until reset.
 //! Every period's state (currents, angle, speed, DC link, outputs on, tripped) is kept
 //! for the fault record ([`super::fault::keep_state`]); the first trip seals the record
 //! with its cause (trip, lost conversion, break) at the end of its period.
-//! i_d = 0 (the torque → i_q conversion (2.34) assumes it).
 
 use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
@@ -37,14 +39,14 @@ use crate::motor::board;
 /// Control periods run (wrapping); the main loop refreshes the watchdog only when
 /// this advances.
 pub static TICKS: AtomicU32 = AtomicU32::new(0);
-/// Latest received i_q setpoint \[A\] as `f32` bits.
+/// Latest received torque setpoint \[N·m\] as `f32` bits.
 static SETPOINT_BITS: AtomicU32 = AtomicU32::new(0);
 /// A setpoint arrived since the interrupt last looked.
 static SETPOINT_FRESH: AtomicBool = AtomicBool::new(false);
 
-/// Hands a received i_q setpoint \[A\] to the control interrupt.
-pub fn publish_setpoint(iq: f32) {
-    SETPOINT_BITS.store(iq.to_bits(), Ordering::Relaxed);
+/// Hands a received torque setpoint \[N·m\] to the control interrupt.
+pub fn publish_setpoint(torque: f32) {
+    SETPOINT_BITS.store(torque.to_bits(), Ordering::Relaxed);
     SETPOINT_FRESH.store(true, Ordering::Release);
 }
 
@@ -125,18 +127,10 @@ impl Control {
             Excitation::Negative
         };
         let sample = adc_frame::to_sample(&raw, excitation);
-        let iq = SETPOINT.process(&mut self.setpoint, take_setpoint());
-        let alive = !(self.setpoint.timed_out(&SETPOINT) && iq == 0.0);
+        let torque = SETPOINT.process(&mut self.setpoint, take_setpoint());
+        let alive = !(self.setpoint.timed_out(&SETPOINT) && torque == 0.0);
         let run = alive && !self.tripped;
-        let normal = if run {
-            Demand::Current {
-                id: 0.0,
-                iq,
-                feed_forward: true,
-            }
-        } else {
-            Demand::Off
-        };
+        let normal = if run { Demand::Torque(torque) } else { Demand::Off };
         // A commissioning routine replaces the torque demand (or switches off). The break
         // as TIM1 latched it: TIM1_SR.BIF (bit 7) is set by hardware as soon as the break
         // input goes active, and software can clear it only once the input is inactive
@@ -144,7 +138,7 @@ impl Control {
         // period's MOE decision aborts a routine here, before its demand is run;
         // `finish_period` reads BIF again before MOE.
         let guards = Guards {
-            torque_setpoint: iq,
+            torque_setpoint: torque,
             fault: self.tripped,
             break_active: pwm::Break(&self.tim1).break_flag(),
             setpoint_timeout: self.setpoint.timed_out(&SETPOINT),

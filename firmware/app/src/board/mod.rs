@@ -107,7 +107,7 @@ pub fn run() -> ! {
             match can_frame::decode_torque(frame.standard_id, frame.bytes()) {
                 Some(torque) => {
                     commissioning::torque_received(torque);
-                    publish_setpoint(can_frame::torque_to_iq(torque, config::IQ_PER_NM));
+                    publish_setpoint(torque);
                 }
                 None => commissioning::frame_received(frame.standard_id, frame.bytes()),
             }
@@ -118,5 +118,11 @@ pub fn run() -> ! {
             watchdog::refresh(&dp.IWDG);
             last = now;
         }
+        // Sleep until the next interrupt — the control interrupt, every carrier period
+        // (PM0214 §2.5.2, §3.11.12: WFI): the loop's work (one received frame, the
+        // transmissions, the watchdog) is once per period at most. A setpoint frame at
+        // 500 kbit/s takes ≥ 94 µs on the bus, longer than a period at f_s ≥ 10.6 kHz,
+        // and the RX FIFO holds three (RM0440 §44.3.3).
+        cortex_m::asm::wfi();
     }
 }

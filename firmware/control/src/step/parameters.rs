@@ -14,6 +14,7 @@ use crate::angle::ResolverToElectrical;
 use crate::ato::{AtoConfig, ObserverError};
 use crate::feedforward::FeedForwardConfig;
 use crate::pi::{CurrentPiConfig, PiConfig, VoltageLimit};
+use crate::torque::{TorqueConfig, TorqueParameters};
 use fixed::types::I1F31;
 
 /// A motor's design on one board, as plain values: the generated constants of the same
@@ -62,6 +63,8 @@ pub struct ControllerParameters {
     /// TIM1 auto-reload of the centre-aligned carrier
     /// ([`crate::modulation::centre_aligned_period`]) \[ticks\].
     pub pwm_period: u16,
+    /// The torque stage's constants (MTPA, field weakening, MTPV; [`crate::torque`]).
+    pub torque: TorqueParameters,
 }
 
 /// `n` as the `u16` of [`ResolverToElectrical`], saturating (no motor or resolver has
@@ -78,7 +81,8 @@ impl ControllerConfig {
     /// * angle: n_p, n_r, θ_off (4.5);
     /// * the current loop limits with the proportional voltage circle
     ///   (`VoltageLimit::Proportional`) at margin 1: V_max = U_dc/√3 (2.50), the whole
-    ///   THPWM linear range (3.8) — the generated `VOLTAGE_LIMIT_V` at the nominal U_dc.
+    ///   THPWM linear range (3.8) — the generated `VOLTAGE_LIMIT_V` at the nominal U_dc;
+    /// * the torque stage of [`TorqueConfig::from_parameters`].
     pub const fn from_parameters(p: &ControllerParameters) -> Self {
         Self {
             sample_period: p.sample_period,
@@ -124,6 +128,7 @@ impl ControllerConfig {
             dc_link_min: p.dc_link_min,
             voltage_margin: 1.0,
             pwm_period: p.pwm_period,
+            torque: TorqueConfig::from_parameters(&p.torque),
         }
     }
 }
@@ -164,6 +169,19 @@ mod tests {
             psi_m: 0.060_421,
             dc_link_min: 432.0,
             pwm_period: 4250,
+            torque: crate::torque::TorqueParameters {
+                sample_period: 50e-6,
+                pole_pairs: 4,
+                psi_m: 0.060_421,
+                ld: 0.393e-3,
+                lq: 0.393e-3,
+                bandwidth: 10.0,
+                base_speed: 4362.5,
+                voltage_fraction: 0.9,
+                current_max: 86.27,
+                mtpa_torque_max: 31.27,
+                mtpa_id: [0.0; crate::torque::MTPA_POINTS],
+            },
         }
     }
 
@@ -196,6 +214,12 @@ mod tests {
         assert_eq!(c.dc_link_min, 432.0);
         assert_eq!(c.voltage_margin, 1.0);
         assert_eq!(Some(c.pwm_period), centre_aligned_period(170_000_000, 20_000.0));
+        // Torque stage: 3/2·n_p = 6, non-salient (ΔL = 0), ψ_M = 0.0604 Wb > L_d·I_max
+        // = 0.0339 Wb: no MTPV line inside the circle; table index 16/31.27 per N·m.
+        assert_eq!(c.torque.torque_factor, 6.0);
+        assert_eq!(c.torque.delta_l, 0.0);
+        assert!(!c.torque.mtpv);
+        assert_eq!(c.torque.mtpa_per_torque, 16.0 / 31.27);
     }
 
     /// The choices: error form 1 is atan2 (4.10); two measured phases are u and v;

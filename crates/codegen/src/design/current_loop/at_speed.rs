@@ -262,6 +262,9 @@ impl<'a> Loop<'a> {
             u_ff,
             (sampled_dc / 3f64.sqrt()) as f32,
             self.dr.sample_period_s as f32,
+            // The image's square root is the FPU's VSQRT.F32, bit-identical to libm's
+            // (firmware/README.md, `cordic`): the same numbers as the board.
+            &mut motor_control::SoftTrig,
         );
         self.i = self.advance();
         self.pending = Some(([f64::from(u.d), f64::from(u.q)], sampled_dc));

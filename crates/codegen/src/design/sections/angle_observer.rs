@@ -112,7 +112,7 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
                 angle_observer::MAX_TRACKING_ERROR_DEG
             ),
             format!(
-                "a natural frequency of at least {wn_min:.0} rad/s, or drive.max_acceleration if the drive accelerates slower than that"
+                "a natural frequency of at least {wn_min:.0} rad/s, or drive.max_acceleration (or drive.application) if the drive accelerates slower than that"
             ),
         ));
     }

@@ -84,9 +84,6 @@ pub(in crate::design) fn field_weakening(
         ));
         return None;
     }
-    if !within_circle_speed_limit(cx, &inp, psi) {
-        return None;
-    }
     let Some(mut out) = field_weakening::design(&inp) else {
         let p = &spec.drive.dc_link_voltage;
         cx.errors.push(cx.src.error(
@@ -102,6 +99,9 @@ pub(in crate::design) fn field_weakening(
         ));
         return None;
     };
+    if !within_torque_speed_limit(cx, &inp, &out) {
+        return None;
+    }
     // |v| must stay within half the margin V_max − V'_max while the shaft accelerates at the
     // drive's largest rate (`motorgen verify` holds the field-weakening run to it).
     let lag = current_loop?.ramp_lag_s;
@@ -136,7 +136,7 @@ pub(in crate::design) fn field_weakening(
         };
         let fix = match need {
             Some(n) if n <= ceiling => format!(
-                "{how} {:.1} (α_fw ≥ {n:.0} rad/s), a smaller field_weakening.voltage_fraction (more margin), or a drive.max_acceleration of at most {:.0} rpm/s",
+                "{how} {:.1} (α_fw ≥ {n:.0} rad/s), a smaller field_weakening.voltage_fraction (more margin), or a drive.max_acceleration of at most {:.0} rpm/s (drive.application sets the default)",
                 if rule == BandwidthRule::DefaultSpeedLoop {
                     10.0 * n
                 } else {
@@ -145,7 +145,7 @@ pub(in crate::design) fn field_weakening(
                 a_max * 30.0 / PI
             ),
             _ => format!(
-                "a smaller field_weakening.voltage_fraction (more margin), a faster current loop, or a drive.max_acceleration of at most {:.0} rpm/s",
+                "a smaller field_weakening.voltage_fraction (more margin), a faster current loop, or a drive.max_acceleration of at most {:.0} rpm/s (drive.application sets the default)",
                 a_max * 30.0 / PI
             ),
         };
@@ -167,12 +167,15 @@ pub(in crate::design) fn field_weakening(
     Some(out)
 }
 
-/// Whether thesis B's field weakening (2.55)–(2.57), which holds the current on the circle
-/// |i| = I_max, still gives the largest torque the limits allow at the top speed; if not,
-/// an error at `motor.datasheet.max_speed` with the highest speed where it does
-/// ([`field_weakening::circle_speed_limit`]).
-fn within_circle_speed_limit(cx: &mut Context<'_>, inp: &field_weakening::Inputs, psi: f64) -> bool {
-    let Some((limit, why)) = field_weakening::circle_speed_limit(inp) else {
+/// Whether any current within |i| ≤ I_max still produces torque at the top speed: without
+/// maximum torque per volt (ψ_M ≥ L_d·I_max) the field weakening (2.55)–(2.57) walks the
+/// circle down to i_d = −I_max, and above the largest corner speed on that path
+/// ([`field_weakening::top_speed_on_circle`]) no current meets V'_max with any torque —
+/// an error at `motor.datasheet.max_speed` naming that speed. With the MTPV line inside
+/// the circle (ψ_M < L_d·I_max) the line reaches zero stator flux at i_d = −ψ_M/L_d, so
+/// some torque is possible at every speed: no limit.
+fn within_torque_speed_limit(cx: &mut Context<'_>, inp: &field_weakening::Inputs, out: &FieldWeakeningOut) -> bool {
+    let Some(limit) = out.torque_speed_limit_rad_s else {
         return true;
     };
     if inp.max_speed <= limit * (1.0 + 1e-9) {
@@ -182,29 +185,18 @@ fn within_circle_speed_limit(cx: &mut Context<'_>, inp: &field_weakening::Inputs
     let p = &m.max_speed;
     let rpm = 30.0 / PI / f64::from(m.pole_pairs);
     let (i_max, v) = (inp.model.i_max, inp.voltage_fraction * inp.voltage_max);
-    let what = match why {
-        field_weakening::CircleLimit::MaxTorquePerVolt => format!(
-            "above {:.0} rpm (ω_e = {limit:.0} rad/s) the largest torque within |i| ≤ I_max = {i_max:.1} A and |v| ≤ V'_max = {v:.1} V (R_s included) lies inside the current circle (maximum torque per volt{}), which the field weakening of thesis B (2.55)–(2.57) does not reach: it holds the current on the circle, so up to the top speed {:.0} rpm it would give less torque than the drive can",
-            limit * rpm,
-            if psi < inp.model.ld * i_max {
-                format!("; ψ_m = {psi:.4} Wb < L_d·I_max = {:.4} Wb", inp.model.ld * i_max)
-            } else {
-                String::new()
-            },
-            inp.max_speed * rpm,
-        ),
-        field_weakening::CircleLimit::Voltage => format!(
-            "above {:.0} rpm (ω_e = {limit:.0} rad/s) no point of the current circle |i| = I_max = {i_max:.1} A meets V'_max = {v:.1} V (2.50), (2.53), R_s included: the field weakening of thesis B (2.55)–(2.57) keeps the current on that circle, so at the top speed {:.0} rpm the loop saturates",
-            limit * rpm,
-            inp.max_speed * rpm,
-        ),
-    };
     cx.errors.push(cx.src.error(
         p.span.clone(),
         &p.key,
-        what,
         format!(
-            "a maximum speed of at most {:.0} rpm, a higher DC link, or a lower peak current",
+            "above {:.0} rpm (ω_e = {limit:.0} rad/s) no current within |i| ≤ I_max = {i_max:.1} A meets V'_max = {v:.1} V with any torque (2.50), (2.53), R_s included: ψ_m = {:.4} Wb ≥ L_d·I_max = {:.4} Wb, so even i_d = −I_max leaves flux, and at the top speed {:.0} rpm the drive could give no torque",
+            limit * rpm,
+            inp.model.psi,
+            inp.model.ld * i_max,
+            inp.max_speed * rpm,
+        ),
+        format!(
+            "a maximum speed of at most {:.0} rpm, a higher DC link, or a higher peak current (more negative i_d)",
             (limit * rpm).floor()
         ),
     ));

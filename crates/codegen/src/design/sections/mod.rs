@@ -48,6 +48,7 @@ impl Context<'_> {
         let v = |p: &Option<crate::spec::Param>| p.as_ref().map(|p| p.value);
         super::acceleration::max_acceleration(
             v(&self.spec.drive.max_acceleration),
+            self.spec.drive.application,
             v(&m.peak_torque),
             v(&m.inertia),
             m.max_speed.value,
