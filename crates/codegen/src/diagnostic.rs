@@ -107,7 +107,9 @@ fn excerpt_window(line: &str, column: usize) -> (String, usize) {
     if len <= EXCERPT_MAX {
         return (line.to_string(), column);
     }
-    let start = (column - 1).saturating_sub(WINDOW_BEFORE).min(len.saturating_sub(EXCERPT_WINDOW));
+    let start = (column - 1)
+        .saturating_sub(WINDOW_BEFORE)
+        .min(len.saturating_sub(EXCERPT_WINDOW));
     let end = (start + EXCERPT_WINDOW).min(len);
     let mut shown = String::new();
     if start > 0 {
@@ -165,7 +167,11 @@ mod tests {
         let pad = "#".repeat(70_000);
         let text = format!("x = \"{pad}\" y = \"{}\"\n", "b".repeat(1000));
         let at = text.find(" y").unwrap() + 1;
-        let d = Source { file: "m.toml", text: &text }.error(at..at + 1, "y", "bad", "good");
+        let d = Source {
+            file: "m.toml",
+            text: &text,
+        }
+        .error(at..at + 1, "y", "bad", "good");
         assert_eq!(d.column, 4 + 1 + 70_000 + 1 + 1 + 1);
         let s = d.to_string();
         let lines: Vec<&str> = s.lines().collect();
@@ -196,7 +202,11 @@ mod tests {
     fn an_error_at_the_end_of_a_long_line() {
         let text = format!("x = \"{}\"", "a".repeat(500));
         let at = text.len() - 1;
-        let d = Source { file: "m.toml", text: &text }.error(at..at + 1, "x", "bad", "good");
+        let d = Source {
+            file: "m.toml",
+            text: &text,
+        }
+        .error(at..at + 1, "x", "bad", "good");
         let s = d.to_string();
         let lines: Vec<&str> = s.lines().collect();
         let excerpt = lines[2].strip_prefix("1 | ").unwrap();

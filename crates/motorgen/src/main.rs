@@ -4,6 +4,7 @@ mod atomic;
 mod commission;
 mod exit;
 mod firmware;
+mod folders;
 mod identify;
 mod output;
 mod report;
@@ -28,7 +29,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Print the whole design of one motor.
+    /// Print the design of one motor: its summary (the headline constants and checks),
+    /// or with --format the whole design as JSON, or the Rust, C or Markdown output.
     Design {
         /// The motor spec, e.g. motors/fischer-ti085.toml.
         #[arg(value_name = "SPEC")]
@@ -76,9 +78,9 @@ enum Command {
         /// File stem: lowercase letters, digits and '-'.
         #[arg(value_name = "STEM")]
         stem: String,
-        /// Directory of motor specs.
-        #[arg(long, value_name = "DIR")]
-        dir: Option<PathBuf>,
+        /// Directory of motor specs (default: motors/ in the working directory).
+        #[arg(long = "motors-dir", visible_alias = "dir", value_name = "DIR", env = folders::MOTORS_ENV)]
+        motors_dir: Option<PathBuf>,
     },
     /// Build the STM32G474 image of one motor (or --all) on a board into
     /// target/firmware/STEM.elf and .bin (target/firmware/BOARD/… for a board other than
@@ -91,14 +93,15 @@ enum Command {
         /// Every motor in the motors folder.
         #[arg(long)]
         all: bool,
-        /// Directory of motor specs (default: motors/).
-        #[arg(long, value_name = "DIR")]
-        dir: Option<PathBuf>,
+        /// Directory of motor specs (default: motors/ in the working directory).
+        #[arg(long = "motors-dir", visible_alias = "dir", value_name = "DIR", env = folders::MOTORS_ENV)]
+        motors_dir: Option<PathBuf>,
         /// Board file stem in the boards folder (default: motorgen-reference).
         #[arg(long, value_name = "BOARD", default_value = codegen::board::DEFAULT_BOARD)]
         board: String,
-        /// Directory of board files (default: boards/ beside the motors folder).
-        #[arg(long, value_name = "DIR")]
+        /// Directory of board files (default: boards/ beside the motors folder, else in
+        /// the working directory).
+        #[arg(long, value_name = "DIR", env = folders::BOARDS_ENV)]
         boards_dir: Option<PathBuf>,
     },
     /// Simulate the firmware's current loop and observer with the motor and print a
@@ -146,17 +149,17 @@ enum Command {
     /// as `identify … --candump` does (exit 6 refused/aborted, 69 no CAN interface,
     /// 75 timeout; nothing written then).
     Commission(commission::CommissionArgs),
-    /// List the motors in a directory (default: motors/).
+    /// List the motors in a directory (default: motors/ in the working directory).
     List {
         /// Directory of motor specs.
-        #[arg(long, value_name = "DIR")]
-        dir: Option<PathBuf>,
+        #[arg(long = "motors-dir", visible_alias = "dir", value_name = "DIR", env = folders::MOTORS_ENV)]
+        motors_dir: Option<PathBuf>,
     },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Format {
-    /// Human-readable headline constants.
+    /// Human-readable headline constants and checks (the default).
     Summary,
     /// The complete design as JSON (SI units).
     Json,
@@ -195,23 +198,42 @@ fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String
     }
 }
 
-/// Reads a spec or board file as UTF-8 text: an unreadable file is an I/O failure,
-/// invalid UTF-8 bad input; both name the file.
+/// What an unreadable motor spec's message says would be accepted.
+const READABLE_SPEC: &str = "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)";
+/// What an unreadable board file's message says would be accepted.
+const READABLE_BOARD: &str = "a readable board file, e.g. boards/motorgen-reference.toml";
+/// What an unreadable file of `check` (a spec or a board) says would be accepted.
+const READABLE_SPEC_OR_BOARD: &str =
+    "a readable motor spec or board file, e.g. motors/fischer-ti085.toml or boards/motorgen-reference.toml";
+
+/// Reads a motor spec as UTF-8 text: an unreadable file is an I/O failure, invalid
+/// UTF-8 bad input; both name the file.
 fn read_spec(path: &Path) -> Result<String, Failure> {
     Ok(read_input(path).text?)
 }
 
-/// A spec or board file as the library crates take it: its text, or why it could not be
-/// read (an unreadable file, or bad input located at its first invalid UTF-8 byte).
+/// Reads a board file as [`read_spec`] reads a spec.
+fn read_board(path: &Path) -> Result<String, Failure> {
+    Ok(read_board_input(path).text?)
+}
+
+/// A motor spec as the library crates take it: its text, or why it could not be read
+/// (an unreadable file, or bad input located at its first invalid UTF-8 byte).
 fn read_input(path: &Path) -> Input {
+    read_as(path, READABLE_SPEC)
+}
+
+/// A board file as the library crates take it (see [`read_input`]).
+fn read_board_input(path: &Path) -> Input {
+    read_as(path, READABLE_BOARD)
+}
+
+/// `path` read as an input whose unreadable message names `accepted`.
+fn read_as(path: &Path, accepted: &str) -> Input {
     let name = path.display().to_string();
     match std::fs::read(path) {
         Ok(bytes) => Input::from_bytes(name, bytes),
-        Err(e) => Input::unreadable(
-            name,
-            format!("cannot read the file: {e}"),
-            "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)",
-        ),
+        Err(e) => Input::unreadable(name, format!("cannot read the file: {e}"), accepted),
     }
 }
 
@@ -226,25 +248,13 @@ fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failu
         return design(path);
     };
     let text = read_spec(path)?;
-    let board_text = read_spec(board)?;
+    let board_text = read_board(board)?;
     Ok(codegen::design_with_board(
         &path.display().to_string(),
         &text,
         &board.display().to_string(),
         &board_text,
     )?)
-}
-
-/// `motors/` in the working directory, else the one in this repository.
-fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
-    dir.unwrap_or_else(|| {
-        let here = PathBuf::from("motors");
-        if here.is_dir() {
-            here
-        } else {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("motors")
-        }
-    })
 }
 
 fn main() -> ExitCode {
@@ -308,19 +318,22 @@ fn run(command: Command) -> Result<(), Failure> {
             for path in &specs {
                 // Read once; a file with a top-level `chip` is a board, anything else a motor.
                 let name = path.display().to_string();
-                let checked = read_spec(path).and_then(|text| {
-                    if codegen::board::is_board_file(&text) {
-                        let b = codegen::board_source(&name, &text)?;
-                        outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
-                    } else {
-                        let d = codegen::design_source(&name, &text)?;
-                        outln!("ok: {name} ({})", d.name);
-                        for w in &d.warnings {
-                            output::warn(format_args!("{name}: {w}"));
+                let checked = read_as(path, READABLE_SPEC_OR_BOARD)
+                    .text
+                    .map_err(Failure::from)
+                    .and_then(|text| {
+                        if codegen::board::is_board_file(&text) {
+                            let b = codegen::board_source(&name, &text)?;
+                            outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
+                        } else {
+                            let d = codegen::design_source(&name, &text)?;
+                            outln!("ok: {name} ({})", d.name);
+                            for w in &d.warnings {
+                                output::warn(format_args!("{name}: {w}"));
+                            }
                         }
-                    }
-                    Ok(())
-                });
+                        Ok(())
+                    });
                 if let Err(f) = checked {
                     failed.push(f.exit);
                     f.report();
@@ -334,7 +347,7 @@ fn run(command: Command) -> Result<(), Failure> {
                 )),
             }
         }
-        Command::New { stem, dir } => {
+        Command::New { stem, motors_dir } => {
             if stem.is_empty()
                 || !stem
                     .chars()
@@ -348,7 +361,7 @@ fn run(command: Command) -> Result<(), Failure> {
                     ),
                 ));
             }
-            let dir = motors_dir(dir);
+            let dir = folders::motors(motors_dir)?;
             let path = dir.join(format!("{stem}.toml"));
             if path.exists() {
                 return Err(Failure::new(
@@ -371,7 +384,7 @@ fn run(command: Command) -> Result<(), Failure> {
         Command::Firmware {
             stem,
             all,
-            dir,
+            motors_dir,
             board,
             boards_dir,
         } => {
@@ -379,15 +392,8 @@ fn run(command: Command) -> Result<(), Failure> {
                 Some(stem) if !all => firmware::Which::One(stem),
                 _ => firmware::Which::All,
             };
-            let motors = motors_dir(dir);
-            let boards = boards_dir.unwrap_or_else(|| {
-                let beside = motors.join("..").join("boards");
-                if beside.is_dir() {
-                    beside
-                } else {
-                    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("boards")
-                }
-            });
+            let motors = folders::motors(motors_dir)?;
+            let boards = folders::boards(boards_dir, &motors)?;
             firmware::run(which, &motors, &board, &boards)
         }
         Command::Verify { spec } => verify::run(&spec),
@@ -400,7 +406,7 @@ fn run(command: Command) -> Result<(), Failure> {
             out,
         } => {
             atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
-            let (spec, board) = (read_input(&spec), read_input(&board));
+            let (spec, board) = (read_input(&spec), read_board_input(&board));
             let logs = identify::read_logs(&candump);
             let files: Vec<(PathBuf, Vec<u8>)> = motor_commission::identify::capture_files(&spec, &board, &logs)?
                 .into_iter()
@@ -413,22 +419,31 @@ fn run(command: Command) -> Result<(), Failure> {
             Ok(())
         }
         Command::Commission(args) => commission::run(&args),
-        Command::List { dir } => {
-            let dir = motors_dir(dir);
+        Command::List { motors_dir } => {
+            let dir = folders::motors(motors_dir)?;
             let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)
                 .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read {}: {e}", dir.display())))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.extension().is_some_and(|x| x == "toml"))
                 .collect();
             entries.sort();
-            for path in entries {
-                let stem = path
-                    .file_stem()
+            let stem = |path: &Path| {
+                path.file_stem()
                     .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default();
+                    .unwrap_or_default()
+            };
+            // One column for every stem, however long (the names start in one column).
+            let width = entries
+                .iter()
+                .map(|p| stem(p).chars().count())
+                .max()
+                .unwrap_or(0)
+                .max(24);
+            for path in entries {
+                let stem = stem(&path);
                 match design(&path) {
-                    Ok(d) => outln!("{stem:<24} {}", d.name),
-                    Err(_) => outln!("{stem:<24} INVALID (`motorgen check {}` says why)", path.display()),
+                    Ok(d) => outln!("{stem:<width$} {}", d.name),
+                    Err(_) => outln!("{stem:<width$} INVALID (`motorgen check {}` says why)", path.display()),
                 }
             }
             Ok(())
