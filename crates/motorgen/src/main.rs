@@ -212,6 +212,11 @@ fn read_spec(path: &Path) -> Result<String, Failure> {
     Ok(read_input(path).text?)
 }
 
+/// Reads a file of `check` (a spec or a board) as [`read_spec`] reads a spec.
+fn read_spec_or_board(path: &Path) -> Result<String, Failure> {
+    Ok(read_as(path, READABLE_SPEC_OR_BOARD).text?)
+}
+
 /// Reads a board file as [`read_spec`] reads a spec.
 fn read_board(path: &Path) -> Result<String, Failure> {
     Ok(read_board_input(path).text?)
@@ -318,22 +323,19 @@ fn run(command: Command) -> Result<(), Failure> {
             for path in &specs {
                 // Read once; a file with a top-level `chip` is a board, anything else a motor.
                 let name = path.display().to_string();
-                let checked = read_as(path, READABLE_SPEC_OR_BOARD)
-                    .text
-                    .map_err(Failure::from)
-                    .and_then(|text| {
-                        if codegen::board::is_board_file(&text) {
-                            let b = codegen::board_source(&name, &text)?;
-                            outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
-                        } else {
-                            let d = codegen::design_source(&name, &text)?;
-                            outln!("ok: {name} ({})", d.name);
-                            for w in &d.warnings {
-                                output::warn(format_args!("{name}: {w}"));
-                            }
+                let checked = read_spec_or_board(path).and_then(|text| {
+                    if codegen::board::is_board_file(&text) {
+                        let b = codegen::board_source(&name, &text)?;
+                        outln!("ok: {name} (board: {}, {} {})", b.name, b.chip, b.package);
+                    } else {
+                        let d = codegen::design_source(&name, &text)?;
+                        outln!("ok: {name} ({})", d.name);
+                        for w in &d.warnings {
+                            output::warn(format_args!("{name}: {w}"));
                         }
-                        Ok(())
-                    });
+                    }
+                    Ok(())
+                });
                 if let Err(f) = checked {
                     failed.push(f.exit);
                     f.report();
