@@ -8,10 +8,10 @@ use super::continuous::{Promise, natural_frequency};
 use super::{Request, axis_letter, design};
 use crate::spec::Method;
 
-/// Both axes' requests (d, q) at bandwidth `alpha` [rad/s]: the first floor breach or
-/// design error, `None` if both axes meet the floors.
-pub fn breach_at(axes: &[Request; 2], alpha: f64) -> Option<String> {
-    for req in axes.map(|r| r.at_bandwidth(alpha)) {
+/// The axes' requests (d, q, or one axis) at bandwidth `alpha` [rad/s]: the first floor
+/// breach or design error, `None` if every axis meets the floors.
+pub fn breach_at(axes: &[Request], alpha: f64) -> Option<String> {
+    for req in axes.iter().map(|r| r.at_bandwidth(alpha)) {
         match design(&req) {
             Ok(g) => {
                 if let Some(b) = g.sampled.breach(&Promise::of(&req)) {
@@ -27,8 +27,8 @@ pub fn breach_at(axes: &[Request; 2], alpha: f64) -> Option<String> {
 /// The smallest bandwidth the method accepts [rad/s]: above the right-half-plane-zero
 /// limit of pole placement (thesis A §5.4.1), above R/L of active damping (thesis B
 /// (2.43)), else 10⁻⁴ of the requested one.
-fn lowest(axes: &[Request; 2]) -> f64 {
-    let [d, _] = axes;
+fn lowest(axes: &[Request]) -> f64 {
+    let Some(d) = axes.first() else { return 0.0 };
     let rl = axes
         .iter()
         .map(|a| a.resistance_ohm / a.inductance_h)
@@ -44,10 +44,11 @@ fn lowest(axes: &[Request; 2]) -> f64 {
 }
 
 /// The largest bandwidth [rad/s] up to the requested one (the axes share it) whose
-/// sampled loop meets the floors of [`super::analysis`] on both axes, by bisection on a
-/// logarithmic scale (to 0.1 %); `None` if even the method's smallest bandwidth does not.
-pub fn largest_bandwidth(axes: &[Request; 2]) -> Option<f64> {
-    let alpha = axes[0].bandwidth_rad_s;
+/// sampled loop meets the floors of [`super::analysis`] on every axis, by bisection on a
+/// logarithmic scale (to 0.1 %); `None` if even the method's smallest bandwidth does not
+/// (or there is no axis).
+pub fn largest_bandwidth(axes: &[Request]) -> Option<f64> {
+    let alpha = axes.first()?.bandwidth_rad_s;
     if breach_at(axes, alpha).is_none() {
         return Some(alpha);
     }

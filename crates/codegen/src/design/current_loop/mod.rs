@@ -10,16 +10,19 @@
 //! 3. [`analysis`] — the sampled loop's poles, gain and phase margins, overshoot and rise
 //!    time, and the floors it must meet;
 //! 4. [`bandwidth`] — the largest bandwidth whose sampled loop meets the floors on both
-//!    axes (what an error names).
+//!    axes (what an error names);
+//! 5. [`rules`] — the verdict on a request with the message of its refusal, the one set
+//!    of rules of the design's current-loop section and the `pi_gains!` proc-macro.
 //!
 //! One [`Request`] carries an axis's inputs through all of them; [`design()`] runs the
 //! first three. The spec-facing side (the `current_loop` section of the design, its
-//! checks and messages) is `design::sections::current_loop`.
+//! checks and messages located at the spec's keys) is `design::sections::current_loop`.
 
 pub mod analysis;
 pub mod bandwidth;
 pub mod continuous;
 pub mod discrete;
+pub mod rules;
 
 pub use analysis::AxisGains;
 pub use continuous::CurrentLoopError;
