@@ -453,7 +453,7 @@ mod tests {
         let mut refused = 0;
         for (method, damping) in [
             ("imc", None),
-            ("pole_placement", Some(0.7071)),
+            ("pole_placement", Some(0.75)),
             ("imc_active_damping", None),
         ] {
             for compensate in [true, false] {
