@@ -6,16 +6,13 @@ use std::path::Path;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 
+/// `(motors/<stem>.toml, text)` of every motor; an empty or unreadable `motors/` fails
+/// (`motor_test_support::motors`) instead of benchmarking nothing.
 fn specs() -> Vec<(String, String)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../motors");
-    let mut v: Vec<_> = std::fs::read_dir(dir)
-        .unwrap()
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .map(|p| (p.display().to_string(), std::fs::read_to_string(&p).unwrap()))
-        .collect();
-    v.sort();
-    v
+    motor_test_support::motors()
+        .into_iter()
+        .map(|(_, rel, text)| (rel, text))
+        .collect()
 }
 
 fn bench(c: &mut Criterion) {

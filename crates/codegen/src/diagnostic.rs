@@ -110,10 +110,13 @@ impl fmt::Display for Diagnostic {
         }
         writeln!(f, "{}", self.problem)?;
         if !self.excerpt.is_empty() {
-            let gutter = self.line.to_string().len();
-            writeln!(f, "{:gutter$} |", "")?;
-            writeln!(f, "{} | {}", self.line, self.excerpt)?;
-            writeln!(f, "{:gutter$} | {:>col$}", "", "^", col = self.column)?;
+            let gutter = " ".repeat(self.line.to_string().len());
+            let (shown, caret) = excerpt_window(&self.excerpt, self.column);
+            writeln!(f, "{gutter} |")?;
+            writeln!(f, "{} | {shown}", self.line)?;
+            // The caret's indent is written out, not a format width: a width above
+            // u16::MAX (a column past 65 535 on one long line) panics in `fmt`.
+            writeln!(f, "{gutter} | {}^", " ".repeat(caret - 1))?;
         }
         write!(f, "  accepted: {}", self.accepted)?;
         for n in &self.notes {
@@ -121,6 +124,40 @@ impl fmt::Display for Diagnostic {
         }
         Ok(())
     }
+}
+
+/// Longest excerpt line shown whole \[characters\] (the shipped specs and boards stay below
+/// 160); a longer line is shown as a window of
+/// [`EXCERPT_WINDOW`] characters around the column.
+pub const EXCERPT_MAX: usize = 240;
+/// Characters of a long line shown around the column \[characters\].
+pub const EXCERPT_WINDOW: usize = 80;
+/// Characters of the window before the column \[characters\].
+const WINDOW_BEFORE: usize = 30;
+
+/// The part of `line` shown under a message and the 1-based character column of the
+/// caret in it: the whole line up to [`EXCERPT_MAX`] characters, else
+/// [`EXCERPT_WINDOW`] characters around `column` with `…` where the line goes on (a
+/// spec may hold one line of megabytes; the excerpt stays one screen line).
+fn excerpt_window(line: &str, column: usize) -> (String, usize) {
+    let len = line.chars().count();
+    let column = column.clamp(1, len + 1);
+    if len <= EXCERPT_MAX {
+        return (line.to_string(), column);
+    }
+    let start = (column - 1)
+        .saturating_sub(WINDOW_BEFORE)
+        .min(len.saturating_sub(EXCERPT_WINDOW));
+    let end = (start + EXCERPT_WINDOW).min(len);
+    let mut shown = String::new();
+    if start > 0 {
+        shown.push('…');
+    }
+    shown.extend(line.chars().skip(start).take(end - start));
+    if end < len {
+        shown.push('…');
+    }
+    (shown, column - start + usize::from(start > 0))
 }
 
 /// All problems found in one spec (never empty when returned as an error).
@@ -158,6 +195,63 @@ mod tests {
         let (line, column, excerpt) = locate(text, 6 + 2 + 1);
         assert_eq!((line, column), (2, 3));
         assert_eq!(excerpt, "µ = \"x\"");
+    }
+
+    /// Issue 31: an error past column 65 535 panicked in `Display` ("Formatting argument
+    /// out of range", the caret's width). Now the line is shown as a window around the
+    /// column with the caret under the offending character.
+    #[test]
+    fn an_error_far_along_one_long_line_displays_a_window() {
+        let pad = "#".repeat(70_000);
+        let text = format!("x = \"{pad}\" y = \"{}\"\n", "b".repeat(1000));
+        let at = text.find(" y").unwrap() + 1;
+        let d = Source {
+            file: "m.toml",
+            text: &text,
+        }
+        .error(at..at + 1, "y", "bad", "good");
+        assert_eq!(d.column, 4 + 1 + 70_000 + 1 + 1 + 1);
+        let s = d.to_string();
+        let lines: Vec<&str> = s.lines().collect();
+        assert!(lines[0].starts_with("error: m.toml:1:70008: `y`: bad"), "{s}");
+        let excerpt = lines[2].strip_prefix("1 | ").unwrap();
+        let caret = lines[3].strip_prefix("  | ").unwrap();
+        // The window: 30 characters before the column, "…" on both sides where the line
+        // is cut, and the caret under `y`.
+        assert!(excerpt.starts_with('…') && excerpt.ends_with('…'), "{excerpt}");
+        assert_eq!(excerpt.chars().count(), EXCERPT_WINDOW + 2, "{excerpt}");
+        let caret_col = caret.chars().count();
+        assert_eq!(caret.trim_start(), "^");
+        assert_eq!(excerpt.chars().nth(caret_col - 1), Some('y'), "{excerpt}\n{caret}");
+        assert_eq!(caret_col, 1 + WINDOW_BEFORE + 1);
+    }
+
+    /// A short line is shown whole, as before: the caret's indent is the column − 1.
+    #[test]
+    fn a_short_line_is_shown_whole() {
+        let text = "inductance = 0.393\n";
+        let d = Source { file: "m.toml", text }.error(13..18, "inductance", "bare", "unit");
+        let s = d.to_string();
+        assert!(s.contains("1 | inductance = 0.393\n  |              ^\n"), "{s}");
+    }
+
+    /// The end of a long line: the window ends at the line's end, no trailing `…`.
+    #[test]
+    fn an_error_at_the_end_of_a_long_line() {
+        let text = format!("x = \"{}\"", "a".repeat(500));
+        let at = text.len() - 1;
+        let d = Source {
+            file: "m.toml",
+            text: &text,
+        }
+        .error(at..at + 1, "x", "bad", "good");
+        let s = d.to_string();
+        let lines: Vec<&str> = s.lines().collect();
+        let excerpt = lines[2].strip_prefix("1 | ").unwrap();
+        assert!(excerpt.starts_with('…') && excerpt.ends_with("a\""), "{excerpt}");
+        assert_eq!(excerpt.chars().count(), EXCERPT_WINDOW + 1);
+        let caret = lines[3].strip_prefix("  | ").unwrap();
+        assert_eq!(excerpt.chars().nth(caret.chars().count() - 1), Some('"'));
     }
 
     #[test]

@@ -4,7 +4,8 @@
 //! * [`motor_constants!`] — the generated module of a motor spec.
 //! * [`q31!`], [`q15!`] — fixed-point literals (`fixed::types::I1F31` / `I1F15`).
 //! * [`ato_gains!`] — angle-tracking-observer gains in Q1.31 (thesis A 4.15, 4.22).
-//! * [`pi_gains!`] — current-loop PI gains (thesis A 5.9, 5.14; thesis B 2.38).
+//! * [`pi_gains!`] — current-loop PI gains (thesis A 5.9, 5.14; thesis B 2.38) through
+//!   the design core's current-loop pipeline and its rules, as `motorgen check` applies them.
 //!
 //! Errors are `compile_error!`s spanned at the offending argument.
 
@@ -55,9 +56,23 @@ pub fn ato_gains(input: TokenStream) -> TokenStream {
         .into()
 }
 
-/// Current-loop PI gains `(K_p, K_i)` as `f32` for one axis:
+/// Current-loop PI gains `(K_p, K_i)` (parallel form, thesis A (5.6a)) as `f32` for one
+/// axis, designed as `motorgen` designs a spec's `[current_loop]`:
 /// `pi_gains!(method = imc, resistance = "0.126 Ω", inductance = "0.393 mH", bandwidth = "100 rad/s", fs = "20 kHz")`
-/// (`damping = 0.7071` for `pole_placement`).
+/// (`damping = 0.7071` for `pole_placement`; `compensate_delay = false` to opt out of
+/// the delay compensation, as in a spec). The gains are the design core's current-loop
+/// pipeline (thesis A 5.9, 5.14; thesis B 2.38, with the firmware's 1.5·T_s delay), and
+/// a bandwidth `motorgen check` refuses — a sampled loop below the phase/gain-margin,
+/// overshoot or rise-time floors, a right-half-plane zero, negative active damping — is a
+/// compile error at `bandwidth` naming the rule, the figure and the bandwidth that works.
+/// What `check` refuses beyond these rules needs the motor, not only R and L: the
+/// at-speed figures `motorgen verify` judges (the axes kept apart by the decoupling
+/// feed-forward, a DC-link step ridden; they need ψ_M, the top speed and the DC link) —
+/// a motor's whole design, with them, is `motor_constants!`. The thesis-A guideline (α
+/// below 30 % / 17 % of f_s) is a warning in `check` and not reported here (a proc-macro
+/// cannot warn on stable Rust). With `imc_active_damping`
+/// the firmware also needs R_a, and with `pole_placement` the prefilter: those come
+/// from `motor_constants!`.
 #[proc_macro]
 pub fn pi_gains(input: TokenStream) -> TokenStream {
     expand::pi_gains(input.into())

@@ -34,18 +34,20 @@ pub struct CommissionArgs {
     /// Directory for the CSV recording of the capture (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
+    // These four are `global`: accepted before the routine or after its own options
+    // (`… step --axis d --voltage "4 V" --trip "30 A" --dry-run`, as README shows).
     /// How long to wait for the whole capture, e.g. "30 s".
-    #[arg(long, default_value = "30 s", value_name = "TIME")]
+    #[arg(long, default_value = "30 s", value_name = "TIME", global = true)]
     pub timeout: String,
     /// Control periods per captured sample (default: the smallest whose capture fits
     /// the drive's buffer).
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", global = true)]
     pub decimation: Option<u16>,
     /// Print the change to the spec instead of writing it (the CSV is still written).
-    #[arg(long)]
+    #[arg(long, global = true)]
     pub dry_run: bool,
     /// Identification date written to `date` (YYYY-MM-DD; default: today, UTC).
-    #[arg(long)]
+    #[arg(long, global = true)]
     pub date: Option<String>,
     /// The routine.
     #[command(subcommand)]
@@ -119,7 +121,7 @@ pub fn run(a: &CommissionArgs) -> Result<(), Failure> {
 fn plan(a: &CommissionArgs) -> Result<Plan, Failure> {
     atomic::check_out_dir(&a.out).map_err(|e| Failure::new(Exit::BadInput, e))?;
     let spec = crate::read_input(&a.spec);
-    let board = crate::read_input(&a.board);
+    let board = crate::read_board_input(&a.board);
     Ok(commission::plan(&options(a), &spec, &board)?)
 }
 

@@ -18,8 +18,8 @@
 //! budget (the G474RE itself has 512 KiB) is an error and is not written.
 //!
 //! The repository root is the nearest ancestor of the motors folder that holds
-//! `firmware/Cargo.toml`, else the nearest such ancestor of the current directory,
-//! else the repository `motorgen` was built from.
+//! `firmware/Cargo.toml`, else the nearest such ancestor of the current directory —
+//! never the source tree `motorgen` was built from (an installed binary's build path).
 
 use std::fmt::Write as _;
 use std::io::{BufRead, BufReader, Read};
@@ -215,7 +215,6 @@ fn root_above(start: &Path) -> Option<PathBuf> {
 fn repo_root(motors: &Path) -> Result<PathBuf, String> {
     root_above(motors)
         .or_else(|| std::env::current_dir().ok().and_then(|d| root_above(&d)))
-        .or_else(|| root_above(&Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")))
         .ok_or_else(|| {
             format!(
                 "cannot find the repository (a folder holding firmware/Cargo.toml) above {} or the \

@@ -181,7 +181,7 @@ pub fn run(what: What) -> Result<(), Failure> {
         .board
         .as_deref()
         .filter(|_| !common.candump.is_empty())
-        .map(crate::read_input);
+        .map(crate::read_board_input);
     let request = Request {
         what,
         date: common.date,

@@ -4,6 +4,7 @@ mod atomic;
 mod commission;
 mod exit;
 mod firmware;
+mod folders;
 mod identify;
 mod output;
 mod report;
@@ -28,7 +29,8 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
-    /// Print the whole design of one motor.
+    /// Print the design of one motor: its summary (the headline constants and checks),
+    /// or with --format the whole design as JSON, or the Rust, C or Markdown output.
     Design {
         /// The motor spec, e.g. motors/fischer-ti085.toml.
         #[arg(value_name = "SPEC")]
@@ -82,9 +84,9 @@ enum Command {
         /// File stem: lowercase letters, digits and '-'.
         #[arg(value_name = "STEM")]
         stem: String,
-        /// Directory of motor specs.
-        #[arg(long, value_name = "DIR")]
-        dir: Option<PathBuf>,
+        /// Directory of motor specs (default: motors/ in the working directory).
+        #[arg(long = "motors-dir", visible_alias = "dir", value_name = "DIR", env = folders::MOTORS_ENV)]
+        motors_dir: Option<PathBuf>,
     },
     /// Build the STM32G474 image of one motor (or --all) on a board into
     /// target/firmware/STEM.elf and .bin (target/firmware/BOARD/… for a board other than
@@ -97,14 +99,15 @@ enum Command {
         /// Every motor in the motors folder.
         #[arg(long)]
         all: bool,
-        /// Directory of motor specs (default: motors/).
-        #[arg(long, value_name = "DIR")]
-        dir: Option<PathBuf>,
+        /// Directory of motor specs (default: motors/ in the working directory).
+        #[arg(long = "motors-dir", visible_alias = "dir", value_name = "DIR", env = folders::MOTORS_ENV)]
+        motors_dir: Option<PathBuf>,
         /// Board file stem in the boards folder (default: motorgen-reference).
         #[arg(long, value_name = "BOARD", default_value = codegen::board::DEFAULT_BOARD)]
         board: String,
-        /// Directory of board files (default: boards/ beside the motors folder).
-        #[arg(long, value_name = "DIR")]
+        /// Directory of board files (default: boards/ beside the motors folder, else in
+        /// the working directory).
+        #[arg(long, value_name = "DIR", env = folders::BOARDS_ENV)]
         boards_dir: Option<PathBuf>,
     },
     /// Simulate the firmware's current loop and observer with the motor and print a
@@ -161,17 +164,17 @@ enum Command {
     /// as `identify … --candump` does (exit 6 refused/aborted, 69 no CAN interface,
     /// 75 timeout; nothing written then).
     Commission(commission::CommissionArgs),
-    /// List the motors in a directory (default: motors/).
+    /// List the motors in a directory (default: motors/ in the working directory).
     List {
         /// Directory of motor specs.
-        #[arg(long, value_name = "DIR")]
-        dir: Option<PathBuf>,
+        #[arg(long = "motors-dir", visible_alias = "dir", value_name = "DIR", env = folders::MOTORS_ENV)]
+        motors_dir: Option<PathBuf>,
     },
 }
 
 #[derive(Clone, Copy, ValueEnum)]
 enum Format {
-    /// Human-readable headline constants.
+    /// Human-readable headline constants and checks (the default).
     Summary,
     /// The complete design as JSON (SI units).
     Json,
@@ -210,23 +213,47 @@ fn render(d: &codegen::Design, out: Output, dir: Option<&Path>) -> Result<String
     }
 }
 
-/// Reads a spec or board file as UTF-8 text: an unreadable file is an I/O failure,
-/// invalid UTF-8 bad input; both name the file.
+/// What an unreadable motor spec's message says would be accepted.
+const READABLE_SPEC: &str = "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)";
+/// What an unreadable board file's message says would be accepted.
+const READABLE_BOARD: &str = "a readable board file, e.g. boards/motorgen-reference.toml";
+/// What an unreadable file of `check` (a spec or a board) says would be accepted.
+const READABLE_SPEC_OR_BOARD: &str =
+    "a readable motor spec or board file, e.g. motors/fischer-ti085.toml or boards/motorgen-reference.toml";
+
+/// Reads a motor spec as UTF-8 text: an unreadable file is an I/O failure, invalid
+/// UTF-8 bad input; both name the file.
 fn read_spec(path: &Path) -> Result<String, Failure> {
     Ok(read_input(path).text?)
 }
 
-/// A spec or board file as the library crates take it: its text, or why it could not be
-/// read (an unreadable file, or bad input located at its first invalid UTF-8 byte).
+/// Reads a file of `check` (a spec or a board) as [`read_spec`] reads a spec.
+fn read_spec_or_board(path: &Path) -> Result<String, Failure> {
+    Ok(read_as(path, READABLE_SPEC_OR_BOARD).text?)
+}
+
+/// Reads a board file as [`read_spec`] reads a spec.
+fn read_board(path: &Path) -> Result<String, Failure> {
+    Ok(read_board_input(path).text?)
+}
+
+/// A motor spec as the library crates take it: its text, or why it could not be read
+/// (an unreadable file, or bad input located at its first invalid UTF-8 byte).
 fn read_input(path: &Path) -> Input {
+    read_as(path, READABLE_SPEC)
+}
+
+/// A board file as the library crates take it (see [`read_input`]).
+fn read_board_input(path: &Path) -> Input {
+    read_as(path, READABLE_BOARD)
+}
+
+/// `path` read as an input whose unreadable message names `accepted`.
+fn read_as(path: &Path, accepted: &str) -> Input {
     let name = path.display().to_string();
     match std::fs::read(path) {
         Ok(bytes) => Input::from_bytes(name, bytes),
-        Err(e) => Input::unreadable(
-            name,
-            format!("cannot read the file: {e}"),
-            "a readable motor spec, e.g. motors/fischer-ti085.toml (`motorgen list` shows them)",
-        ),
+        Err(e) => Input::unreadable(name, format!("cannot read the file: {e}"), accepted),
     }
 }
 
@@ -250,7 +277,7 @@ fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failu
         return design(path);
     };
     let text = read_spec(path)?;
-    let board_text = read_spec(board)?;
+    let board_text = read_board(board)?;
     Ok(codegen::design_with_board(
         &path.display().to_string(),
         &text,
@@ -259,22 +286,16 @@ fn design_on(path: &Path, board: Option<&Path>) -> Result<codegen::Design, Failu
     )?)
 }
 
-/// `motors/` in the working directory, else the one in this repository.
-fn motors_dir(dir: Option<PathBuf>) -> PathBuf {
-    shipped_dir(dir, "motors")
-}
-
-/// `dir` if given, else `folder` (`motors` or `boards`) in the working directory, else the
-/// one in this repository.
-fn shipped_dir(dir: Option<PathBuf>, folder: &str) -> PathBuf {
-    dir.unwrap_or_else(|| {
-        let here = PathBuf::from(folder);
-        if here.is_dir() {
-            here
-        } else {
-            Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join(folder)
-        }
-    })
+/// The folder a bare name is looked up in: `MOTORGEN_MOTORS_DIR` / `MOTORGEN_BOARDS_DIR`
+/// if set, else `motors/` or `boards/` in the working directory (never the source tree
+/// the binary was built from, [`folders`]).
+fn shipped_dir(folder: &str) -> PathBuf {
+    let var = if folder == "boards" {
+        folders::BOARDS_ENV
+    } else {
+        folders::MOTORS_ENV
+    };
+    std::env::var_os(var).map_or_else(|| PathBuf::from(folder), PathBuf::from)
 }
 
 /// A spec or board argument: the file it names if there is one, else a bare name (no
@@ -286,7 +307,7 @@ fn locate(path: PathBuf, folder: &str) -> PathBuf {
     if path.exists() || !bare {
         return path;
     }
-    let dir = shipped_dir(None, folder);
+    let dir = shipped_dir(folder);
     let mut with_toml = path.clone().into_os_string();
     with_toml.push(".toml");
     [dir.join(&path), dir.join(with_toml)]
@@ -379,7 +400,7 @@ fn run(command: Command) -> Result<(), Failure> {
             for path in &specs {
                 // Read once; a file with a top-level `chip` is a board, anything else a motor.
                 let name = path.display().to_string();
-                let checked = read_spec(path).and_then(|text| {
+                let checked = read_spec_or_board(path).and_then(|text| {
                     if codegen::board::is_board_file(&text) {
                         boards += 1;
                         let b = codegen::board_source(&name, &text)?;
@@ -425,7 +446,7 @@ fn run(command: Command) -> Result<(), Failure> {
                 )),
             }
         }
-        Command::New { stem, dir } => {
+        Command::New { stem, motors_dir } => {
             if stem.is_empty()
                 || !stem
                     .chars()
@@ -439,7 +460,7 @@ fn run(command: Command) -> Result<(), Failure> {
                     ),
                 ));
             }
-            let dir = motors_dir(dir);
+            let dir = folders::motors(motors_dir)?;
             let path = dir.join(format!("{stem}.toml"));
             if path.exists() {
                 return Err(Failure::new(
@@ -462,7 +483,7 @@ fn run(command: Command) -> Result<(), Failure> {
         Command::Firmware {
             stem,
             all,
-            dir,
+            motors_dir,
             board,
             boards_dir,
         } => {
@@ -470,15 +491,8 @@ fn run(command: Command) -> Result<(), Failure> {
                 Some(stem) if !all => firmware::Which::One(stem),
                 _ => firmware::Which::All,
             };
-            let motors = motors_dir(dir);
-            let boards = boards_dir.unwrap_or_else(|| {
-                let beside = motors.join("..").join("boards");
-                if beside.is_dir() {
-                    beside
-                } else {
-                    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..").join("boards")
-                }
-            });
+            let motors = folders::motors(motors_dir)?;
+            let boards = folders::boards(boards_dir, &motors)?;
             firmware::run(which, &motors, &board, &boards)
         }
         Command::Verify { spec, board, format } => {
@@ -493,7 +507,7 @@ fn run(command: Command) -> Result<(), Failure> {
             out,
         } => {
             atomic::check_out_dir(&out).map_err(|e| Failure::new(Exit::BadInput, e))?;
-            let (spec, board) = (read_input(&spec), read_input(&board));
+            let (spec, board) = (read_input(&spec), read_board_input(&board));
             let logs = identify::read_logs(&candump);
             let files: Vec<(PathBuf, Vec<u8>)> = motor_commission::identify::capture_files(&spec, &board, &logs)?
                 .into_iter()
@@ -506,22 +520,31 @@ fn run(command: Command) -> Result<(), Failure> {
             Ok(())
         }
         Command::Commission(args) => commission::run(&args),
-        Command::List { dir } => {
-            let dir = motors_dir(dir);
+        Command::List { motors_dir } => {
+            let dir = folders::motors(motors_dir)?;
             let mut entries: Vec<PathBuf> = std::fs::read_dir(&dir)
                 .map_err(|e| Failure::new(Exit::Io, format!("error: cannot read {}: {e}", dir.display())))?
                 .filter_map(|e| e.ok().map(|e| e.path()))
                 .filter(|p| p.extension().is_some_and(|x| x == "toml"))
                 .collect();
             entries.sort();
-            for path in entries {
-                let stem = path
-                    .file_stem()
+            let stem = |path: &Path| {
+                path.file_stem()
                     .map(|s| s.to_string_lossy().into_owned())
-                    .unwrap_or_default();
+                    .unwrap_or_default()
+            };
+            // One column for every stem, however long (the names start in one column).
+            let width = entries
+                .iter()
+                .map(|p| stem(p).chars().count())
+                .max()
+                .unwrap_or(0)
+                .max(24);
+            for path in entries {
+                let stem = stem(&path);
                 match design(&path) {
-                    Ok(d) => outln!("{stem:<24} {}", d.name),
-                    Err(_) => outln!("{stem:<24} INVALID (`motorgen check {}` says why)", path.display()),
+                    Ok(d) => outln!("{stem:<width$} {}", d.name),
+                    Err(_) => outln!("{stem:<width$} INVALID (`motorgen check {}` says why)", path.display()),
                 }
             }
             Ok(())

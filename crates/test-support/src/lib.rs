@@ -4,6 +4,7 @@
 //! A list that comes out empty (a moved or unreadable `motors/`, a typo in a filter
 //! variable) is a failure, never a loop that runs zero times and passes.
 
+pub mod budget;
 pub mod fuzz;
 
 use std::path::{Path, PathBuf};

@@ -328,7 +328,14 @@ mod tests {
         assert!(worst < 1e-3, "{worst}");
     }
 
-    /// Saturating speed: a sustained maximal error never overflows ω^i.
+    /// Saturating speed: an error that drives ω̂^i past the i32 range leaves it at the
+    /// bound, never wrapped to the other sign. By hand, atan2 error, K̃_p = K̃_i = 1 − 2^-31:
+    /// from θ̂ = 0, ω̂ = 2^31 − 6 with the resolver at −π/2 (atan2 = −2^30), (4.19) gives
+    /// θ̂ = 2^31 − 6 and ẽ = −2^30 − (2^31 − 6) wrapped into [−2^31, 2^31) = 2^30 + 6;
+    /// (4.22): ω̂ = 2^31 − 6 + 0 (ẽ(n−1) = 0) + K̃_p·ẽ ≈ 2^31 + 2^30 → i32::MAX. The mirror
+    /// image (ω̂ = −2^31 + 5, resolver at +π/2) ends at i32::MIN (a wrapped sum would land
+    /// near the other bound; an unchecked i32 sum would panic: overflow checks are on in
+    /// the test profile).
     #[test]
     fn speed_saturates() {
         let cfg = AtoConfig {
@@ -337,10 +344,15 @@ mod tests {
             error: ObserverError::Atan2,
         };
         let mut st = AtoState::locked(0, i32::MAX - 5);
-        for _ in 0..100 {
-            cfg.process(&mut st, &mut SoftTrig, sample(3.0));
-        }
-        // Reaching this line is the test: with overflow checks on (test profile),
-        // any non-saturating i32/i64 overflow in (4.22) would have panicked.
+        let theta = cfg.process(&mut st, &mut SoftTrig, sample(-PI / 2.0));
+        assert_eq!(theta, i32::MAX - 5);
+        // atan2 to 2 LSB (trig.rs).
+        assert!((st.error - ((1 << 30) + 6)).abs() <= 2, "ẽ = {}", st.error);
+        assert_eq!(st.omega, i32::MAX);
+
+        let mut st = AtoState::locked(0, i32::MIN + 5);
+        cfg.process(&mut st, &mut SoftTrig, sample(PI / 2.0));
+        assert!((st.error - (-(1 << 30) - 5)).abs() <= 2, "ẽ = {}", st.error);
+        assert_eq!(st.omega, i32::MIN);
     }
 }

@@ -34,16 +34,10 @@ const CORDIC_CYCLES: u64 = 6;
 /// Cycle budget of one step: 170 MHz core clock / 20 kHz control rate.
 const BUDGET_CYCLES: u64 = 8_500;
 
-/// Motor stems in `dir`, sorted.
-fn motors(dir: &Path) -> Result<Vec<String>, String> {
-    let mut stems: Vec<String> = std::fs::read_dir(dir)
-        .map_err(|e| format!("cannot read {}: {e}", dir.display()))?
-        .filter_map(|e| e.ok().map(|e| e.path()))
-        .filter(|p| p.extension().is_some_and(|x| x == "toml"))
-        .filter_map(|p| p.file_stem().map(|s| s.to_string_lossy().into_owned()))
-        .collect();
-    stems.sort();
-    Ok(stems)
+/// Motor stems in `dir`, sorted; an unreadable or empty `dir` fails
+/// (`motor_test_support::stems_in`), never a table of no motors.
+fn motors(dir: &Path) -> Vec<String> {
+    motor_test_support::stems_in(dir)
 }
 
 /// `x` (× 10) as `<int>.<digit>`.
@@ -135,10 +129,7 @@ fn run() -> Result<(), String> {
         .ok_or("the crate lies inside the firmware workspace")?
         .to_path_buf();
     let dir = std::env::var_os("MOTORS_DIR").map_or_else(|| workspace.join("..").join("motors"), PathBuf::from);
-    let stems = motors(&dir)?;
-    if stems.is_empty() {
-        return Err(format!("no *.toml in {}", dir.display()));
-    }
+    let stems = motors(&dir);
     let mut rows = Vec::new();
     for stem in &stems {
         let elf = build(&workspace, "icount", Some(stem))?;

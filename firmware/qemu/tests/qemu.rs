@@ -66,3 +66,58 @@ fn stack_overflow_reaches_the_hard_fault_handler() {
         "sp {sp:#010x} is not at the stack's bottom"
     );
 }
+
+/// The board the `icount` binary is built for: `motor-config`'s default without `BOARD`
+/// (`codegen::board::DEFAULT_BOARD`, not a dependency of this workspace's tests).
+const DEFAULT_BOARD: &str = "motorgen-reference";
+
+/// Instructions per control step on the emulated Cortex-M4F (`src/bin/icount.rs`, the
+/// `FastTrig` step the image runs, 1000 measured steps, `-icount shift=5`), per motor in
+/// `motors/`: the largest count must lie within ±10 % of the figure recorded in
+/// `firmware/instruction-budgets.txt` (`qemu_control_step`; `MOTORGEN_RECORD_BUDGETS=1`
+/// records a deliberate change). The 1024-`nop` calibration must read 1024 instructions
+/// (5505 ± 1 ticks), or the tick → instruction conversion (and every figure) is wrong.
+#[test]
+fn control_step_instructions_within_budget() {
+    assert!(on_path("qemu-system-arm"), "qemu-system-arm is not on PATH");
+    assert!(on_path("timeout"), "`timeout` (GNU coreutils) is not on PATH");
+    let boards = motor_test_support::board_stems();
+    assert!(
+        boards.iter().any(|b| b == DEFAULT_BOARD),
+        "{DEFAULT_BOARD} is not in boards/: {boards:?}"
+    );
+    let workspace = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("the crate lies inside the firmware workspace");
+    let mut measured = Vec::new();
+    for motor in motor_test_support::motor_stems() {
+        let elf = build(workspace, "icount", Some(&motor)).unwrap_or_else(|e| panic!("{e}"));
+        let stdout = emulate(&elf, &["-icount", "shift=5"], 120).unwrap_or_else(|e| panic!("{motor}: {e}"));
+        let get = |name: &str| {
+            stdout
+                .lines()
+                .filter_map(motor_qemu::icount::Measurement::parse)
+                .find(|m| m.name == name)
+                .unwrap_or_else(|| panic!("{motor}: no `{name}` line in\n{stdout}"))
+                .stats
+        };
+        let nops = get("nop-1024");
+        assert!(
+            nops.min >= 5_504 && nops.max <= 5_506,
+            "{motor}: 1024 nops took {}..{} ticks, expected 5505 ± 1",
+            nops.min,
+            nops.max
+        );
+        let step = get("step-fast-trig");
+        assert!(step.count >= 1000, "{motor}: {} measured steps", step.count);
+        // Instructions × 10, rounded; the figure is whole instructions.
+        let max = (motor_qemu::icount::deci_instructions(u64::from(step.max), 1) + 5) / 10;
+        measured.push(motor_test_support::budget::Figure {
+            figure: "qemu_control_step".into(),
+            motor: motor.clone(),
+            board: DEFAULT_BOARD.into(),
+            instructions: max,
+        });
+    }
+    motor_test_support::budget::check(&measured).unwrap_or_else(|e| panic!("{e}"));
+}

@@ -64,6 +64,27 @@ fn walk(value: &Value, path: &mut String) -> Option<(String, f64)> {
     }
 }
 
+/// The board keys that decide the board section's value at `path` (a JSON path below
+/// `board`), the first the one an error is located at; the sensing keys when the path
+/// is not one of the listed results.
+pub fn deciding_board_keys(path: &str) -> Vec<&'static str> {
+    let leaf = path.rsplit('.').next().unwrap_or(path);
+    match leaf {
+        "dc_link_volts_per_lsb" | "dc_link_full_scale_v" | "dc_link_divider" => {
+            vec!["sensing.dc_link_divider", "sensing.adc_reference"]
+        }
+        "can_bit_rate" | "bit_rate" => vec!["can.bit_rate"],
+        "dead_time_ns" | "dead_time" => vec!["pwm.dead_time"],
+        "over_speed_electrical_rad_s" | "over_speed" => vec!["protection.over_speed"],
+        "conversion_time_s" => vec!["sensing.sampling_cycles", "sensing.adc_reference"],
+        _ => vec![
+            "sensing.current_gain",
+            "sensing.current_offset",
+            "sensing.adc_reference",
+        ],
+    }
+}
+
 /// The spec keys that decide the design section `section` (the first segment of a JSON
 /// path), and the span to report at.
 fn deciding(spec: &Spec, section: &str) -> (&'static str, Range<usize>) {

@@ -170,12 +170,20 @@ fn failed(cx: Context<'_>) -> Diagnostics {
 pub fn on_board(mut design: Design, board: &Board, board_src: Source<'_>) -> Result<Design, Diagnostics> {
     let (out, warnings) = sections::board::board(board, board_src, &design).map_err(Diagnostics)?;
     if let Some((path, x)) = finite::first_non_finite(&minijinja::Value::from(minijinja::value::Serde(&out))) {
+        let keys = finite::deciding_board_keys(&path);
+        let key = keys.first().copied().unwrap_or("");
         return Err(board_src
             .error(
-                0..0,
-                "",
-                format!("the board design's `board.{path}` comes out as {x}: the board's values with this motor overflow f64"),
-                "board values in their physically sensible ranges (see boards/nucleo-g474re.toml)",
+                board.span(key),
+                key,
+                format!(
+                    "the board design's `board.{path}` comes out as {x}: the board's values with this motor overflow f64 (decided by {})",
+                    keys.join(", ")
+                ),
+                format!(
+                    "board values in their physically sensible ranges, as in boards/{}.toml",
+                    crate::board::DEFAULT_BOARD
+                ),
             )
             .into());
     }

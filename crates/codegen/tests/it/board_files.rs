@@ -265,4 +265,33 @@ fn a_stated_fact_contradicting_its_part_is_warned_at_the_key() {
     .unwrap();
     assert!(shipped.warnings.is_empty(), "{:?}", shipped.warnings);
     assert_eq!(board::tim1_ccer_polarity(&shipped), 0x0888);
+/// A board value that only overflows with a motor (issue 31): a DC-link divider of
+/// 1e-300 passes its own range check (a plain ratio) but gives ∞ volts per LSB. The
+/// error is at `sensing.dc_link_divider` (not line 1, column 1), names the keys that
+/// decide the value, and every board file the message points at exists.
+#[test]
+fn a_board_value_overflowing_with_the_motor_is_located_at_its_key() {
+    let board = motor_test_support::read("boards/motorgen-reference.toml");
+    let bad = board.replacen("dc_link_divider = 0.0044", "dc_link_divider = 1e-300", 1);
+    assert_ne!(bad, board, "the reference board's divider line");
+    let spec = motor_test_support::read("motors/fischer-ti085.toml");
+    let e = codegen::design_with_board("motors/fischer-ti085.toml", &spec, "b.toml", &bad)
+        .expect_err("an overflowing board value is refused");
+    let d = &e.0[0];
+    let (line, column) = position(&bad, "1e-300");
+    assert_eq!((d.file.as_str(), d.line, d.column), ("b.toml", line, column), "{d}");
+    assert_eq!(d.key, "sensing.dc_link_divider", "{d}");
+    assert!(d.problem.contains("sensing.adc_reference"), "{d}");
+    let message = d.to_string();
+    let named: Vec<&str> = message
+        .split(|c: char| c.is_whitespace() || c == '(' || c == ')' || c == ',')
+        .filter(|w| w.starts_with("boards/") && w.ends_with(".toml"))
+        .collect();
+    assert!(!named.is_empty(), "{message}");
+    for file in named {
+        assert!(
+            repo().join(file).is_file(),
+            "the message names {file}, which does not exist:\n{message}"
+        );
+    }
 }

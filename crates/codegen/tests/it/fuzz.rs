@@ -112,10 +112,72 @@ const LINES: &[&str] = &[
     "\"",
 ];
 
+/// Extreme but syntactically valid `[fir]` corners (issue 31: a narrow pass band, a stop
+/// edge near f_s/2 and a 99 dB target hung the design): band edges at the validator's
+/// limits and next to f_s/2 for the seed motors' 10 and 20 kHz, orders up to the FMAC's.
+const FIR_PASS: &[&str] = &["0.02 Hz", "0.01 Hz", "1 Hz", "100 Hz", "4 kHz", "4999 Hz"];
+const FIR_STOP: &[&str] = &[
+    "101 Hz", "2 kHz", "4990 Hz", "4999 Hz", "9900 Hz", "9990 Hz", "9999 Hz", "10 kHz",
+];
+const FIR_LENGTH: &[&str] = &[
+    "order = 2",
+    "order = 8",
+    "order = 14",
+    "order = 40",
+    "order = 126",
+    "stop_attenuation = \"99 dB\"",
+    "stop_attenuation = \"100 dB\"",
+    "stop_attenuation = \"60 dB\"",
+    "stop_attenuation = \"1 dB\"",
+];
+const FIR_RIPPLE: &[&str] = &["0.001", "1e-6", "0.5"];
+
 /// One mutation of `text`.
 fn mutate(rng: &mut Rng, text: &str) -> String {
     let lines: Vec<&str> = text.lines().collect();
-    match rng.below(9) {
+    match rng.below(11) {
+        // One very long line (issue 31: an error located past column 65 535 panicked in
+        // the diagnostic's Display): a value pushed far right, or a long bad value.
+        9 => {
+            let candidates: Vec<usize> = lines
+                .iter()
+                .enumerate()
+                .filter(|(_, l)| l.contains('=') && !l.trim_start().starts_with('#'))
+                .map(|(i, _)| i)
+                .collect();
+            if candidates.is_empty() {
+                return text.to_string();
+            }
+            let i = *rng.pick(&candidates);
+            let (key, value) = lines[i].split_once('=').unwrap();
+            let n = *rng.pick(&[300, 65_530, 65_536, 70_000, 200_000]);
+            let line = match rng.below(3) {
+                0 => format!("{key}={}{value}", " ".repeat(n)),
+                1 => format!("{key}= \"{}\"", "9".repeat(n)),
+                _ => format!("{key}={value} # {}", "x".repeat(n)),
+            };
+            replace_line(&lines, i, &line)
+        }
+        // The `[fir]` section replaced by an extreme corner.
+        10 => {
+            let Some(h) = lines.iter().position(|l| l.trim_start().starts_with("[fir]")) else {
+                return text.to_string();
+            };
+            let end = (h + 1..lines.len())
+                .find(|&k| lines[k].trim_start().starts_with('['))
+                .unwrap_or(lines.len());
+            let fir = [
+                "[fir]".to_string(),
+                format!("pass_edge = \"{}\"", rng.pick(FIR_PASS)),
+                format!("stop_edge = \"{}\"", rng.pick(FIR_STOP)),
+                format!("pass_ripple = {}", rng.pick(FIR_RIPPLE)),
+                rng.pick(FIR_LENGTH).to_string(),
+            ];
+            let mut out: Vec<String> = lines[..h].iter().map(|l| (*l).to_string()).collect();
+            out.extend(fir);
+            out.extend(lines[end..].iter().map(|l| (*l).to_string()));
+            out.join("\n")
+        }
         // A number inside a quoted quantity (or a bare number) replaced, its unit maybe too.
         0 | 1 => {
             let candidates: Vec<usize> = lines
@@ -257,7 +319,14 @@ fn judge_design(result: Result<Design, Diagnostics>, files: &[&str]) -> Result<b
             }
             Ok(true)
         }
-        Err(e) => located_in(&e, files).map(|()| false),
+        Err(e) => {
+            // The message as the CLI prints it (its Display panicked past column 65 535).
+            let shown = e.to_string();
+            if !files.iter().any(|f| shown.contains(f)) {
+                return Err(format!("the printed diagnostics name no file: {shown}"));
+            }
+            located_in(&e, files).map(|()| false)
+        }
     }
 }
 

@@ -149,12 +149,17 @@ fn aden_written_once_after_calibration_is_refused_with_the_rule() {
 /// the whole handler: conversions read, trips, setpoint, the control step with the
 /// CORDIC, compare values, BIF/MOE), over 200 periods under a torque setpoint. At one
 /// instruction per cycle the handler must fit in the carrier period's cycles
-/// (SYSCLK/f_s) — a necessary condition; the QEMU figures in firmware/README.md count the
-/// control step alone.
+/// (SYSCLK/f_s) — a necessary condition — and its largest count must lie within ±10 % of
+/// the figure recorded in `firmware/instruction-budgets.txt` (`control_interrupt`, per
+/// motor and board; `MOTORGEN_RECORD_BUDGETS=1` records a deliberate change,
+/// `motor_test_support::budget`): a regression fails, an improvement asks to be recorded.
+/// The QEMU figures (`qemu_control_step`, firmware/qemu/tests/qemu.rs) count the control
+/// step alone.
 #[test]
-fn control_interrupt_instructions_fit_the_period() {
-    for (motor, board) in benches() {
-        let bench = Bench::new(&motor, &board).unwrap();
+fn control_interrupt_instructions_fit_the_period_and_the_budget() {
+    let mut measured = Vec::new();
+    for (motor_stem, board) in benches() {
+        let bench = Bench::new(&motor_stem, &board).unwrap();
         let motor = bench.name();
         let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{motor}: {e}"));
         rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{motor}: {e}"));
@@ -182,5 +187,12 @@ fn control_interrupt_instructions_fit_the_period() {
              {:.1} % of the {cycles:.0} cycles of a period",
             mean / cycles * 100.0
         );
+        measured.push(motor_test_support::budget::Figure {
+            figure: "control_interrupt".into(),
+            motor: motor_stem.clone(),
+            board: board.clone(),
+            instructions: *max,
+        });
     }
+    motor_test_support::budget::check(&measured).unwrap_or_else(|e| panic!("{e}"));
 }

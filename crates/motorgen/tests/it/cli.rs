@@ -113,9 +113,125 @@ fn help_documents_exit_codes_and_value_names() {
     );
     let help = String::from_utf8_lossy(&motorgen(&["new", "--help"]).stdout).into_owned();
     assert!(
-        help.contains("<STEM>") && help.contains("--dir <DIR>") && help.contains("DIR/STEM.toml"),
+        help.contains("<STEM>")
+            && help.contains("--motors-dir <DIR>")
+            && help.contains("MOTORGEN_MOTORS_DIR")
+            && help.contains("DIR/STEM.toml"),
         "{help}"
     );
+    // `design` prints the summary unless --format says otherwise (it said "the whole
+    // design", issue 31).
+    let help = String::from_utf8_lossy(&motorgen(&["design", "--help"]).stdout).into_owned();
+    let first = help.lines().next().unwrap_or_default();
+    let (by_default, _) = first.split_once(", or with --format").unwrap_or((first, ""));
+    assert!(
+        by_default.contains("summary") && !by_default.contains("whole design"),
+        "{first}"
+    );
+    assert!(help.contains("summary") && help.contains("(the default)"), "{help}");
+}
+
+/// `motorgen` (the binary, as `cargo install` leaves it) outside the repository: `list`
+/// and `new` without a motors folder name the option and the variable that give one
+/// (exit 2, nothing written) instead of falling back to the source tree it was built
+/// from; with `--motors-dir` (or `--dir`, or `MOTORGEN_MOTORS_DIR`) they work.
+#[test]
+fn outside_the_repository_the_motors_folder_is_asked_for() {
+    let empty = crate::common::tmp("cli", "no-motors-folder");
+    let run = |args: &[&str], env: Option<&std::path::Path>| {
+        let mut c = std::process::Command::new(env!("CARGO_BIN_EXE_motorgen"));
+        c.args(args)
+            .current_dir(&empty)
+            .env_remove("MOTORGEN_MOTORS_DIR")
+            .env_remove("MOTORGEN_BOARDS_DIR");
+        if let Some(dir) = env {
+            c.env("MOTORGEN_MOTORS_DIR", dir);
+        }
+        c.output().unwrap()
+    };
+    for args in [
+        &["list"][..],
+        &["new", "my-motor"][..],
+        &["firmware", "fischer-ti085"][..],
+    ] {
+        let o = run(args, None);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {}", crate::common::text_of(&o));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.starts_with("error: no motors folder")
+                && err.contains("--motors-dir DIR")
+                && err.contains("MOTORGEN_MOTORS_DIR=DIR"),
+            "{args:?}: {err}"
+        );
+        assert!(o.stdout.is_empty());
+    }
+    assert_eq!(std::fs::read_dir(&empty).unwrap().count(), 0, "nothing written");
+    let motors = repo().join("motors");
+    let m = motors.to_str().unwrap();
+    for o in [
+        run(&["list", "--motors-dir", m], None),
+        run(&["list", "--dir", m], None),
+        run(&["list"], Some(&motors)),
+    ] {
+        assert!(o.status.success(), "{}", crate::common::text_of(&o));
+        let listed = String::from_utf8_lossy(&o.stdout);
+        for stem in crate::common::motor_stems() {
+            assert!(
+                listed.lines().any(|l| l.starts_with(&format!("{stem} "))),
+                "{stem}:\n{listed}"
+            );
+        }
+    }
+}
+
+/// `list` keeps one column for the names however long a stem is (a fixed 24-character
+/// column misaligned longer stems, issue 31).
+#[test]
+fn list_aligns_the_names_after_long_stems() {
+    let dir = crate::common::tmp("cli", "long-stems");
+    let long = "a-motor-stem-much-longer-than-twenty-four-characters";
+    std::fs::write(dir.join(format!("{long}.toml")), fischer()).unwrap();
+    std::fs::write(dir.join("m.toml"), fischer()).unwrap();
+    std::fs::write(dir.join("broken.toml"), "not a spec").unwrap();
+    let o = motorgen(&["list", "--motors-dir", dir.to_str().unwrap()]);
+    assert!(o.status.success(), "{}", crate::common::text_of(&o));
+    let out = String::from_utf8_lossy(&o.stdout).into_owned();
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), 3, "{out}");
+    // Each line: the stem, padding, one space, then the name (or INVALID) — all from
+    // the same column, one past the longest stem.
+    let column = long.chars().count() + 1;
+    for line in &lines {
+        let (stem, rest) = line.split_at(column);
+        assert!(stem.ends_with(' ') && !rest.starts_with(' '), "{out}");
+    }
+    assert!(lines.iter().any(|l| l[column..].starts_with("INVALID")), "{out}");
+    assert!(lines.iter().any(|l| l[column..].starts_with("Fischer TI085")), "{out}");
+}
+
+/// An unreadable `--board` file is named as a board file in the "accepted" line (it was
+/// "a readable motor spec", issue 31); an unreadable spec still as a motor spec.
+#[test]
+fn an_unreadable_board_is_named_as_a_board() {
+    let o = motorgen(&[
+        "design",
+        "motors/fischer-ti085.toml",
+        "--board",
+        "boards/no-such-board.toml",
+    ]);
+    assert_eq!(o.status.code(), Some(EXIT_IO), "{}", crate::common::text_of(&o));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("boards/no-such-board.toml:1:1") && err.contains("accepted: a readable board file"),
+        "{err}"
+    );
+    let o = motorgen(&[
+        "design",
+        "motors/no-such-motor.toml",
+        "--board",
+        "boards/motorgen-reference.toml",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("accepted: a readable motor spec"));
 }
 
 /// The Chalmers HEV50 spec with `compensate_delay = false`, written as `name`: its

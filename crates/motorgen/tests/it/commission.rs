@@ -90,3 +90,32 @@ fn bad_options_exit_1() {
     );
     assert!(!dir.join("out").exists());
 }
+
+/// README's `commission … step --axis d --voltage "4 V" --trip "30 A" --dry-run`: the
+/// session's options are accepted after the routine's own (clap refused them there, exit
+/// 2, issue 31); the command then gets as far as the bus (69 without an interface), and an
+/// option given there is read (`--decimation 0` after `flux`: exit 1 naming it).
+#[test]
+fn session_options_are_accepted_after_the_routine() {
+    let (dir, spec, out) = setup("after");
+    let o = commission(
+        &spec,
+        "mgnone0",
+        &out,
+        &["step", "--axis", "d", "--voltage", "4 V", "--trip", "30 A", "--dry-run"],
+    );
+    assert_eq!(o.status.code(), Some(69), "{}", text_of(&o));
+    let o = commission(
+        &spec,
+        "mgnone0",
+        &out,
+        &["flux", "--decimation", "0", "--timeout", "5 s"],
+    );
+    assert_eq!(o.status.code(), Some(1), "{}", text_of(&o));
+    assert!(
+        String::from_utf8_lossy(&o.stderr).contains("--decimation"),
+        "{}",
+        text_of(&o)
+    );
+    assert!(!dir.join("out").exists());
+}

@@ -11,12 +11,12 @@ use super::continuous::{Promise, natural_frequency};
 use super::{Request, axis_letter, design};
 use crate::spec::Method;
 
-/// Both axes' requests (d, q) at bandwidth `alpha` [rad/s]: the first floor breach or
-/// design error, then (with a `drive`) an at-speed figure that fails ([`at_speed_breach`]);
-/// `None` if both axes meet them.
-pub fn breach_at(axes: &[Request; 2], drive: Option<&Drive>, alpha: f64) -> Option<String> {
+/// The axes' requests (d, q, or one axis) at bandwidth `alpha` [rad/s]: the first floor
+/// breach or design error, then (with a `drive` and both axes, d then q) an at-speed
+/// figure that fails ([`at_speed_breach`]); `None` if every axis meets them.
+pub fn breach_at(axes: &[Request], drive: Option<&Drive>, alpha: f64) -> Option<String> {
     let mut gains = Vec::new();
-    for req in axes.map(|r| r.at_bandwidth(alpha)) {
+    for req in axes.iter().map(|r| r.at_bandwidth(alpha)) {
         match design(&req) {
             Ok(g) => {
                 if let Some(b) = g.sampled.breach(&Promise::of(&req)) {
@@ -73,8 +73,10 @@ pub fn at_speed_breach(dr: &Drive, gains: [&super::AxisGains; 2], alpha: f64) ->
 /// The smallest bandwidth the method accepts [rad/s]: above the right-half-plane-zero
 /// limit of pole placement (thesis A §5.4.1), above R/L of active damping (thesis B
 /// (2.43)), else 10⁻⁴ of the requested one.
-fn lowest(axes: &[Request; 2]) -> f64 {
-    let [d, _] = axes;
+fn lowest(axes: &[Request]) -> f64 {
+    let Some(d) = axes.first() else {
+        return 0.0;
+    };
     let rl = axes
         .iter()
         .map(|a| a.resistance_ohm / a.inductance_h)
@@ -93,11 +95,11 @@ fn lowest(axes: &[Request; 2]) -> f64 {
 /// sampled loop meets the floors of [`super::analysis`] on both axes and (with a `drive`)
 /// the at-speed figures of [`super::at_speed`] (`verify`'s decoupling and DC-link-step
 /// criteria), by bisection on a logarithmic scale (to 0.1 %); `None` if even the method's
-/// smallest bandwidth does not. (The figures worsen with α, the floors hold below their
+/// smallest bandwidth does not (or there is no axis). (The figures worsen with α, the floors hold below their
 /// first breach: the accepted set is an interval from below; the sweep of
 /// `motor-verify`'s `bandwidth_sweep.rs` runs `verify` at the result.)
-pub fn largest_bandwidth(axes: &[Request; 2], drive: Option<&Drive>) -> Option<f64> {
-    let alpha = axes[0].bandwidth_rad_s;
+pub fn largest_bandwidth(axes: &[Request], drive: Option<&Drive>) -> Option<f64> {
+    let alpha = axes.first()?.bandwidth_rad_s;
     if breach_at(axes, drive, alpha).is_none() {
         return Some(alpha);
     }

@@ -13,17 +13,20 @@
 //!    apart after an i_q step with and without the feed-forward (5.3), and a DC-link step
 //!    under the 1/U_dc feed-forward (5.1) — the figures `motorgen verify` judges there;
 //! 5. [`bandwidth`] — the largest bandwidth whose sampled loop meets the floors on both
-//!    axes and the at-speed figures (what an error names).
+//!    axes and the at-speed figures (what an error names);
+//! 6. [`rules`] — the verdict on a request with the message of its refusal, the one set
+//!    of rules of the design's current-loop section and the `pi_gains!` proc-macro.
 //!
 //! One [`Request`] carries an axis's inputs through all of them; [`design()`] runs the
 //! first three. The spec-facing side (the `current_loop` section of the design, its
-//! checks and messages) is `design::sections::current_loop`.
+//! checks and messages located at the spec's keys) is `design::sections::current_loop`.
 
 pub mod analysis;
 pub mod at_speed;
 pub mod bandwidth;
 pub mod continuous;
 pub mod discrete;
+pub mod rules;
 
 pub use analysis::AxisGains;
 pub use continuous::CurrentLoopError;

@@ -596,3 +596,53 @@ fn err_text(db: f64) -> String {
     .unwrap_err()
     .to_string()
 }
+
+/// Issue 31: a narrow pass band, a stop edge near f_s/2 and a 99 dB target ran for more
+/// than a minute in a release build before any answer; so did fixed orders on wide
+/// transition bands (pass 100 Hz, stop 9 900 Hz, order 14), inside a single exchange:
+/// nalgebra's Schur decomposition of the extrema search iterated without a bound
+/// (vendor/pm-remez now bounds it). Every one answers — a design or a refusal naming the
+/// key — and each exchange is bounded in work (at most 100 iterations, each with bounded
+/// QR sweeps), so the whole search is bounded by its run count: the walk from Kaiser's
+/// start, at most [`FMAC_MAX_TAPS`] orders, plus [`MAX_WEIGHT_EVALUATIONS`].
+#[test]
+fn near_nyquist_stop_edges_answer_in_bounded_work() {
+    use super::remez::RUNS;
+    let cases = [
+        (0.02, 9_999.0, FirLength::StopAttenuationDb(99.0)),
+        (100.0, 9_900.0, FirLength::Order(14)),
+        (0.02, 9_980.0, FirLength::Order(8)),
+        (2.0, 9_900.0, FirLength::Order(12)),
+        (0.02, 9_999.0, FirLength::StopAttenuationDb(60.0)),
+    ];
+    for (pass, stop, length) in cases {
+        RUNS.with(|r| r.set(0));
+        let t = std::time::Instant::now();
+        let r = design_fir(&FirRequest {
+            sample_rate_hz: 20e3,
+            pass_edge_hz: pass,
+            stop_edge_hz: stop,
+            pass_ripple: 0.001,
+            length,
+        });
+        let runs = RUNS.with(|r| r.get());
+        eprintln!(
+            "pass {pass} Hz, stop {stop} Hz, {length:?}: {:?} in {:?}, {runs} Parks–McClellan runs",
+            r.as_ref().map(|d| d.order).map_err(ToString::to_string),
+            t.elapsed()
+        );
+        match &r {
+            Ok(d) => {
+                assert_eq!(d.taps_q15.iter().map(|&t| i32::from(t)).sum::<i32>(), Q15_ONE);
+                if let FirLength::StopAttenuationDb(a) = length {
+                    assert!(d.stop_attenuation_db_quantised >= a, "{d:?}");
+                }
+            }
+            Err(e) => assert!(
+                ["order", "stop_attenuation", "stop_edge", "pass_edge", "pass_ripple"].contains(&e.key()),
+                "{e}"
+            ),
+        }
+        assert!(runs <= FMAC_MAX_TAPS + MAX_WEIGHT_EVALUATIONS + 1, "{runs} runs");
+    }
+}

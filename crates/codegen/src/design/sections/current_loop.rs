@@ -1,8 +1,8 @@
 //! The current-loop section: both axes through the pipeline of `design::current_loop`,
 //! judged on the sampled loop with its 1.5·T_s delay (poles, margins, overshoot:
 //! `current_loop::analysis`; a breach of its floors is an error at
-//! `current_loop.bandwidth` naming the largest bandwidth that meets them,
-//! `current_loop::bandwidth`), the bandwidth guidelines of thesis A §5.4.1 (warnings), the
+//! `current_loop.bandwidth` naming the largest bandwidth that meets them, in the words of
+//! `current_loop::rules`, which `pi_gains!` prints too), the bandwidth guidelines of thesis A §5.4.1 (warnings), the
 //! hot-winding variant (thesis B 2.24) and the feed-forward constants (5.3), (2.34).
 
 use std::f64::consts::PI;
@@ -15,7 +15,7 @@ use crate::design::current_loop::analysis::{
 };
 use crate::design::current_loop::at_speed;
 use crate::design::current_loop::continuous::{self, CurrentLoopError, Promise};
-use crate::design::current_loop::{self, Axis, FIRMWARE_LOOP_DELAY_PERIODS, Request, axis_letter, bandwidth, discrete};
+use crate::design::current_loop::{self, Axis, FIRMWARE_LOOP_DELAY_PERIODS, Request, discrete, rules};
 use crate::design::thermal;
 use crate::diagnostic::{Diagnostic, Source};
 use crate::spec::{Method, Spec};
@@ -105,14 +105,6 @@ pub struct HotVariant {
     pub q: AxisGains,
 }
 
-/// `x` > 0 rounded down to three significant figures: the bandwidth an error names lies
-/// inside the floors, not on the bisected boundary (where the firmware's fixed-point step
-/// may land a hair past the overshoot floor).
-fn round_down_3(x: f64) -> f64 {
-    let unit = 10f64.powi(x.log10().floor() as i32 - 2);
-    (x / unit).floor() * unit
-}
-
 /// The current-loop section, or `None` with the broken rules in `cx.errors`.
 pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoopOut> {
     let spec = cx.spec;
@@ -135,65 +127,22 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
     let r = m.phase_resistance.value;
     let requests = requests(spec, r, ts);
     let gains = axes(&requests)
-        .map_err(|e| cx.errors.push(loop_error(&cx.src, spec, e)))
+        .map_err(|e| {
+            cx.errors
+                .push(refused(&cx.src, spec, rules::design_error(&requests, e)))
+        })
         .ok();
     let promise = Promise::of(&requests[0]);
     let designed_os = promise.overshoot_pct;
     let drive = drive(spec, r, ts, cx.max_electrical_frequency());
-    // The floors on both axes, then the at-speed figures (`verify`'s decoupling and DC-link-step criteria).
-    let floor_breach = gains.as_ref().and_then(|(gd, gq)| {
-        [('d', gd), ('q', gq)]
-            .iter()
-            .find_map(|(a, g)| g.sampled.breach(&promise).map(|b| (*a, b)))
-    });
-    let at_speed_breach = match (&gains, &floor_breach) {
-        (Some((gd, gq)), None) => bandwidth::at_speed_breach(&drive, [gd, gq], c.bandwidth.value),
-        _ => None,
-    };
-    if let Some(breach) = at_speed_breach {
-        let best = bandwidth::largest_bandwidth(&requests, Some(&drive)).map(round_down_3);
-        let b = &c.bandwidth;
-        cx.errors.push(cx.src.error(
-            b.span.clone(),
-            &b.key,
-            format!("at α = {:.1} rad/s (f_s = {fs} Hz) the loop {breach}", b.value),
-            match best {
-                Some(a) => format!(
-                    "a bandwidth up to {a:.0} rad/s, the largest that meets the sampled-loop floors and the at-speed figures for this motor at f_s = {fs} Hz"
-                ),
-                None => "a higher f_s: no bandwidth meets the floors and the at-speed figures for this motor at this f_s".to_string(),
-            },
-        ));
-    }
-    if let Some((axis, breach)) = floor_breach {
-        let best = bandwidth::largest_bandwidth(&requests, Some(&drive)).map(round_down_3);
-        let b = &c.bandwidth;
-        cx.errors.push(cx.src.error(
-            b.span.clone(),
-            &b.key,
-            format!(
-                "the sampled {axis}-axis loop at α = {:.1} rad/s (f_s = {fs} Hz, {FIRMWARE_LOOP_DELAY_PERIODS}·T_s delay{}) is {breach}; the floors are phase margin ≥ {MIN_PHASE_MARGIN_DEG}°, gain margin ≥ {MIN_GAIN_MARGIN_DB} dB (Åström & Murray §10.3), overshoot ≤ {:.1} % (designed {designed_os:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %){}",
-                b.value,
-                if c.compensate_delay { ", delay-compensated" } else { "" },
-                designed_os + OVERSHOOT_ALLOWANCE_PCT,
-                promise.rise_time_s.map_or(String::new(), |t| format!(
-                    " and a rise time within {:.0} % of the designed {:.4} ms",
-                    RISE_TOLERANCE * 100.0,
-                    t * 1e3
-                )),
-            ),
-            match best {
-                Some(a) => format!(
-                    "a bandwidth up to {a:.0} rad/s, the largest that meets the floors on both axes and the at-speed figures `motorgen verify` checks (decoupling, DC-link step) for this motor at f_s = {fs} Hz{}, or a higher f_s",
-                    // Where the at-speed figures bind, the floors' own limit too.
-                    match bandwidth::largest_bandwidth(&requests, None).map(round_down_3) {
-                        Some(f) if f > a => format!(" (the floors alone allow up to {f:.0} rad/s)"),
-                        _ => String::new(),
-                    }
-                ),
-                None => "a higher f_s: no bandwidth meets the floors for this motor at this f_s".to_string(),
-            },
-        ));
+    // The floors on both axes, then the at-speed figures (`verify`'s decoupling and
+    // DC-link-step criteria): the rules `pi_gains!` applies, and those of a motor.
+    if let Some((gd, gq)) = &gains {
+        let refusal = rules::floor_breach(&requests, &[gd.clone(), gq.clone()], Some(&drive))
+            .or_else(|| rules::at_speed_refusal(&requests, [gd, gq], &drive));
+        if let Some(r) = refusal {
+            cx.errors.push(refused(&cx.src, spec, r));
+        }
     }
     let sampled_rise = gains
         .as_ref()
@@ -341,32 +290,9 @@ fn axes([d, q]: &[Request; 2]) -> Result<(AxisGains, AxisGains), CurrentLoopErro
     Ok((current_loop::design(d)?, current_loop::design(q)?))
 }
 
-fn loop_error(src: &Source<'_>, spec: &Spec, e: CurrentLoopError) -> Diagnostic {
+/// A refusal of the current-loop rules ([`rules::verdict`]'s), located at the spec's
+/// `current_loop.bandwidth`.
+fn refused(src: &Source<'_>, spec: &Spec, r: rules::Refusal) -> Diagnostic {
     let b = &spec.current_loop.bandwidth;
-    match e {
-        CurrentLoopError::RhpZero { axis, min_bandwidth_rad_s } => src.error(
-            b.span.clone(),
-            &b.key,
-            format!("pole placement at α = {:.4} rad/s puts a right-half-plane zero in the {}-axis loop (ω_n·ζ < R/(2L), thesis A §5.4.1)", b.value, axis_letter(axis)),
-            format!("a bandwidth above {:.1} rad/s, a larger damping, or method = \"imc\"", min_bandwidth_rad_s),
-        ),
-        CurrentLoopError::NegativeActiveDamping { axis, min_bandwidth_rad_s } => src.error(
-            b.span.clone(),
-            &b.key,
-            format!("α_c·L < R on the {} axis: the active damping R_a = α_c·L − R (thesis B 2.43) would be negative", axis_letter(axis)),
-            format!("a bandwidth above R/L = {:.1} rad/s, or method = \"imc\"", min_bandwidth_rad_s),
-        ),
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::round_down_3;
-
-    #[test]
-    fn named_bandwidth_is_rounded_down() {
-        assert_eq!(round_down_3(13_694.6), 13_600.0);
-        assert_eq!(round_down_3(6280.3), 6280.0);
-        assert_eq!(round_down_3(999.99), 999.0);
-    }
+    src.error(b.span.clone(), &b.key, r.problem, r.accepted)
 }
