@@ -265,6 +265,8 @@ fn a_stated_fact_contradicting_its_part_is_warned_at_the_key() {
     .unwrap();
     assert!(shipped.warnings.is_empty(), "{:?}", shipped.warnings);
     assert_eq!(board::tim1_ccer_polarity(&shipped), 0x0888);
+}
+
 /// A board value that only overflows with a motor (issue 31): a DC-link divider of
 /// 1e-300 passes its own range check (a plain ratio) but gives ∞ volts per LSB. The
 /// error is at `sensing.dc_link_divider` (not line 1, column 1), names the keys that
