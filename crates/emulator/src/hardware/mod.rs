@@ -123,6 +123,10 @@ pub struct AnalogInput {
 pub struct Hardware {
     /// The board file (`boards/<stem>.toml`) this describes.
     pub board: &'static str,
+    /// The board this one is a variant of — the same hardware but for the phase-current
+    /// sensing's gain (`motorgen-reference-400a` of `motorgen-reference`): the scenarios
+    /// run on it only the motors the other board does not take ([`crate::rig::benches`]).
+    pub variant_of: Option<&'static str>,
     /// The chip on it.
     pub chip: &'static str,
     /// Per leg u, v, w: the high-side and low-side driver inputs.

@@ -63,6 +63,7 @@ pub fn hardware() -> Hardware {
         source: "TSV994 current-sense stage (UM1996)",
     };
     Hardware {
+        variant_of: None,
         board: "nucleo-g474re-ihm08m1",
         chip: "STM32G474RE",
         legs: [

@@ -25,18 +25,19 @@ const FRONT_END_OHM: f64 = 1_100.0;
 pub fn hardware() -> Hardware {
     // Hall sensors mounted positive for a current out of the leg: 15 mV/A about
     // mid-supply (sized for thesis A's Fischer TI085, ±110 A).
-    with_sensing("motorgen-reference", 0.015)
+    with_sensing("motorgen-reference", None, 0.015)
 }
 
 /// The same controller with its Hall sensors sized for the seed traction motors:
 /// 3.75 mV/A about mid-supply, ±440 A (sized for the EMRAX 228 HV's 339 A peak at thesis
 /// A's 1.25 headroom, Table 4.1); everything else is the reference board's.
 pub fn hardware_400a() -> Hardware {
-    with_sensing("motorgen-reference-400a", 3.75e-3)
+    with_sensing("motorgen-reference-400a", Some("motorgen-reference"), 3.75e-3)
 }
 
-/// The reference controller named `board` with Hall sensors of `sensitivity` \[V/A\].
-fn with_sensing(board: &'static str, sensitivity: f64) -> Hardware {
+/// The reference controller named `board` (a variant of `variant_of`) with Hall sensors
+/// of `sensitivity` \[V/A\].
+fn with_sensing(board: &'static str, variant_of: Option<&'static str>, sensitivity: f64) -> Hardware {
     let input = |pin, signal, source| AnalogInput {
         pin,
         signal,
@@ -45,6 +46,7 @@ fn with_sensing(board: &'static str, sensitivity: f64) -> Hardware {
     };
     Hardware {
         board,
+        variant_of,
         chip: "STM32G474RE",
         legs: [
             [in_plus("PA8"), in_plus("PB13")],
