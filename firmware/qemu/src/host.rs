@@ -20,6 +20,12 @@ pub fn on_path(program: &str) -> bool {
 /// Builds the release binary `bin` of `motor-qemu` for [`TARGET`] in the firmware
 /// `workspace` (with `MOTOR=<motor>` when given) and returns the ELF's path.
 pub fn build(workspace: &Path, bin: &str, motor: Option<&str>) -> Result<PathBuf, String> {
+    build_on(workspace, bin, motor, None)
+}
+
+/// [`build`] for the board `boards/<board>.toml` (`BOARD`; `motor-config`'s default
+/// board without one).
+pub fn build_on(workspace: &Path, bin: &str, motor: Option<&str>, board: Option<&str>) -> Result<PathBuf, String> {
     let mut cargo = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
     cargo
         .args([
@@ -37,11 +43,15 @@ pub fn build(workspace: &Path, bin: &str, motor: Option<&str>) -> Result<PathBuf
     if let Some(motor) = motor {
         cargo.env("MOTOR", motor);
     }
+    if let Some(board) = board {
+        cargo.env("BOARD", board);
+    }
     let out = cargo.output().map_err(|e| format!("running cargo: {e}"))?;
     if !out.status.success() {
         return Err(format!(
-            "{}cargo build --release --target {TARGET} -p motor-qemu --bin {bin} failed ({}):\n{}",
+            "{}{}cargo build --release --target {TARGET} -p motor-qemu --bin {bin} failed ({}):\n{}",
             motor.map_or_else(String::new, |m| format!("MOTOR={m} ")),
+            board.map_or_else(String::new, |b| format!("BOARD={b} ")),
             out.status,
             String::from_utf8_lossy(&out.stderr)
         ));

@@ -110,7 +110,10 @@ fn a_600_v_motor_is_refused_on_the_48_v_nucleo_at_its_sensing() {
     assert!(i.problem.contains("±30.7 A") && i.problem.contains("86.3 A"), "{e}");
     // In the key's terms: min(1.71, 3.3 − 1.71) V/86.27 A = 18.43 mV/A at the pin, over
     // the 10 mΩ shunt an amplifier gain of 1.84.
-    assert!(i.accepted.contains("amplifier gain up to 1.84 with this 10.0 mΩ shunt"), "{e}");
+    assert!(
+        i.accepted.contains("amplifier gain up to 1.84 with this 10.0 mΩ shunt"),
+        "{e}"
+    );
     assert!(e.0.iter().all(|d| d.file == "b.toml"), "{e}");
 }
 

@@ -158,7 +158,11 @@ pub struct Hardware {
 
 /// The boards this crate has a hardware description of, by board-file stem.
 pub fn all() -> Vec<Hardware> {
-    vec![reference::hardware(), reference::hardware_400a(), nucleo_ihm08m1::hardware()]
+    vec![
+        reference::hardware(),
+        reference::hardware_400a(),
+        nucleo_ihm08m1::hardware(),
+    ]
 }
 
 /// The hardware of `boards/<stem>.toml`, if described.

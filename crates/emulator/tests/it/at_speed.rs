@@ -354,7 +354,10 @@ fn torque_along_a_speed_ramp_matches_verify() {
                 (mean / at_corner - 1.0).abs() <= TORQUE_TOLERANCE,
                 "{motor}: standstill torque {mean} where the machine makes {at_corner} at the MTPA corner"
             );
-            assert!(mean > at_id0, "{motor}: standstill torque {mean}, not above i_d = 0's {at_id0}");
+            assert!(
+                mean > at_id0,
+                "{motor}: standstill torque {mean}, not above i_d = 0's {at_id0}"
+            );
         }
     }
 }

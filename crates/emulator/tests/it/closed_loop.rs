@@ -66,11 +66,7 @@ fn mtpa_iq(d: &codegen::design::Design, torque: f64, iq_per_nm: f64) -> f64 {
     let (mut lo, mut hi) = (0.0, 2.0 * torque * iq_per_nm);
     for _ in 0..100 {
         let mid = 0.5 * (lo + hi);
-        if made(mid) < torque {
-            lo = mid
-        } else {
-            hi = mid
-        }
+        if made(mid) < torque { lo = mid } else { hi = mid }
     }
     point(0.5 * (lo + hi)).1
 }

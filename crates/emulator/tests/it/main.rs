@@ -1,8 +1,8 @@
 //! The real image on the emulated G474, one test binary: boot, protection, CAN and the
 //! closed loop, on every motor in `motors/` (README, "Scenarios").
 
-mod boards;
 mod at_speed;
+mod boards;
 mod boot;
 mod can;
 mod closed_loop;

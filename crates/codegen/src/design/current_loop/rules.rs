@@ -9,8 +9,8 @@
 use std::fmt;
 
 use super::analysis::{AxisGains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
-use super::continuous::{CurrentLoopError, Promise};
 use super::at_speed::Drive;
+use super::continuous::{CurrentLoopError, Promise};
 use super::{FIRMWARE_LOOP_DELAY_PERIODS, Request, axis_letter, bandwidth, design};
 
 /// Why a current-loop request is refused: what is wrong (the rule and the figure that
@@ -171,7 +171,8 @@ pub fn at_speed_refusal(axes: &[Request], gains: [&AxisGains; 2], drive: &Drive)
             Some(a) => format!(
                 "a bandwidth up to {a:.0} rad/s, the largest that meets the sampled-loop floors and the at-speed figures for this motor at f_s = {fs} Hz"
             ),
-            None => "a higher f_s: no bandwidth meets the floors and the at-speed figures for this motor at this f_s".to_string(),
+            None => "a higher f_s: no bandwidth meets the floors and the at-speed figures for this motor at this f_s"
+                .to_string(),
         },
     })
 }

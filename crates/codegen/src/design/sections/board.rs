@@ -221,11 +221,19 @@ pub(in crate::design) fn board(
     if i_fs < peak {
         // The largest |gain| [V/A] at the pin that keeps ±I_peak inside the ADC's range at
         // this offset, said in the key's own terms.
-        let gain_max = board.current.offset_v.min(board.adc_reference_v - board.current.offset_v) / peak;
+        let gain_max = board
+            .current
+            .offset_v
+            .min(board.adc_reference_v - board.current.offset_v)
+            / peak;
         let (gain_key, gain_accepted) = match (board.current.kind, board.current.shunt_ohm) {
             (crate::board::SensorKind::Shunt, Some(shunt)) => (
                 "current_sensing.amplifier_gain",
-                format!("an amplifier gain up to {:.2} with this {:.1} mΩ shunt and offset", gain_max / shunt, shunt * 1e3),
+                format!(
+                    "an amplifier gain up to {:.2} with this {:.1} mΩ shunt and offset",
+                    gain_max / shunt,
+                    shunt * 1e3
+                ),
             ),
             (crate::board::SensorKind::Shunt, None) => (
                 "current_sensing.amplifier_gain",
