@@ -272,7 +272,7 @@ pub fn benches() -> Vec<(String, String)> {
         let mut n = 0;
         for motor in image::motors() {
             let fits_it = |b: &str| fits(&motor, b).unwrap_or_else(|e| panic!("{motor} on {b}: {e}"));
-            if fits_it(&board) && !hw.variant_of.is_some_and(|other| fits_it(other)) {
+            if fits_it(&board) && !hw.variant_of.is_some_and(fits_it) {
                 out.push((motor.clone(), board.clone()));
                 n += 1;
             }
