@@ -53,6 +53,9 @@ pub const CAN_MAX_TQ_PER_BIT: u32 = 385;
 pub const CAN_MAX_PRESCALER: u32 = 512;
 
 /// The CiA 301 bit rates \[bit/s\] (named in the message when a rate cannot be made).
+/// Classic CAN's largest nominal bit rate \[bit/s\] (ISO 11898-1).
+pub const CLASSIC_CAN_MAX_BIT_RATE: u32 = 1_000_000;
+
 pub const CIA_BIT_RATES: [u32; 9] = [
     10_000, 20_000, 50_000, 100_000, 125_000, 250_000, 500_000, 800_000, 1_000_000,
 ];
@@ -270,14 +273,30 @@ fn bit_rate_text(rate: f64) -> String {
 /// The bit timing of `bit_rate` from `kernel_hz`, or why that clock cannot make the rate
 /// exactly, naming the CiA 301 rates it can make and the nearest rates around the request.
 pub fn can_bit_rate(kernel_hz: u32, bit_rate: f64) -> Result<CanBitTiming, Refusal> {
-    if let Some(t) = can_bit_timing(kernel_hz, bit_rate) {
-        return Ok(t);
-    }
     let made: Vec<String> = CIA_BIT_RATES
         .iter()
         .filter(|&&r| can_bit_timing(kernel_hz, f64::from(r)).is_some())
         .map(|&r| bit_rate_text(f64::from(r)))
         .collect();
+    // The image runs FDCAN1 as classic CAN (CCCR.FDOE left at its reset 0, RM0440 §44.4.1;
+    // firmware/app/src/board/can.rs), whose nominal bit rate ends at 1 Mbit/s (ISO
+    // 11898-1; CiA 301's table ends there): a faster rate would build, and no classic
+    // node on the bus could follow it.
+    if bit_rate > f64::from(CLASSIC_CAN_MAX_BIT_RATE) {
+        return Err(Refusal {
+            problem: format!(
+                "{} is beyond classic CAN's nominal bit rate of at most 1 Mbit/s (ISO 11898-1): the image runs FDCAN1 in classic mode (FDCAN_CCCR.FDOE = 0, RM0440 §44.4.1), where a bit rate switch does not exist",
+                bit_rate_text(bit_rate)
+            ),
+            accepted: format!(
+                "a rate up to 1 Mbit/s this clock makes exactly: {} (CiA 301)",
+                made.join(", ")
+            ),
+        });
+    }
+    if let Some(t) = can_bit_timing(kernel_hz, bit_rate) {
+        return Ok(t);
+    }
     // Exact rates near the request: kernel/(prescaler·quanta) that are whole bit/s.
     let mut near: Vec<u32> = Vec::new();
     for divisor in 1..=(CAN_MAX_PRESCALER * CAN_MAX_TQ_PER_BIT) {

@@ -234,6 +234,22 @@ fn issue_27_unbuildable_values_are_refused_at_their_key() {
     // now it works.
     let text = set_toml_key(&board, "can.bit_rate", "\"1 Mbit/s\"");
     assert!(codegen::board_source("b.toml", &text).is_ok());
+    // 2 Mbit/s the clock makes exactly (170 MHz/2 Mbit/s = 85 = 5 × 17 quanta) and the
+    // image would build, but classic CAN ends at 1 Mbit/s (ISO 11898-1): refused at its key.
+    let text = set_toml_key(&board, "can.bit_rate", "\"2 Mbit/s\"");
+    let e = codegen::board_source("b.toml", &text).unwrap_err();
+    let d =
+        e.0.iter()
+            .find(|d| d.key == "can.bit_rate")
+            .unwrap_or_else(|| panic!("{e}"));
+    assert!(
+        d.problem.contains("classic CAN") && d.problem.contains("ISO 11898-1"),
+        "{e}"
+    );
+    assert!(
+        d.accepted.contains("up to 1 Mbit/s") && d.accepted.contains("1 Mbit/s (CiA 301)"),
+        "{e}"
+    );
     // f_s in [1 kHz, 1.297 kHz): inside the plausible range, beyond the 16-bit ARR.
     let spec = set_toml_key(
         &set_toml_key(
