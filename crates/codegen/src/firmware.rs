@@ -52,10 +52,10 @@ pub const CAN_MAX_TQ_PER_BIT: u32 = 385;
 /// Largest nominal prescaler (NBRP + 1, RM0440 §44.4.9: NBRP 0 … 511).
 pub const CAN_MAX_PRESCALER: u32 = 512;
 
-/// The CiA 301 bit rates \[bit/s\] (named in the message when a rate cannot be made).
 /// Classic CAN's largest nominal bit rate \[bit/s\] (ISO 11898-1).
 pub const CLASSIC_CAN_MAX_BIT_RATE: u32 = 1_000_000;
 
+/// The CiA 301 bit rates \[bit/s\] (named in the message when a rate cannot be made).
 pub const CIA_BIT_RATES: [u32; 9] = [
     10_000, 20_000, 50_000, 100_000, 125_000, 250_000, 500_000, 800_000, 1_000_000,
 ];

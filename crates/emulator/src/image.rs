@@ -94,7 +94,8 @@ pub struct BoardFile {
 impl BoardFile {
     /// `boards/<stem>.toml`.
     pub fn shipped(stem: &str) -> Result<Self, String> {
-        let (_, text) = crate::wiring::read(&format!("boards/{stem}.toml"))?;
+        let file = format!("boards/{stem}.toml");
+        let text = std::fs::read_to_string(repo().join(&file)).map_err(|e| format!("{file}: {e}"))?;
         Ok(Self {
             stem: stem.to_string(),
             text,

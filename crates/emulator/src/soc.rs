@@ -17,9 +17,7 @@ use crate::periph::tim1::{Tim1, TimerEvent};
 use crate::periph::tim3::Tim3;
 use crate::violation::{Broken, Violation};
 
-/// Bus time unit: 1/8 of a 170 MHz cycle, so 16, 85 and 170 MHz cycles are whole
-/// numbers of units (85, 16 and 8).
-pub const UNITS_PER_S: f64 = 1.36e9;
+pub use crate::periph::UNITS_PER_S;
 
 /// FLASH_OPTR.nSWBOOT0 (RM0440 §5.4.1): 1 = BOOT0 taken from the PB8-BOOT0 pin.
 pub const OPTR_NSWBOOT0: u32 = 1 << 26;

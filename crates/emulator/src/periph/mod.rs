@@ -2,6 +2,11 @@
 //! block; the bus ([`crate::soc`]) routes accesses, clock gates and the signals between
 //! them (TIM1 → ADC trigger, TIM1 → TIM3 reset, pins → break, ADC → NVIC).
 
+/// Bus time unit: 1/8 of a 170 MHz cycle, so 16, 85 and 170 MHz cycles are whole
+/// numbers of units (85, 16 and 8). The peripherals count in it; the bus
+/// ([`crate::soc`]) advances it.
+pub const UNITS_PER_S: f64 = 1.36e9;
+
 pub mod adc;
 pub mod clock;
 pub mod fdcan;
