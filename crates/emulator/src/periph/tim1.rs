@@ -349,7 +349,7 @@ impl Tim1 {
 
     /// Seconds per timer tick.
     pub fn tick_s(&self) -> f64 {
-        self.tick as f64 / super::UNITS_PER_S
+        self.tick as f64 / crate::periph::UNITS_PER_S
     }
 
     /// The six outputs at `t` (bus units) — the pins' levels for GPIO IDR reads — `None`
@@ -561,7 +561,7 @@ mod tests {
             t.write(0x00, 0b01 << 5 | 1, 80).unwrap();
             t
         };
-        let tick_s = 8.0 / super::UNITS_PER_S;
+        let tick_s = 8.0 / crate::periph::UNITS_PER_S;
         let t = setup(1);
         assert!(!t.update_at_overflow);
         assert_eq!(t.next(TimerEvent::Update, 81), Some(80 + 200 * 8));
