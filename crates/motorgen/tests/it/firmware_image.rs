@@ -230,11 +230,20 @@ fn every_fitting_motor_builds(board: Option<&str>, fits: &[&str]) -> String {
 
 /// `firmware --all` builds every motor the default board fits into `target/firmware/`:
 /// the reference board measures ±1.65 V/15 mV/A = ±110 A, so the two traction motors
-/// (Chalmers HEV50 √2·224 = 316.8 A, EMRAX 228 √2·240 = 339.4 A peak) are left out (they
-/// build on motorgen-reference-400a).
+/// (Chalmers HEV50 √2·224 = 316.8 A, EMRAX 228 √2·240 = 339.4 A peak) are left out, and
+/// so is the AMK DD5 (√2·74.2 = 105.0 A peak over the board's 100 A ceiling); they build
+/// on motorgen-reference-400a. The Mini Cheetah actuator (24 V, √2·28.28 = 40.0 A peak) fits.
 #[test]
 fn every_motor_builds_on_the_default_board() {
-    every_fitting_motor_builds(None, &["fischer-ti085", "maxon-ec45-flat-70w", "unimotor-142umd300"]);
+    every_fitting_motor_builds(
+        None,
+        &[
+            "fischer-ti085",
+            "maxon-ec45-flat-70w",
+            "mit-mini-cheetah-actuator",
+            "unimotor-142umd300",
+        ],
+    );
 }
 
 /// On the NUCLEO-G474RE + X-NUCLEO-IHM08M1 (±30.7 A, 63.2 V, 25 A / 52 V / 6000 rpm
