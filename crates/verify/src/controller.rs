@@ -6,25 +6,13 @@
 //! Q1.15 full scale instead of a board's ADC codes.
 
 use motor_control::angle::to_radians_f64;
-use motor_control::pi::PiConfig;
 use motor_control::step::{ControllerConfig, ControllerParameters};
 use motor_control::torque::{MTPA_POINTS, TorqueParameters};
 
 use codegen::design::Design;
-use codegen::design::current_loop::AxisGains;
 
 /// Mid-scale code of a bipolar current channel read as a 16-bit (Q1.15 offset-binary) value.
 pub const CURRENT_OFFSET: i32 = 1 << 15;
-
-fn axis(g: &AxisGains) -> PiConfig {
-    PiConfig {
-        kp: g.kp as f32,
-        ki: g.ki as f32,
-        anti_windup: g.anti_windup_gain as f32,
-        active_damping: g.active_damping_ohm as f32,
-        reference_filter: g.reference_filter as f32,
-    }
-}
 
 /// The parameters of `d` for [`ControllerConfig::from_parameters`]:
 ///
@@ -75,8 +63,8 @@ pub fn controller_parameters(d: &Design) -> ControllerParameters {
         resolver_pole_pairs: o.resolver_pole_pairs,
         resolver_offset_q31: o.resolver_offset_q31.unwrap_or(0),
         lead_q16: o.lead_q16,
-        d: axis(&cl.d),
-        q: axis(&cl.q),
+        d: cl.d.pi_config(),
+        q: cl.q.pi_config(),
         ld: cl.feedforward.d_inductance_h as f32,
         lq: cl.feedforward.q_inductance_h as f32,
         psi_m: cl.feedforward.flux_linkage_wb.unwrap_or(0.0) as f32,

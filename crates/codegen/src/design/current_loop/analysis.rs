@@ -62,6 +62,7 @@
 
 use std::f64::consts::PI;
 
+use motor_control::pi::PiConfig;
 use nalgebra::{Complex, Matrix3};
 use serde::Serialize;
 
@@ -394,6 +395,19 @@ impl AxisGains {
             ki: self.ki,
             active_damping: self.active_damping_ohm,
             prefilter: self.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient),
+        }
+    }
+
+    /// The firmware's PI configuration of these gains, as the generated constants carry
+    /// them (`f32`): the one mapping the at-speed scenarios and `motor-verify`'s
+    /// controller both run.
+    pub fn pi_config(&self) -> PiConfig {
+        PiConfig {
+            kp: self.kp as f32,
+            ki: self.ki as f32,
+            anti_windup: self.anti_windup_gain as f32,
+            active_damping: self.active_damping_ohm as f32,
+            reference_filter: self.reference_filter as f32,
         }
     }
 }

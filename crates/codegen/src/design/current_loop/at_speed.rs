@@ -35,7 +35,7 @@
 //! 0.1 %.
 
 use motor_control::feedforward::FeedForwardConfig;
-use motor_control::pi::{CurrentPiConfig, CurrentPiState, PiConfig, VoltageLimit};
+use motor_control::pi::{CurrentPiConfig, CurrentPiState, VoltageLimit};
 use motor_control::transforms::Dq;
 
 use super::AxisGains;
@@ -139,18 +139,6 @@ pub struct Drive {
     pub damping: f64,
 }
 
-/// The firmware's PI configuration of an axis's gains (as the generated constants carry
-/// them, `f32`).
-pub fn pi_config(g: &AxisGains) -> PiConfig {
-    PiConfig {
-        kp: g.kp as f32,
-        ki: g.ki as f32,
-        anti_windup: g.anti_windup_gain as f32,
-        active_damping: g.active_damping_ohm as f32,
-        reference_filter: g.reference_filter as f32,
-    }
-}
-
 /// The decoupling scenario's figures.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Decoupling {
@@ -223,8 +211,8 @@ impl<'a> Loop<'a> {
             w,
             psi,
             pi: CurrentPiConfig {
-                d: pi_config(gains[0]),
-                q: pi_config(gains[1]),
+                d: gains[0].pi_config(),
+                q: gains[1].pi_config(),
                 limit: VoltageLimit::Proportional,
             },
             ff_model: FeedForwardConfig {
