@@ -11,11 +11,9 @@
 //!   `MOTORGEN_FIRMWARE_FUZZ=N` builds N accepted pairs (CI: 2; each image build costs
 //!   seconds after the first), `MOTORGEN_FUZZ_SEED` moves the seeds.
 
-use std::process::Command;
-
 use codegen::firmware::{FIRMWARE_LIMITS, Home};
 use motor_test_support::fuzz::{Rng, seed_base};
-use motor_test_support::{read, repo, set_toml_key};
+use motor_test_support::{read, set_toml_key};
 
 /// Builds the release image of `motor` on `board` (texts) in `firmware/target`, from a
 /// temporary motors and boards folder; `Err` with cargo's messages.
@@ -25,23 +23,8 @@ fn build(tag: &str, motor: &str, board: &str) -> Result<(), String> {
     std::fs::create_dir_all(dir.join("boards")).unwrap();
     std::fs::write(dir.join("motors/fuzz-motor.toml"), motor).unwrap();
     std::fs::write(dir.join("boards/fuzz-board.toml"), board).unwrap();
-    let firmware = repo().join("firmware");
-    let out = Command::new(env!("CARGO"))
-        .args([
-            "build",
-            "--locked",
-            "--release",
-            "--target",
-            "thumbv7em-none-eabihf",
-            "-p",
-            "motor-firmware",
-        ])
-        .current_dir(&firmware)
-        .env("CARGO_TARGET_DIR", firmware.join("target"))
-        .env("MOTOR", "fuzz-motor")
+    let out = motor_test_support::firmware_image_build("fuzz-motor", "fuzz-board", &dir.join("boards"))
         .env("MOTORS_DIR", dir.join("motors"))
-        .env("BOARD", "fuzz-board")
-        .env("BOARDS_DIR", dir.join("boards"))
         .output()
         .map_err(|e| format!("cargo: {e}"))?;
     if out.status.success() {

@@ -7,7 +7,6 @@
 //! symbols by name.
 
 use std::path::{Path, PathBuf};
-use std::process::Command;
 use std::sync::Mutex;
 
 use object::read::elf::{ElfFile32, ProgramHeader};
@@ -232,23 +231,7 @@ pub fn build(motor: &str, board: &BoardFile) -> Result<Image, String> {
     } else {
         repo.join("boards")
     };
-    let firmware = repo.join("firmware");
-    let out = Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
-        .args([
-            "build",
-            "--locked",
-            "--release",
-            "--target",
-            "thumbv7em-none-eabihf",
-            "-p",
-            "motor-firmware",
-        ])
-        .current_dir(&firmware)
-        .env("CARGO_TARGET_DIR", firmware.join("target"))
-        .env("MOTOR", motor)
-        .env("BOARD", &board.stem)
-        .env("BOARDS_DIR", &boards_dir)
-        .env_remove("MOTORS_DIR")
+    let out = motor_test_support::firmware_image_build(motor, &board.stem, &boards_dir)
         .output()
         .map_err(|e| format!("cargo: {e}"))?;
     if !out.status.success() {
@@ -258,7 +241,7 @@ pub fn build(motor: &str, board: &BoardFile) -> Result<Image, String> {
             String::from_utf8_lossy(&out.stderr)
         ));
     }
-    let built = firmware.join("target/thumbv7em-none-eabihf/release/motor-firmware");
+    let built = motor_test_support::firmware_image_path();
     std::fs::copy(&built, &elf).map_err(|e| format!("{}: {e}", built.display()))?;
     std::fs::write(&stamp, &hash).map_err(|e| e.to_string())?;
     let bytes = std::fs::read(&elf).map_err(|e| format!("{}: {e}", elf.display()))?;

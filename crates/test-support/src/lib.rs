@@ -8,6 +8,7 @@ pub mod budget;
 pub mod fuzz;
 
 use std::path::{Path, PathBuf};
+use std::process::Command;
 
 /// The repository root (this crate lives at `crates/test-support`).
 pub fn repo() -> PathBuf {
@@ -167,6 +168,43 @@ pub const ISSUE_18_RANGE_EXAMPLES: &[(&str, &str, &str, &str)] = &[
         "[1 rad/s, 1e6 rad/s]",
     ),
 ];
+
+/// The target triple of the STM32G474 image.
+pub const FIRMWARE_TARGET: &str = "thumbv7em-none-eabihf";
+
+/// `cargo build --locked --release --target thumbv7em-none-eabihf -p motor-firmware` in
+/// the repository's `firmware/`, in its shared `firmware/target` (so only the app crate
+/// rebuilds per motor and board), for `motor` (a stem) on `board` of `boards_dir`.
+/// The caller adds `MOTORS_DIR` when the motor is not one of `motors/`. The image lands
+/// at [`firmware_image_path`].
+pub fn firmware_image_build(motor: &str, board: &str, boards_dir: &Path) -> Command {
+    let firmware = repo().join("firmware");
+    let mut cmd = Command::new(std::env::var_os("CARGO").unwrap_or_else(|| "cargo".into()));
+    cmd.args([
+        "build",
+        "--locked",
+        "--release",
+        "--target",
+        FIRMWARE_TARGET,
+        "-p",
+        "motor-firmware",
+    ])
+    .current_dir(&firmware)
+    .env("CARGO_TARGET_DIR", firmware.join("target"))
+    .env("MOTOR", motor)
+    .env("BOARD", board)
+    .env("BOARDS_DIR", boards_dir)
+    .env_remove("MOTORS_DIR");
+    cmd
+}
+
+/// Where [`firmware_image_build`] leaves the image (an ELF).
+pub fn firmware_image_path() -> PathBuf {
+    repo()
+        .join("firmware/target")
+        .join(FIRMWARE_TARGET)
+        .join("release/motor-firmware")
+}
 
 #[cfg(test)]
 mod tests {
