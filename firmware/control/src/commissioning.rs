@@ -531,8 +531,8 @@ pub fn schroeder_phase(j: usize, count: usize) -> f32 {
 /// Loop-breaking frequency response of one current-loop axis at standstill: both
 /// currents are regulated to zero, and the injection d is added to the axis's
 /// controller output (PI and active damping) after its limit, v = u_PI + d
-/// ([`Demand::Injected`]). d is the multisine Σ a·sin(2π·k_j·n/N + φ_j) over the
-/// [`Lines`], clamped to ±`amplitude`; it repeats every N periods exactly (each line's
+/// ([`Demand::Injected`]). d is the multisine Σ a_j·sin(2π·k_j·n/N + φ_j) over the
+/// [`Lines`] ([`FrequencyResponse::line_amplitude`]), clamped to ±`amplitude`; it repeats every N periods exactly (each line's
 /// oscillator restarts from its initial phasor at every period boundary). After
 /// `settle_periods` periods of N, one period of N samples (u_PI, v) is captured.
 ///
@@ -571,11 +571,28 @@ pub struct FrequencyResponseState {
 pub type LoopSample = (f32, f32);
 
 impl FrequencyResponse {
-    /// The per-line amplitude a for a peak of `amplitude`: a = amplitude/√(2·count)
-    /// (the sum's rms is amplitude/2; with Schroeder's phases its peak stays near the
-    /// amplitude, and the clamp takes the rest).
-    pub fn line_amplitude(&self) -> f32 {
-        self.amplitude / libm::sqrtf(2.0 * self.lines.count.max(1) as f32)
+    /// The weight of line `j`: w_j = max(1, k_j/(4·k_0)), k_0 the first harmonic. The
+    /// host puts the first line two octaves below the designed crossover, so the lines
+    /// above the crossover grow with frequency as a first-order loop's |L| ≈ ω_c/ω falls:
+    /// each line's u_PI = −L·v stays about the same size, and the gain margin, read
+    /// where |L| is small, is measured with the crossover's resolution (the injected
+    /// current a/|R + jωL| stays about constant there too).
+    pub fn line_weight(&self, j: usize) -> f32 {
+        let first = f32::from(self.lines.harmonics.first().copied().unwrap_or(1).max(1));
+        let k = f32::from(self.lines.harmonics.get(j).copied().unwrap_or(0));
+        (k / (4.0 * first)).max(1.0)
+    }
+
+    /// The amplitude a_j of line `j` for a peak of `amplitude`:
+    /// a_j = amplitude·w_j/√(2·Σw²) (the sum's rms is amplitude/2; with Schroeder's
+    /// phases its peak stays near the amplitude, and the clamp takes the rest).
+    pub fn line_amplitude(&self, j: usize) -> f32 {
+        let mut sum = 0.0f32;
+        for i in 0..self.lines.count {
+            let w = self.line_weight(i);
+            sum += w * w;
+        }
+        self.amplitude * self.line_weight(j) / libm::sqrtf(2.0 * sum.max(1.0))
     }
 
     /// Periods the routine runs: (settle + 1)·N + 2 (the capture of period p is taken at
@@ -596,9 +613,9 @@ impl FrequencyResponse {
             phasor: [(0.0, 0.0); MAX_LINES],
             last: 0.0,
         };
-        let a = self.line_amplitude();
         let period = self.period.max(1) as f32;
         for (j, &k) in self.lines.used().iter().enumerate() {
+            let a = self.line_amplitude(j);
             let w = 2.0 * core::f32::consts::PI * f32::from(k) / period;
             let phi = schroeder_phase(j, self.lines.count);
             if let (Some(r), Some(i)) = (st.rotation.get_mut(j), st.initial.get_mut(j)) {
@@ -875,7 +892,10 @@ mod tests {
         }
         let mut st = r.start();
         let (pr, c) = r.process(&mut st, Dq { d: 4.0, q: 4.0 }, 0.0);
-        assert!(matches!(pr, Progress::Finished(Err(CommissioningError::Tripped { sample: 0, .. }))));
+        assert!(matches!(
+            pr,
+            Progress::Finished(Err(CommissioningError::Tripped { sample: 0, .. }))
+        ));
         assert_eq!(c, None);
     }
 }

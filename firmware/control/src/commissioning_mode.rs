@@ -24,9 +24,8 @@
 use crate::angle::to_radians;
 use crate::can_protocol::{self as p, Command, End, Frame, Header, Layout, Reason, Routine, State};
 use crate::commissioning::{
-    Axis, CommissioningError, FluxLinkage, FluxLinkageState, FrequencyResponse, FrequencyResponseState,
-    PolePairRatio, PolePairRatioState, Progress, ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState,
-    multisine_lines,
+    Axis, CommissioningError, FluxLinkage, FluxLinkageState, FrequencyResponse, FrequencyResponseState, PolePairRatio,
+    PolePairRatioState, Progress, ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState, multisine_lines,
 };
 use crate::step::Demand;
 use crate::transforms::Dq;
@@ -309,7 +308,14 @@ impl CommissioningMode {
             Routine::FrequencyResponse => return Reason::BadCommand,
         };
         let trip = if routine == Routine::Step { c.current_trip } else { 0.0 };
-        self.start(cfg, routine, run, routine == Routine::Step && c.axis_q, decimation, trip);
+        self.start(
+            cfg,
+            routine,
+            run,
+            routine == Routine::Step && c.axis_q,
+            decimation,
+            trip,
+        );
         Reason::None
     }
 

@@ -1,0 +1,547 @@
+//! The current loop's frequency response measured where the loop runs, and compared
+//! with the design.
+//!
+//! The drive's `frequency_response` routine (`motor_control::commissioning::
+//! FrequencyResponse`) breaks one axis's loop at the controller's output: it regulates
+//! both currents to zero and adds a multisine d to the controller's output u_PI (PI and
+//! active damping), so the inverter gets v = u_PI + d. With the reference at zero the
+//! loop answers u_PI = −L·v, L the loop transfer function broken at the plant input —
+//! the L(z) of the design's sampled-loop analysis (`codegen::design::current_loop::
+//! analysis`), delay included. One multisine period of N samples of (u_PI, v) is
+//! captured after one period of settling, so at each line k (frequency k/(N·T_s)) the
+//! DFT gives
+//!
+//! ```text
+//! L(e^{jω_kT_s}) = −U_PI[k] / V[k],    X[k] = Σ_{n<N} x_n·e^{−j2πkn/N}
+//! ```
+//!
+//! exactly for a linear loop in periodic steady state, whatever d's amplitude and the
+//! clamp did to its shape (the ratio holds at every frequency v has energy at).
+//!
+//! # Margins from measured points
+//!
+//! Between two adjacent lines the magnitude in dB is interpolated linearly in ln ω
+//! (a loop falling at 20 dB per decade is a straight line there) and the unwrapped
+//! phase linearly in ω (the loop delay's −ω·T_d is a straight line there):
+//!
+//! * crossover ω_c: where the interpolated |L| passes 0 dB (the lowest such crossing);
+//!   phase margin 180° + arg L(ω_c);
+//! * phase crossover ω_p: where the unwrapped phase passes −180° (− k·360°); gain
+//!   margin −|L(ω_p)| in dB; the smallest over the crossings, as the design's
+//!   analysis takes it.
+//!
+//! None of them outside the measured lines: the crossing is then not measured (null).
+
+use std::f64::consts::PI;
+use std::path::Path;
+use std::time::Duration;
+
+use codegen::Design;
+use codegen::units::{self, Kind};
+use motor_control::can_protocol::{Command, Layout, Routine};
+use motor_control::commissioning_mode::FREQUENCY_RESPONSE_SETTLE_PERIODS;
+
+use super::candump;
+use super::commission::{self, FrameBus};
+use super::error::{Error, Problem};
+use super::identify::Input;
+use codegen::design::current_loop::analysis::{self, AxisGains};
+use codegen::design::current_loop::discrete;
+use motor_control::commissioning::{Axis, Lines, multisine_lines};
+use motor_control::commissioning_mode::frequency_response_period;
+
+/// One measured (or modelled) point of L(jω).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Point {
+    /// ω [rad/s].
+    pub omega_rad_s: f64,
+    /// Re L.
+    pub re: f64,
+    /// Im L.
+    pub im: f64,
+}
+
+impl Point {
+    /// |L| in dB.
+    pub fn magnitude_db(&self) -> f64 {
+        20.0 * self.re.hypot(self.im).log10()
+    }
+
+    /// arg L in (−π, π] \[rad\].
+    pub fn phase(&self) -> f64 {
+        self.im.atan2(self.re)
+    }
+
+    /// Frequency \[Hz\].
+    pub fn frequency_hz(&self) -> f64 {
+        self.omega_rad_s / (2.0 * PI)
+    }
+}
+
+/// Margins and crossover of a loop, read from points or from the design.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Margins {
+    /// Gain margin \[dB\] at the phase crossover (None: no phase crossover).
+    pub gain_margin_db: Option<f64>,
+    /// Phase margin [°] at the crossover (None: no crossover).
+    pub phase_margin_deg: Option<f64>,
+    /// Gain crossover ω_c [rad/s].
+    pub crossover_rad_s: Option<f64>,
+    /// Phase crossover ω_p [rad/s].
+    pub phase_crossover_rad_s: Option<f64>,
+}
+
+/// The DFT bin `k` of the `n`-sample sequence `x` (one whole period).
+fn bin(x: impl Iterator<Item = f64>, k: u16, n: usize) -> (f64, f64) {
+    let w = 2.0 * PI * f64::from(k) / n as f64;
+    let (mut re, mut im) = (0.0, 0.0);
+    for (i, v) in x.enumerate() {
+        let (s, c) = (w * i as f64).sin_cos();
+        re += v * c;
+        im -= v * s;
+    }
+    (re, im)
+}
+
+/// L at every line from one captured period of (u_PI, v) \[V\] (module documentation):
+/// L = −U_PI/V. `ts` is T_s \[s\]. Lines whose V is zero (nothing injected) are left out.
+pub fn response(rows: &[(f64, f64)], harmonics: &[u16], ts: f64) -> Vec<Point> {
+    let n = rows.len();
+    harmonics
+        .iter()
+        .filter_map(|&k| {
+            let (ur, ui) = bin(rows.iter().map(|r| r.0), k, n);
+            let (vr, vi) = bin(rows.iter().map(|r| r.1), k, n);
+            let den = vr * vr + vi * vi;
+            (den > 0.0).then(|| Point {
+                omega_rad_s: 2.0 * PI * f64::from(k) / (n as f64 * ts),
+                // −(U·conj V)/|V|².
+                re: -(ur * vr + ui * vi) / den,
+                im: -(ui * vr - ur * vi) / den,
+            })
+        })
+        .collect()
+}
+
+/// Wraps an angle difference into (−π, π].
+fn wrap(x: f64) -> f64 {
+    let y = x.rem_euclid(2.0 * PI);
+    if y > PI { y - 2.0 * PI } else { y }
+}
+
+/// The phases of `points` unwrapped along increasing ω, starting from the principal
+/// value at the first \[rad\].
+pub fn unwrapped_phase(points: &[Point]) -> Vec<f64> {
+    let mut out: Vec<f64> = Vec::with_capacity(points.len());
+    for (k, p) in points.iter().enumerate() {
+        let ph = match (
+            k.checked_sub(1).and_then(|j| out.get(j)),
+            k.checked_sub(1).and_then(|j| points.get(j)),
+        ) {
+            (Some(prev), Some(q)) => prev + wrap(p.phase() - q.phase()),
+            _ => p.phase(),
+        };
+        out.push(ph);
+    }
+    out
+}
+
+/// The margins of the module documentation from measured `points` (increasing ω).
+pub fn margins(points: &[Point]) -> Margins {
+    let phase = unwrapped_phase(points);
+    let mut m = Margins::default();
+    for k in 0..points.len().saturating_sub(1) {
+        let (p0, p1) = (points[k], points[k + 1]);
+        let (w0, w1) = (p0.omega_rad_s, p1.omega_rad_s);
+        let (g0, g1) = (p0.magnitude_db(), p1.magnitude_db());
+        let (f0, f1) = (phase[k], phase[k + 1]);
+        // Gain crossover: the lowest.
+        if m.crossover_rad_s.is_none() && (g0 >= 0.0) != (g1 >= 0.0) {
+            let t = g0 / (g0 - g1);
+            let wc = (w0.ln() + t * (w1.ln() - w0.ln())).exp();
+            let ph = f0 + (wc - w0) / (w1 - w0) * (f1 - f0);
+            m.crossover_rad_s = Some(wc);
+            m.phase_margin_deg = Some(wrap(ph + PI).to_degrees());
+        }
+        // Phase crossovers: the unwrapped phase passes −π − 2πj.
+        let (j0, j1) = (((f0 + PI) / (2.0 * PI)).floor(), ((f1 + PI) / (2.0 * PI)).floor());
+        if j0 != j1 {
+            let target = -PI + 2.0 * PI * j0.max(j1);
+            let wp = w0 + (target - f0) / (f1 - f0) * (w1 - w0);
+            let t = (wp.ln() - w0.ln()) / (w1.ln() - w0.ln());
+            let gm = -(g0 + t * (g1 - g0));
+            if m.gain_margin_db.is_none_or(|g| gm < g) {
+                m.gain_margin_db = Some(gm);
+                m.phase_crossover_rad_s = Some(wp);
+            }
+        }
+    }
+    m
+}
+
+/// The design's gains of `axis`.
+pub fn axis_gains(d: &Design, axis: Axis) -> &AxisGains {
+    match axis {
+        Axis::D => &d.current_loop.d,
+        Axis::Q => &d.current_loop.q,
+    }
+}
+
+/// The designed margins of `axis` (the design's sampled-loop analysis).
+pub fn designed_margins(d: &Design, axis: Axis) -> Margins {
+    let s = &axis_gains(d, axis).sampled;
+    Margins {
+        gain_margin_db: s.gain_margin_db,
+        phase_margin_deg: s.phase_margin_deg,
+        crossover_rad_s: s.gain_crossover_rad_s,
+        phase_crossover_rad_s: s.phase_crossover_rad_s,
+    }
+}
+
+/// The designed L(e^{jωT_s}) of `axis` at `omega` [rad/s]: the design's gains on the
+/// sampled plant of the design's request (R, L, T_s and the loop delay).
+pub fn designed_point(d: &Design, axis: Axis, omega: f64) -> Point {
+    let req = d.current_loop_request(axis);
+    let l = analysis::open_loop(&axis_gains(d, axis).loop_gains(), &discrete::plant(&req), omega);
+    Point {
+        omega_rad_s: omega,
+        re: l.re,
+        im: l.im,
+    }
+}
+
+/// The multisine's period N \[samples\] on a drive with a capture buffer of `capacity`.
+pub fn period(capacity: usize) -> u32 {
+    frequency_response_period(capacity)
+}
+
+/// The default line set for `axis` of design `d` with period `n`: the first line two
+/// octaves below the designed crossover (at least harmonic 1), as many lines per octave
+/// (1–8) as `motor_control::commissioning::MAX_LINES` allows up to the Nyquist harmonic N/2.
+pub fn default_lines(d: &Design, axis: Axis, n: u32) -> Option<(u16, u8)> {
+    let ts = d.drive.sample_period_s;
+    let w0 = 2.0 * PI / (f64::from(n) * ts);
+    let wc = designed_margins(d, axis)
+        .crossover_rad_s
+        .unwrap_or(d.current_loop.bandwidth_rad_s);
+    let first = ((wc / 4.0 / w0).floor() as u32).clamp(1, 255);
+    lines_spanning(first, n)
+}
+
+/// `first` with the most lines per octave whose set still reaches the highest octave
+/// below N/2 within `motor_control::commissioning::MAX_LINES` lines.
+pub fn lines_spanning(first: u32, n: u32) -> Option<(u16, u8)> {
+    let first = u16::try_from(first).ok()?;
+    // The last line within an octave of N/2 (a set cut at MAX_LINES ends lower).
+    let reach = |l: &Lines| l.used().last().is_some_and(|&k| u32::from(k) * 2 >= n / 2);
+    (1..=8u8)
+        .rev()
+        .find(|&r| multisine_lines(first, r, n).is_some_and(|l| reach(&l)))
+        .map(|r| (first, r))
+}
+
+// ---------------------------------------------------------------------------------
+// The session
+// ---------------------------------------------------------------------------------
+
+/// A frequency-response session's options, as the user gave them (`motorgen commission
+/// … frequency-response`).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Options {
+    /// The interface's name (in messages and the log).
+    pub iface: String,
+    /// How long to wait for the whole capture, e.g. `30 s` (at most an hour).
+    pub timeout: String,
+    /// The injected axis.
+    pub axis: Axis,
+    /// Peak of the injection, e.g. `5 V` (`None`: [`default_amplitude`]).
+    pub amplitude: Option<String>,
+    /// The lines: `FIRST_HARMONIC/PER_OCTAVE`, e.g. `4/3` (`None`: [`default_lines`]).
+    pub frequencies: Option<String>,
+}
+
+/// A session checked before the bus is touched.
+#[derive(Debug, Clone)]
+pub struct Plan {
+    /// The CAN interface of the design on the board.
+    pub layout: Layout,
+    /// The board's CAN bit rate \[bit/s\].
+    pub bit_rate: u32,
+    /// The command frame's content.
+    pub command: Command,
+    /// How long the whole session may take.
+    pub timeout: Duration,
+    /// The multisine's period N \[samples\].
+    pub period: u32,
+    /// The lines' harmonic numbers.
+    pub harmonics: Vec<u16>,
+    /// The design the margins are compared with.
+    pub design: Design,
+    options: Options,
+    spec_stem: String,
+}
+
+/// A measured frequency response next to the design.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Measurement {
+    /// The injected axis.
+    pub axis: Axis,
+    /// Margins read from the measured points.
+    pub measured: Margins,
+    /// The design's margins (its sampled-loop analysis).
+    pub designed: Margins,
+    /// The measured points.
+    pub points: Vec<Point>,
+    /// The designed L at the same frequencies.
+    pub designed_points: Vec<Point>,
+    /// Injection peak \[V\] and trip \[A\] as sent.
+    pub amplitude_v: f64,
+    /// Trip level \[A\].
+    pub trip_a: f64,
+    /// Periods the routine ran and T_s \[s\].
+    pub duration_s: f64,
+    /// (file name, CSV recording) of the capture.
+    pub csv: (String, String),
+}
+
+fn bad_option(option: &str, problem: String, accepted: &str) -> Error {
+    Error::Option(Problem::new(option, problem, accepted))
+}
+
+/// The default injection peak of `axis` \[V\]: 5 % of the voltage limit U_dc/√3. The
+/// lines' weights (`FrequencyResponse::line_weight`) put most of it at high frequencies,
+/// where the axis's impedance |R + jωL| is large; the current stays small (the
+/// measured figures in README.md).
+pub fn default_amplitude(d: &Design, _axis: Axis) -> f64 {
+    0.05 * d.current_loop.voltage_limit_v
+}
+
+/// The trip level \[A\]: half the motor's peak current.
+pub fn trip_level(d: &Design) -> f64 {
+    0.5 * d.motor.peak_current_a
+}
+
+/// Checks the options, the spec and the board (a design with a CAN interface).
+pub fn plan(o: &Options, spec: &Input, board: &Input) -> Result<Plan, Error> {
+    let d = codegen::design_with_board(&spec.name, spec.text()?, &board.name, board.text()?)?;
+    plan_design(o, d, &spec.name)
+}
+
+/// [`plan`] for a design already made (`spec_name` names the CSV file).
+pub fn plan_design(o: &Options, d: Design, spec_name: &str) -> Result<Plan, Error> {
+    let Some((cfg, capacity)) = candump::mode_config(&d) else {
+        return Err(bad_option(
+            "--board",
+            "the design has no CAN interface".into(),
+            "a board file with a [can] section",
+        ));
+    };
+    let timeout = units::parse(Kind::Time, &o.timeout)
+        .ok()
+        .filter(|t| *t > 0.0 && *t <= 3600.0)
+        .ok_or_else(|| {
+            bad_option(
+                "--timeout",
+                format!("`{}` is not a time up to an hour", o.timeout),
+                "a time, e.g. \"30 s\"",
+            )
+        })?;
+    let n = period(capacity);
+    let limit = d.current_loop.voltage_limit_v;
+    let amplitude = match &o.amplitude {
+        None => default_amplitude(&d, o.axis),
+        Some(t) => units::parse(Kind::Voltage, t)
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0 && *v <= 0.2 * limit)
+            .ok_or_else(|| {
+                bad_option(
+                    "--amplitude",
+                    format!("`{t}` is not a voltage above 0 and up to 20 % of the voltage limit U_dc/√3"),
+                    &format!("a voltage up to {:.3} V, e.g. \"5 V\"", 0.2 * limit),
+                )
+            })?,
+    };
+    let accepted = format!(
+        "FIRST/PER_OCTAVE: a first harmonic 1–255 below {} and 1–8 lines per octave, e.g. \"4/3\"",
+        n / 2
+    );
+    let (first, per_octave) = match &o.frequencies {
+        None => default_lines(&d, o.axis, n).ok_or_else(|| {
+            bad_option(
+                "--frequencies",
+                "no line set fits this drive's capture".into(),
+                &accepted,
+            )
+        })?,
+        Some(t) => t
+            .split_once('/')
+            .and_then(|(a, b)| Some((a.trim().parse::<u8>().ok()?, b.trim().parse::<u8>().ok()?)))
+            .filter(|(a, b)| multisine_lines(u16::from(*a), *b, n).is_some())
+            .map(|(a, b)| (u16::from(a), b))
+            .ok_or_else(|| {
+                bad_option(
+                    "--frequencies",
+                    format!("`{t}` is not a line set of this drive"),
+                    &accepted,
+                )
+            })?,
+    };
+    let lines = multisine_lines(first, per_octave, n).ok_or_else(|| {
+        bad_option(
+            "--frequencies",
+            "no line set fits this drive's capture".into(),
+            &accepted,
+        )
+    })?;
+    let trip = trip_level(&d);
+    let current_full_scale = cfg.layout.current_per_lsb as f64 * 32767.0;
+    let command = Command {
+        routine: Some(Routine::FrequencyResponse),
+        axis_q: o.axis == Axis::Q,
+        voltage: amplitude as f32,
+        current_trip: trip.min(current_full_scale) as f32,
+        decimation: u16::from_le_bytes([first as u8, per_octave]),
+    };
+    let bit_rate = d.board.as_ref().map_or(0, |b| b.board.can_bit_rate.round() as u32);
+    let spec_stem = Path::new(spec_name)
+        .file_stem()
+        .map_or_else(|| "motor".into(), |s| s.to_string_lossy().into_owned());
+    Ok(Plan {
+        layout: cfg.layout,
+        bit_rate,
+        command,
+        timeout: Duration::from_secs_f64(timeout),
+        period: n,
+        harmonics: lines.used().to_vec(),
+        design: d,
+        options: o.clone(),
+        spec_stem,
+    })
+}
+
+impl Plan {
+    /// Runs the session on `bus`: the command, the capture (reassembled and checked as
+    /// a `candump -l` log's), L at every line, the margins and the design's.
+    pub fn run<B: FrameBus>(&self, bus: &mut B) -> Result<Measurement, Error> {
+        let o = &self.options;
+        let rec = commission::run_session(bus, &o.iface, &self.layout, &self.command, self.timeout)
+            .map_err(|e| commission::session_error(e, &o.iface, &o.timeout))?;
+        let name = format!("{} (live)", o.iface);
+        let caps = candump::captures(&name, &rec.text, &rec.frames, &self.layout)?;
+        let bad = |problem: String| {
+            bad_option(
+                &name,
+                problem,
+                "one complete frequency-response capture of one multisine period",
+            )
+        };
+        let Some(c) = caps.iter().find(|c| c.header.routine == Routine::FrequencyResponse) else {
+            return Err(bad("the session brought no frequency-response capture".into()));
+        };
+        if c.header.tripped {
+            return Err(bad(format!(
+                "the routine tripped at sample {} at {:.3} A; lower --amplitude",
+                c.end.trip_sample, c.end.trip_current
+            )));
+        }
+        if c.rows.len() != self.period as usize {
+            return Err(bad(format!(
+                "the capture has {} samples, not the multisine period {}",
+                c.rows.len(),
+                self.period
+            )));
+        }
+        let per = f64::from(self.layout.voltage_per_lsb);
+        let rows: Vec<(f64, f64)> = c
+            .rows
+            .iter()
+            .map(|&(a, b)| (f64::from(a) * per, f64::from(b) * per))
+            .collect();
+        let ts = c.sample_period_s();
+        let d = &self.design;
+        let points = response(&rows, &self.harmonics, ts);
+        let designed_points = points
+            .iter()
+            .map(|p| designed_point(d, o.axis, p.omega_rad_s))
+            .collect();
+        let axis = match o.axis {
+            Axis::D => "d",
+            Axis::Q => "q",
+        };
+        let t = rec
+            .frames
+            .iter()
+            .position(|f| f.offset == c.header_offset)
+            .map_or(0.0, |k| rec.times[k]);
+        let file = format!(
+            "{}-frequency_response-{axis}-{}.csv",
+            self.spec_stem,
+            commission::stamp(t)
+        );
+        Ok(Measurement {
+            axis: o.axis,
+            measured: margins(&points),
+            designed: designed_margins(d, o.axis),
+            points,
+            designed_points,
+            amplitude_v: f64::from(self.command.voltage),
+            trip_a: f64::from(self.command.current_trip),
+            duration_s: (u64::from(FREQUENCY_RESPONSE_SETTLE_PERIODS) + 1) as f64 * f64::from(self.period) * ts,
+            csv: (file, c.to_csv(&self.layout)),
+        })
+    }
+}
+
+fn json_number(x: Option<f64>) -> String {
+    match x {
+        Some(v) if v.is_finite() => format!("{v:.6}"),
+        _ => "null".into(),
+    }
+}
+
+fn json_margins(m: &Margins) -> String {
+    format!(
+        "{{\"gain_margin_db\": {}, \"phase_margin_deg\": {}, \"crossover_rad_s\": {}}}",
+        json_number(m.gain_margin_db),
+        json_number(m.phase_margin_deg),
+        json_number(m.crossover_rad_s)
+    )
+}
+
+impl Measurement {
+    /// `frequency-response-<axis>.json`: the axis, the measured and designed margins and
+    /// every point with the designed response at its frequency (phases unwrapped along
+    /// the points, in degrees).
+    pub fn to_json(&self) -> String {
+        let axis = match self.axis {
+            Axis::D => "d",
+            Axis::Q => "q",
+        };
+        let (pm, pd) = (unwrapped_phase(&self.points), unwrapped_phase(&self.designed_points));
+        let points: Vec<String> = self
+            .points
+            .iter()
+            .zip(&self.designed_points)
+            .enumerate()
+            .map(|(k, (m, d))| {
+                format!(
+                    "    {{\"frequency_hz\": {}, \"magnitude_db\": {}, \"phase_deg\": {}, \"designed_magnitude_db\": {}, \"designed_phase_deg\": {}}}",
+                    json_number(Some(m.frequency_hz())),
+                    json_number(Some(m.magnitude_db())),
+                    json_number(pm.get(k).map(|p| p.to_degrees())),
+                    json_number(Some(d.magnitude_db())),
+                    json_number(pd.get(k).map(|p| p.to_degrees())),
+                )
+            })
+            .collect();
+        format!(
+            "{{\n  \"axis\": \"{axis}\",\n  \"measured\": {},\n  \"designed\": {},\n  \"amplitude_v\": {},\n  \"trip_a\": {},\n  \"duration_s\": {},\n  \"points\": [\n{}\n  ]\n}}\n",
+            json_margins(&self.measured),
+            json_margins(&self.designed),
+            json_number(Some(self.amplitude_v)),
+            json_number(Some(self.trip_a)),
+            json_number(Some(self.duration_s)),
+            points.join(",\n")
+        )
+    }
+}

@@ -1,0 +1,108 @@
+//! The current loop's frequency response on the simulated drive (`sim_drive`: the
+//! firmware's commissioning mode, its `frequency_response` routine and CAN encoder on
+//! the firmware's control step and `verify`'s plant), for every motor in `motors/` on
+//! the reference board (or the first board that fits it): the margins read from the
+//! measured points must be the design's — ±0.5 dB gain margin, ±3° phase margin, ±5 %
+//! crossover per axis (issue 28). The designed figures are the design's sampled-loop
+//! analysis (a fine grid refined by bisection), an independent computation from the
+//! measured DFT ratio of the captured u_PI and v.
+
+use codegen::{Design, Source};
+use motor_commission::frequency_response::{self as fr, Margins, Measurement, Options};
+use motor_commission::sim_drive::SimulatedDrive;
+use motor_control::commissioning::Axis;
+use motor_test_support::repo;
+
+const BOARD: &str = "boards/motorgen-reference.toml";
+
+/// The design of `stem` on the reference board or the first board that fits, and its
+/// parsed spec.
+pub fn motor(stem: &str) -> (String, Design, codegen::spec::Spec) {
+    let rel = format!("motors/{stem}.toml");
+    let text = std::fs::read_to_string(repo().join(&rel)).unwrap();
+    let mut boards: Vec<String> = motor_test_support::board_stems()
+        .into_iter()
+        .map(|b| format!("boards/{b}.toml"))
+        .collect();
+    boards.sort_by_key(|b| b != BOARD);
+    let design = boards
+        .into_iter()
+        .find_map(|b| {
+            let board_text = std::fs::read_to_string(repo().join(&b)).unwrap();
+            codegen::design_with_board(&rel, &text, &b, &board_text).ok()
+        })
+        .unwrap_or_else(|| panic!("{stem} fits no board"));
+    let spec = codegen::spec::parse(Source {
+        file: &rel,
+        text: &text,
+    })
+    .unwrap();
+    (rel, design, spec)
+}
+
+/// The measurement of `axis` on the simulated bench of `d`.
+pub fn measure(rel: &str, d: &Design, spec: &codegen::spec::Spec, axis: Axis) -> Measurement {
+    let options = Options {
+        iface: "sim0".into(),
+        timeout: "60 s".into(),
+        axis,
+        amplitude: None,
+        frequencies: None,
+    };
+    let plan = fr::plan_design(&options, d.clone(), rel).unwrap();
+    let setup = motor_verify::Setup::new(spec, d);
+    let mut drive = SimulatedDrive::new(d, setup.bench(0.0), 0.0).unwrap();
+    plan.run(&mut drive).unwrap()
+}
+
+/// Measured within ±0.5 dB, ±3°, ±5 % of `expected`; the differences.
+pub fn within(measured: &Margins, expected: &Margins) -> Result<(f64, f64, f64), String> {
+    let (Some(gm), Some(pm), Some(wc)) = (
+        measured.gain_margin_db,
+        measured.phase_margin_deg,
+        measured.crossover_rad_s,
+    ) else {
+        return Err(format!("not measured: {measured:?}"));
+    };
+    let (Some(egm), Some(epm), Some(ewc)) = (
+        expected.gain_margin_db,
+        expected.phase_margin_deg,
+        expected.crossover_rad_s,
+    ) else {
+        return Err(format!("no expected figures: {expected:?}"));
+    };
+    let e = (gm - egm, pm - epm, wc / ewc - 1.0);
+    if e.0.abs() <= 0.5 && e.1.abs() <= 3.0 && e.2.abs() <= 0.05 {
+        Ok(e)
+    } else {
+        Err(format!("measured {measured:?} vs {expected:?}: {e:?}"))
+    }
+}
+
+/// Every motor, both axes: the measured margins are the designed ones.
+#[test]
+fn simulated_bench_measures_the_designed_margins_on_every_motor() {
+    let mut failures = vec![];
+    for (stem, _, _) in motor_test_support::motors() {
+        let (rel, d, spec) = motor(&stem);
+        for axis in [Axis::D, Axis::Q] {
+            let m = measure(&rel, &d, &spec, axis);
+            let r = within(&m.measured, &m.designed);
+            println!(
+                "{stem} {axis:?}: measured GM {:?} dB PM {:?}° ω_c {:?} rad/s; designed GM {:?} PM {:?} ω_c {:?}; A = {:.3} V, {} lines; {r:?}",
+                m.measured.gain_margin_db,
+                m.measured.phase_margin_deg,
+                m.measured.crossover_rad_s,
+                m.designed.gain_margin_db,
+                m.designed.phase_margin_deg,
+                m.designed.crossover_rad_s,
+                m.amplitude_v,
+                m.points.len(),
+            );
+            if let Err(e) = r {
+                failures.push(format!("{stem} {axis:?}: {e}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
