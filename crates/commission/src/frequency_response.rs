@@ -545,3 +545,300 @@ impl Measurement {
         )
     }
 }
+
+// ---------------------------------------------------------------------------------
+// The sampled loop with any delay, and the plant fitted to the measured points
+// ---------------------------------------------------------------------------------
+
+fn c_mul(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    (a.0 * b.0 - a.1 * b.1, a.0 * b.1 + a.1 * b.0)
+}
+
+fn c_div(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    let d = b.0 * b.0 + b.1 * b.1;
+    ((a.0 * b.0 + a.1 * b.1) / d, (a.1 * b.0 - a.0 * b.1) / d)
+}
+
+/// A plant the loop is modelled with: R \[Ω\], L \[H\] and the loop delay in sample
+/// periods (the design's is the firmware's, `codegen::design::current_loop::
+/// FIRMWARE_LOOP_DELAY_PERIODS` through the design's request).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PlantModel {
+    /// R \[Ω\].
+    pub resistance_ohm: f64,
+    /// L \[H\].
+    pub inductance_h: f64,
+    /// Loop delay D \[periods\] (≥ 0.5: the ZOH's half period).
+    pub delay_periods: f64,
+}
+
+/// L(e^{jωT_s}) of gains `g` on `plant` at sample period `ts`: the ZOH-sampled
+/// 1/(Ls + R) whose voltage acts τ = D − 1/2 periods after the sample (the ZOH's half
+/// period makes the rest of D). With τ = q + x (q whole periods, 0 ≤ x < 1) the voltage
+/// v_k acts on [t_k + τ, t_{k+1} + τ), so over one period the current sees v_{n−q−1}
+/// for x·T_s, then v_{n−q} (the modified z-transform):
+///
+/// ```text
+/// i_{n+1} = a·i_n + c₁·v_{n−q−1} + c₂·v_{n−q}
+/// a  = e^(−R·T_s/L),   c₂ = (1 − e^(−R(1−x)T_s/L))/R,   c₁ = (e^(−R(1−x)T_s/L) − a)/R
+/// P(z) = (c₂·z + c₁) / (z^(q+1)·(z − a)),     L(z) = P(z)·(k_p + R_a + k_i·T_s/(z − 1))
+/// ```
+///
+/// At D = 1.5 (q = 1, x = 0) this is the design's b/(z·(z − a)) (`analysis::open_loop`).
+pub fn model_point(g: &discrete::LoopGains, plant: &PlantModel, ts: f64, omega: f64) -> Point {
+    let (r, l) = (plant.resistance_ohm, plant.inductance_h);
+    let tau = (plant.delay_periods - 0.5).max(0.0);
+    let q = tau.floor();
+    let x = tau - q;
+    let a = (-r * ts / l).exp();
+    let e = (-r * (1.0 - x) * ts / l).exp();
+    let (c2, c1) = ((1.0 - e) / r, (e - a) / r);
+    let th = omega * ts;
+    let z = (th.cos(), th.sin());
+    let zq1 = ((q + 1.0) * th).cos();
+    let zq1 = (zq1, ((q + 1.0) * th).sin());
+    let num = (c2 * z.0 + c1, c2 * z.1);
+    let p = c_div(num, c_mul(zq1, (z.0 - a, z.1)));
+    let c = c_div((g.ki * ts, 0.0), (z.0 - 1.0, z.1));
+    let c = (c.0 + g.kp + g.active_damping, c.1);
+    let lz = c_mul(p, c);
+    Point {
+        omega_rad_s: omega,
+        re: lz.0,
+        im: lz.1,
+    }
+}
+
+/// The margins of gains `g` on `plant` ([`model_point`] on 3000 logarithmic points from
+/// 10⁻⁴/T_s to the Nyquist frequency, read as measured points are, [`margins`]).
+pub fn model_margins(g: &discrete::LoopGains, plant: &PlantModel, ts: f64) -> Margins {
+    let n = 3000;
+    let (lo, hi) = ((1e-4 / ts).ln(), (PI / ts).ln());
+    let points: Vec<Point> = (0..n)
+        .map(|k| model_point(g, plant, ts, (lo + (hi - lo) * k as f64 / (n - 1) as f64).exp()))
+        .collect();
+    margins(&points)
+}
+
+/// The plant fitted to measured points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Fit {
+    /// The fitted plant.
+    pub plant: PlantModel,
+    /// rms of the relative error |L_model − L|/|L| over the points after the fit.
+    pub rms_relative_error: f64,
+    /// R is determined by the points (its sensitivity is at least 1 % of L's): below the
+    /// corner R/L the plant's magnitude is R's; far above it, R hardly shows.
+    pub resistance_determined: bool,
+}
+
+/// Solves the 3×3 system `a·x = b` (Gaussian elimination with partial pivoting); `None`
+/// when singular.
+fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
+    for col in 0..3 {
+        let piv = (col..3).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[piv][col].abs() < 1e-300 {
+            return None;
+        }
+        a.swap(col, piv);
+        b.swap(col, piv);
+        for row in col + 1..3 {
+            let f = a[row][col] / a[col][col];
+            for k in col..3 {
+                a[row][k] -= f * a[col][k];
+            }
+            b[row] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; 3];
+    for row in (0..3).rev() {
+        let s: f64 = (row + 1..3).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    Some(x)
+}
+
+/// R, L and the loop delay fitted to `points` with the loop's gains `g` at `ts`:
+/// Levenberg–Marquardt on (ln R, ln L, D) from `start`, minimising the squared relative
+/// errors (L_model − L)/L over the points (real and imaginary parts), numeric Jacobian.
+pub fn fit_plant(points: &[Point], g: &discrete::LoopGains, ts: f64, start: &PlantModel) -> Fit {
+    let model = |p: [f64; 3]| PlantModel {
+        resistance_ohm: p[0].exp(),
+        inductance_h: p[1].exp(),
+        delay_periods: p[2].max(0.5),
+    };
+    let residuals = |p: [f64; 3]| -> Vec<f64> {
+        let m = model(p);
+        points
+            .iter()
+            .flat_map(|pt| {
+                let l = model_point(g, &m, ts, pt.omega_rad_s);
+                let e = c_div((l.re - pt.re, l.im - pt.im), (pt.re, pt.im));
+                [e.0, e.1]
+            })
+            .collect()
+    };
+    let cost = |r: &[f64]| r.iter().map(|x| x * x).sum::<f64>();
+    let mut p = [start.resistance_ohm.ln(), start.inductance_h.ln(), start.delay_periods];
+    let mut r = residuals(p);
+    let mut c = cost(&r);
+    let mut lambda = 1e-3;
+    let mut jac_norm = [0.0; 3];
+    for _ in 0..100 {
+        let h = [1e-6, 1e-6, 1e-6];
+        let cols: Vec<Vec<f64>> = (0..3)
+            .map(|j| {
+                let mut q = p;
+                q[j] += h[j];
+                residuals(q).iter().zip(&r).map(|(a, b)| (a - b) / h[j]).collect()
+            })
+            .collect();
+        let mut jtj = [[0.0; 3]; 3];
+        let mut jtr = [0.0; 3];
+        for i in 0..3 {
+            for k in 0..3 {
+                jtj[i][k] = cols[i].iter().zip(&cols[k]).map(|(a, b)| a * b).sum();
+            }
+            jtr[i] = -cols[i].iter().zip(&r).map(|(a, b)| a * b).sum::<f64>();
+            jac_norm[i] = jtj[i][i].sqrt();
+        }
+        let mut improved = false;
+        for _ in 0..20 {
+            let mut a = jtj;
+            for (i, row) in a.iter_mut().enumerate() {
+                row[i] += lambda * jtj[i][i].max(1e-12);
+            }
+            let Some(step) = solve3(a, jtr) else { break };
+            let q = [p[0] + step[0], p[1] + step[1], (p[2] + step[2]).max(0.5)];
+            let rq = residuals(q);
+            let cq = cost(&rq);
+            if cq.is_finite() && cq < c {
+                let done = (c - cq) < 1e-14 * c.max(1e-30);
+                p = q;
+                r = rq;
+                c = cq;
+                lambda = (lambda / 10.0).max(1e-12);
+                improved = !done;
+                break;
+            }
+            lambda *= 10.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    Fit {
+        plant: model(p),
+        rms_relative_error: (c / points.len().max(1) as f64).sqrt(),
+        resistance_determined: jac_norm[0] >= 0.01 * jac_norm[1],
+    }
+}
+
+// ---------------------------------------------------------------------------------
+// The simulated plant, perturbed (`--sim-scale KEY=FACTOR`)
+// ---------------------------------------------------------------------------------
+
+/// Factors on the simulated plant: R, L_d, L_q and the loop delay (1: as designed).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SimScale {
+    /// Factor on R.
+    pub resistance: f64,
+    /// Factor on L_d.
+    pub ld: f64,
+    /// Factor on L_q.
+    pub lq: f64,
+    /// Factor on the loop delay.
+    pub delay: f64,
+}
+
+impl Default for SimScale {
+    fn default() -> Self {
+        SimScale {
+            resistance: 1.0,
+            ld: 1.0,
+            lq: 1.0,
+            delay: 1.0,
+        }
+    }
+}
+
+/// The simulated bench's own loop delay \[periods\]: the duties computed at t_n act
+/// during [t_{n+1}, t_{n+2}) (`motor_sim::bench`), 1.5 with the ZOH's half period.
+pub const BENCH_DELAY_PERIODS: f64 = 1.5;
+
+impl SimScale {
+    /// `KEY=FACTOR` options (`R`, `Ld`, `Lq`, `delay`; a key given twice is refused).
+    /// `design_delay` is the design's loop delay \[periods\]: the perturbed delay
+    /// `delay`·design_delay must lie within one period above the bench's own
+    /// ([`BENCH_DELAY_PERIODS`]), which [`SimScale::apply`] lengthens.
+    pub fn parse(options: &[String], design_delay: f64) -> Result<SimScale, Error> {
+        let accepted = "KEY=FACTOR with KEY one of R, Ld, Lq, delay and a factor from 0.1 to 10, e.g. Lq=0.7";
+        let mut s = SimScale::default();
+        let mut seen: Vec<&str> = Vec::new();
+        for o in options {
+            let bad = |p: String| bad_option("--sim-scale", p, accepted);
+            let (key, value) = o.split_once('=').ok_or_else(|| bad(format!("`{o}` has no `=`")))?;
+            let f: f64 = value
+                .trim()
+                .parse()
+                .ok()
+                .filter(|f: &f64| f.is_finite() && (0.1..=10.0).contains(f))
+                .ok_or_else(|| bad(format!("`{value}` is not a factor from 0.1 to 10")))?;
+            let key = key.trim();
+            if seen.contains(&key) {
+                return Err(bad(format!("`{key}` is given twice")));
+            }
+            match key {
+                "R" => s.resistance = f,
+                "Ld" => s.ld = f,
+                "Lq" => s.lq = f,
+                "delay" => {
+                    let d = f * design_delay;
+                    if !(BENCH_DELAY_PERIODS..BENCH_DELAY_PERIODS + 1.0).contains(&d) {
+                        return Err(bad_option(
+                            "--sim-scale",
+                            format!(
+                                "delay={value} makes the loop delay {d:.3} periods; the simulated bench delays from {BENCH_DELAY_PERIODS} to below {} periods",
+                                BENCH_DELAY_PERIODS + 1.0
+                            ),
+                            &format!(
+                                "a delay factor from {:.3} to below {:.3}",
+                                BENCH_DELAY_PERIODS / design_delay,
+                                (BENCH_DELAY_PERIODS + 1.0) / design_delay
+                            ),
+                        ));
+                    }
+                    s.delay = f;
+                }
+                _ => return Err(bad(format!("`{key}` is not a key"))),
+            }
+            seen.push(key);
+        }
+        Ok(s)
+    }
+
+    /// The plant of `axis` perturbed: the design's R, L and delay times the factors.
+    pub fn plant_of(&self, d: &Design, axis: Axis) -> PlantModel {
+        let req = d.current_loop_request(axis);
+        let l = match axis {
+            Axis::D => self.ld,
+            Axis::Q => self.lq,
+        };
+        PlantModel {
+            resistance_ohm: req.resistance_ohm * self.resistance,
+            inductance_h: req.inductance_h * l,
+            delay_periods: req.loop_delay_s / req.sample_period_s * self.delay,
+        }
+    }
+
+    /// Perturbs the simulated `plant` (its motor's R, L_d, L_q; the delay beyond the
+    /// bench's own as [`motor_sim::plant::Plant::extra_delay`]) for a design whose loop
+    /// delay is `design_delay` periods.
+    pub fn apply(&self, plant: &mut motor_sim::plant::Plant, design_delay: f64) {
+        plant.motor.resistance *= self.resistance;
+        plant.motor.ld *= self.ld;
+        plant.motor.lq *= self.lq;
+        plant.motor.q_saturation.iter_mut().for_each(|(_, l)| *l *= self.lq);
+        plant.extra_delay = (self.delay * design_delay - BENCH_DELAY_PERIODS).max(0.0);
+    }
+}

@@ -8,7 +8,7 @@
 //! measured DFT ratio of the captured u_PI and v.
 
 use codegen::{Design, Source};
-use motor_commission::frequency_response::{self as fr, Margins, Measurement, Options};
+use motor_commission::frequency_response::{self as fr, Margins, Measurement, Options, SimScale};
 use motor_commission::sim_drive::SimulatedDrive;
 use motor_control::commissioning::Axis;
 use motor_test_support::repo;
@@ -42,6 +42,17 @@ pub fn motor(stem: &str) -> (String, Design, codegen::spec::Spec) {
 
 /// The measurement of `axis` on the simulated bench of `d`.
 pub fn measure(rel: &str, d: &Design, spec: &codegen::spec::Spec, axis: Axis) -> Measurement {
+    measure_scaled(rel, d, spec, axis, &SimScale::default())
+}
+
+/// The design's loop delay \[periods\].
+fn design_delay(d: &Design) -> f64 {
+    let req = d.current_loop_request(Axis::D);
+    req.loop_delay_s / req.sample_period_s
+}
+
+/// [`measure`] on the plant perturbed by `scale`.
+pub fn measure_scaled(rel: &str, d: &Design, spec: &codegen::spec::Spec, axis: Axis, scale: &SimScale) -> Measurement {
     let options = Options {
         iface: "sim0".into(),
         timeout: "60 s".into(),
@@ -51,7 +62,9 @@ pub fn measure(rel: &str, d: &Design, spec: &codegen::spec::Spec, axis: Axis) ->
     };
     let plan = fr::plan_design(&options, d.clone(), rel).unwrap();
     let setup = motor_verify::Setup::new(spec, d);
-    let mut drive = SimulatedDrive::new(d, setup.bench(0.0), 0.0).unwrap();
+    let mut bench = setup.bench(0.0);
+    scale.apply(&mut bench.plant, design_delay(d));
+    let mut drive = SimulatedDrive::new(d, bench, 0.0).unwrap();
     plan.run(&mut drive).unwrap()
 }
 
@@ -105,4 +118,71 @@ fn simulated_bench_measures_the_designed_margins_on_every_motor() {
         }
     }
     assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Every motor with the plant perturbed: the q axis with L_q × 0.7, the d axis with the
+/// loop delay × 1.5. The measured margins follow the perturbed plant's sampled-loop model
+/// (`fr::model_margins`, the design's gains on R, L and delay of the perturbed plant),
+/// not the design, within the same tolerances; the fit recovers the perturbed L and
+/// delay within 5 %.
+#[test]
+fn measurement_follows_the_perturbed_plant_and_the_fit_recovers_it() {
+    let mut failures = vec![];
+    for (stem, _, _) in motor_test_support::motors() {
+        let (rel, d, spec) = motor(&stem);
+        let ts = d.drive.sample_period_s;
+        let delay = design_delay(&d);
+        for (axis, options) in [(Axis::Q, ["Lq=0.7".to_string()]), (Axis::D, ["delay=1.5".to_string()])] {
+            let scale = SimScale::parse(&options, delay).unwrap();
+            let m = measure_scaled(&rel, &d, &spec, axis, &scale);
+            let gains = fr::axis_gains(&d, axis).loop_gains();
+            let truth = scale.plant_of(&d, axis);
+            let expected = fr::model_margins(&gains, &truth, ts);
+            let r = within(&m.measured, &expected);
+            let design_plant = SimScale::default().plant_of(&d, axis);
+            let fit = fr::fit_plant(&m.points, &gains, ts, &design_plant);
+            let e_l = fit.plant.inductance_h / truth.inductance_h - 1.0;
+            let e_d = fit.plant.delay_periods / truth.delay_periods - 1.0;
+            let e_r = fit.plant.resistance_ohm / truth.resistance_ohm - 1.0;
+            println!(
+                "{stem} {axis:?} {options:?}: measured GM {:?} PM {:?} ω_c {:?}; model GM {:?} PM {:?} ω_c {:?}; {r:?}; fit L {e_l:+.4} D {e_d:+.4} R {e_r:+.4} (determined {}), rms {:.2e}",
+                m.measured.gain_margin_db,
+                m.measured.phase_margin_deg,
+                m.measured.crossover_rad_s,
+                expected.gain_margin_db,
+                expected.phase_margin_deg,
+                expected.crossover_rad_s,
+                fit.resistance_determined,
+                fit.rms_relative_error,
+            );
+            if let Err(e) = r {
+                failures.push(format!("{stem} {axis:?}: {e}"));
+            }
+            if e_l.abs() > 0.05 || e_d.abs() > 0.05 || (fit.resistance_determined && e_r.abs() > 0.05) {
+                failures.push(format!("{stem} {axis:?}: fit {fit:?} vs {truth:?}"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// The sampled-loop model at the design's delay is the design's own L(z) (its
+/// analysis), and its margins on the grid are the design's.
+#[test]
+fn the_model_at_the_design_delay_is_the_designs_loop() {
+    let (_, d, _) = motor("fischer-ti085");
+    let ts = d.drive.sample_period_s;
+    for axis in [Axis::D, Axis::Q] {
+        let gains = fr::axis_gains(&d, axis).loop_gains();
+        let plant = SimScale::default().plant_of(&d, axis);
+        for w in [10.0, 300.0, 3000.0, 30000.0] {
+            let a = fr::model_point(&gains, &plant, ts, w);
+            let b = fr::designed_point(&d, axis, w);
+            assert!(
+                (a.re - b.re).abs() + (a.im - b.im).abs() < 1e-9 * b.re.hypot(b.im),
+                "{a:?} {b:?}"
+            );
+        }
+        within(&fr::model_margins(&gains, &plant, ts), &fr::designed_margins(&d, axis)).unwrap();
+    }
 }
