@@ -45,6 +45,7 @@ use super::candump;
 use super::commission::{self, FrameBus};
 use super::error::{Error, Problem};
 use super::identify::Input;
+use super::writeback;
 use codegen::design::current_loop::analysis::{self, AxisGains};
 use codegen::design::current_loop::discrete;
 use motor_control::commissioning::{Axis, Lines, multisine_lines};
@@ -302,6 +303,13 @@ pub struct Measurement {
     pub duration_s: f64,
     /// (file name, CSV recording) of the capture.
     pub csv: (String, String),
+    /// The plant fitted to the measured points, from the design's.
+    pub fit: Fit,
+    /// The design's plant of the axis (R, L, loop delay).
+    pub design_plant: PlantModel,
+    /// The largest bandwidth whose loop, designed by the spec's method for the fitted
+    /// plant, meets the margin floors on it ([`retune`]) [rad/s].
+    pub retune_rad_s: Option<f64>,
 }
 
 fn bad_option(option: &str, problem: String, accepted: &str) -> Error {
@@ -478,7 +486,13 @@ impl Plan {
             self.spec_stem,
             commission::stamp(t)
         );
+        let gains = axis_gains(d, o.axis).loop_gains();
+        let design_plant = SimScale::default().plant_of(d, o.axis);
+        let fit = fit_plant(&points, &gains, ts, &design_plant);
         Ok(Measurement {
+            retune_rad_s: retune(d, o.axis, &fit.plant),
+            fit,
+            design_plant,
             axis: o.axis,
             measured: margins(&points),
             designed: designed_margins(d, o.axis),
@@ -505,6 +519,18 @@ fn json_margins(m: &Margins) -> String {
         json_number(m.gain_margin_db),
         json_number(m.phase_margin_deg),
         json_number(m.crossover_rad_s)
+    )
+}
+
+fn json_plant(p: &PlantModel, determined: Option<bool>) -> String {
+    let r = match determined {
+        Some(false) => "null".to_string(),
+        _ => json_number(Some(p.resistance_ohm)),
+    };
+    format!(
+        "{{\"resistance_ohm\": {r}, \"inductance_h\": {}, \"delay_periods\": {}}}",
+        json_number(Some(p.inductance_h)),
+        json_number(Some(p.delay_periods))
     )
 }
 
@@ -535,9 +561,12 @@ impl Measurement {
             })
             .collect();
         format!(
-            "{{\n  \"axis\": \"{axis}\",\n  \"measured\": {},\n  \"designed\": {},\n  \"amplitude_v\": {},\n  \"trip_a\": {},\n  \"duration_s\": {},\n  \"points\": [\n{}\n  ]\n}}\n",
+            "{{\n  \"axis\": \"{axis}\",\n  \"measured\": {},\n  \"designed\": {},\n  \"fitted_plant\": {},\n  \"designed_plant\": {},\n  \"retune_bandwidth_rad_s\": {},\n  \"amplitude_v\": {},\n  \"trip_a\": {},\n  \"duration_s\": {},\n  \"points\": [\n{}\n  ]\n}}\n",
             json_margins(&self.measured),
             json_margins(&self.designed),
+            json_plant(&self.fit.plant, Some(self.fit.resistance_determined)),
+            json_plant(&self.design_plant, None),
+            json_number(self.retune_rad_s),
             json_number(Some(self.amplitude_v)),
             json_number(Some(self.trip_a)),
             json_number(Some(self.duration_s)),
@@ -840,5 +869,151 @@ impl SimScale {
         plant.motor.lq *= self.lq;
         plant.motor.q_saturation.iter_mut().for_each(|(_, l)| *l *= self.lq);
         plant.extra_delay = (self.delay * design_delay - BENCH_DELAY_PERIODS).max(0.0);
+    }
+}
+
+// ---------------------------------------------------------------------------------
+// What to change: the retune and the values for the spec
+// ---------------------------------------------------------------------------------
+
+/// The phase and gain margins of `g` on `plant` meet the design's floors
+/// (`analysis::MIN_PHASE_MARGIN_DEG`, `analysis::MIN_GAIN_MARGIN_DB`).
+fn meets_floors(g: &discrete::LoopGains, plant: &PlantModel, ts: f64) -> bool {
+    let m = model_margins(g, plant, ts);
+    m.phase_margin_deg
+        .is_some_and(|pm| pm >= analysis::MIN_PHASE_MARGIN_DEG)
+        && m.gain_margin_db.is_none_or(|gm| gm >= analysis::MIN_GAIN_MARGIN_DB)
+}
+
+/// The retune: the largest bandwidth α whose gains, designed by the spec's method (and
+/// delay compensation) for the fitted R and L, meet the margin floors on the fitted
+/// plant with its delay. Scanned on 48 logarithmic steps from α/100 to 0.5/T_s, then
+/// refined by bisection between the last step that meets the floors and the next;
+/// `None` when none does.
+pub fn retune(d: &Design, axis: Axis, plant: &PlantModel) -> Option<f64> {
+    let req = d.current_loop_request(axis);
+    let ts = req.sample_period_s;
+    let ok = |alpha: f64| {
+        let r = codegen::design::current_loop::Request {
+            resistance_ohm: plant.resistance_ohm,
+            inductance_h: plant.inductance_h,
+            ..req.at_bandwidth(alpha)
+        };
+        codegen::design::current_loop::design(&r).is_ok_and(|g| meets_floors(&g.loop_gains(), plant, ts))
+    };
+    let (lo, hi) = ((req.bandwidth_rad_s / 100.0).ln(), (0.5 / ts).ln());
+    let steps = 48;
+    let at = |k: usize| (lo + (hi - lo) * k as f64 / steps as f64).exp();
+    let last = (0..=steps).rev().find(|&k| ok(at(k)))?;
+    if last == steps {
+        return Some(at(steps));
+    }
+    let (mut a, mut b) = (at(last), at(last + 1));
+    for _ in 0..20 {
+        let m = (a * b).sqrt();
+        if ok(m) { a = m } else { b = m }
+    }
+    Some(a)
+}
+
+impl Measurement {
+    /// What the measurement says, one line each: measured against designed margins; the
+    /// fitted plant against the design's, the values off by more than 5 % named; the
+    /// retune.
+    pub fn summary(&self) -> String {
+        let f = |x: Option<f64>, unit: &str| x.map_or_else(|| "not measured".into(), |v| format!("{v:.2}{unit}"));
+        let axis = match self.axis {
+            Axis::D => "d",
+            Axis::Q => "q",
+        };
+        let (m, d) = (&self.measured, &self.designed);
+        let mut out = format!(
+            "{axis} axis: gain margin {} (designed {}), phase margin {} (designed {}), crossover {} (designed {})\n",
+            f(m.gain_margin_db, " dB"),
+            f(d.gain_margin_db, " dB"),
+            f(m.phase_margin_deg, "°"),
+            f(d.phase_margin_deg, "°"),
+            f(m.crossover_rad_s, " rad/s"),
+            f(d.crossover_rad_s, " rad/s"),
+        );
+        let (p, q) = (&self.fit.plant, &self.design_plant);
+        let pct = |a: f64, b: f64| 100.0 * (a / b - 1.0);
+        let r = if self.fit.resistance_determined {
+            format!(
+                "R {:.4} Ω ({:+.1} %)",
+                p.resistance_ohm,
+                pct(p.resistance_ohm, q.resistance_ohm)
+            )
+        } else {
+            "R not determined (the lines lie far above R/L)".into()
+        };
+        out.push_str(&format!(
+            "fitted plant: {r}, L_{axis} {:.4} mH ({:+.1} %), loop delay {:.3} periods ({:+.1} %); rms fit error {:.2} %\n",
+            p.inductance_h * 1e3,
+            pct(p.inductance_h, q.inductance_h),
+            p.delay_periods,
+            pct(p.delay_periods, q.delay_periods),
+            100.0 * self.fit.rms_relative_error
+        ));
+        let mut off = vec![];
+        if self.fit.resistance_determined && pct(p.resistance_ohm, q.resistance_ohm).abs() > 5.0 {
+            off.push(format!(
+                "R is {:+.1} % off the spec",
+                pct(p.resistance_ohm, q.resistance_ohm)
+            ));
+        }
+        if pct(p.inductance_h, q.inductance_h).abs() > 5.0 {
+            off.push(format!(
+                "L_{axis} is {:+.1} % off the spec",
+                pct(p.inductance_h, q.inductance_h)
+            ));
+        }
+        if pct(p.delay_periods, q.delay_periods).abs() > 5.0 {
+            off.push(format!(
+                "the loop delay is {:+.1} % off the design's (the board's timing)",
+                pct(p.delay_periods, q.delay_periods)
+            ));
+        }
+        out.push_str(&if off.is_empty() {
+            "the design's plant holds (R, L and delay within 5 %)\n".to_string()
+        } else {
+            format!("{}\n", off.join("; "))
+        });
+        out.push_str(&match self.retune_rad_s {
+            Some(a) => format!(
+                "retune: current_loop.bandwidth up to {a:.0} rad/s meets the margin floors on the measured plant\n"
+            ),
+            None => "retune: no bandwidth meets the margin floors on the measured plant\n".into(),
+        });
+        out
+    }
+
+    /// The values for `[motor.identified]` (`--write`): the axis's L, and R when the
+    /// points determine it.
+    pub fn entries(&self) -> Vec<writeback::Entry> {
+        let p = &self.fit.plant;
+        let (axis, key) = match self.axis {
+            Axis::D => ("d", "d_inductance"),
+            Axis::Q => ("q", "q_inductance"),
+        };
+        let note = format!(
+            "fitted to the {axis}-axis frequency response (loop delay {:.3} periods, rms error {:.2} %)",
+            p.delay_periods,
+            100.0 * self.fit.rms_relative_error
+        );
+        let mut e = vec![];
+        if self.fit.resistance_determined {
+            e.push(writeback::Entry {
+                key: "phase_resistance",
+                value: writeback::ohms(p.resistance_ohm),
+                note: note.clone(),
+            });
+        }
+        e.push(writeback::Entry {
+            key,
+            value: writeback::henries(p.inductance_h),
+            note,
+        });
+        e
     }
 }

@@ -186,3 +186,22 @@ fn the_model_at_the_design_delay_is_the_designs_loop() {
         within(&fr::model_margins(&gains, &plant, ts), &fr::designed_margins(&d, axis)).unwrap();
     }
 }
+
+/// The retune on the design's own plant names at least the designed bandwidth (the
+/// design meets the floors there; its bandwidth may be lower for the at-speed figures),
+/// and a longer loop delay lowers it.
+#[test]
+fn retune_follows_the_measured_plant() {
+    let (_, d, _) = motor("chalmers-hev50");
+    let alpha = d.current_loop.bandwidth_rad_s;
+    let own = SimScale::default().plant_of(&d, Axis::D);
+    let a_own = fr::retune(&d, Axis::D, &own).unwrap();
+    let late = fr::PlantModel {
+        delay_periods: 1.5 * own.delay_periods,
+        ..own
+    };
+    let a_late = fr::retune(&d, Axis::D, &late).unwrap();
+    println!("chalmers-hev50 d: α = {alpha}, retune {a_own:.0} (design plant), {a_late:.0} (delay × 1.5)");
+    assert!(a_own >= alpha, "{a_own} < {alpha}");
+    assert!(a_late < a_own, "{a_late} ≥ {a_own}");
+}
