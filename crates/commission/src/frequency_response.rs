@@ -887,9 +887,10 @@ fn meets_floors(g: &discrete::LoopGains, plant: &PlantModel, ts: f64) -> bool {
 
 /// The retune: the largest bandwidth α whose gains, designed by the spec's method (and
 /// delay compensation) for the fitted R and L, meet the margin floors on the fitted
-/// plant with its delay. Scanned on 48 logarithmic steps from α/100 to 0.5/T_s, then
-/// refined by bisection between the last step that meets the floors and the next;
-/// `None` when none does.
+/// plant with its delay. Scanned on 48 logarithmic steps from α/100 to a quarter of the
+/// sampling frequency π/(2·T_s), then refined by bisection between the last step that
+/// meets the floors and the next; `None` when none does (the top of the scan when all
+/// do).
 pub fn retune(d: &Design, axis: Axis, plant: &PlantModel) -> Option<f64> {
     let req = d.current_loop_request(axis);
     let ts = req.sample_period_s;
@@ -901,7 +902,7 @@ pub fn retune(d: &Design, axis: Axis, plant: &PlantModel) -> Option<f64> {
         };
         codegen::design::current_loop::design(&r).is_ok_and(|g| meets_floors(&g.loop_gains(), plant, ts))
     };
-    let (lo, hi) = ((req.bandwidth_rad_s / 100.0).ln(), (0.5 / ts).ln());
+    let (lo, hi) = ((req.bandwidth_rad_s / 100.0).ln(), (0.5 * PI / ts).ln());
     let steps = 48;
     let at = |k: usize| (lo + (hi - lo) * k as f64 / steps as f64).exp();
     let last = (0..=steps).rev().find(|&k| ok(at(k)))?;
