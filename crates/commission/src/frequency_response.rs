@@ -671,12 +671,13 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
         }
         a.swap(col, piv);
         b.swap(col, piv);
-        for row in col + 1..3 {
-            let f = a[row][col] / a[col][col];
-            for k in col..3 {
-                a[row][k] -= f * a[col][k];
+        let (pivot, pb) = (a[col], b[col]);
+        for (row, rb) in a.iter_mut().zip(b.iter_mut()).skip(col + 1) {
+            let f = row[col] / pivot[col];
+            for (x, p) in row.iter_mut().zip(pivot).skip(col) {
+                *x -= f * p;
             }
-            b[row] -= f * b[col];
+            *rb -= f * pb;
         }
     }
     let mut x = [0.0; 3];

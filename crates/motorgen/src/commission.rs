@@ -381,7 +381,9 @@ mod tests {
             CommissionArgs {
                 spec: self.spec.clone(),
                 board: repo().join(BOARD),
-                can: "sim0".into(),
+                can: Some("sim0".into()),
+                sim: false,
+                sim_scale: Vec::new(),
                 out: self.dir.path().join("out"),
                 timeout: "60 s".into(),
                 decimation: None,
