@@ -514,7 +514,7 @@ pub fn multisine_lines(first: u16, per_octave: u8, period: u32) -> Option<Lines>
         if let Some(slot) = lines.harmonics.get_mut(lines.count) {
             *slot = u16::try_from(k).unwrap_or(u16::MAX);
         }
-        lines.count += 1;
+        lines.count = lines.count.saturating_add(1);
         let next = k.saturating_mul(ratio).saturating_add(512) >> 10;
         k = next.max(k.saturating_add(1));
     }

@@ -98,7 +98,11 @@ pub const FREQUENCY_RESPONSE_SETTLE_PERIODS: u32 = 1;
 /// sees whole periods; 0 for an empty buffer.
 pub fn frequency_response_period(capacity: usize) -> u32 {
     let c = capacity.min(1 << 15) as u32;
-    if c == 0 { 0 } else { 1 << (31 - c.leading_zeros()) }
+    if c == 0 {
+        0
+    } else {
+        1u32.checked_shl(31u32.saturating_sub(c.leading_zeros())).unwrap_or(0)
+    }
 }
 
 /// What the current-control step gets this period.
@@ -112,6 +116,9 @@ pub enum Control {
     Off,
 }
 
+// The frequency response's oscillators (3·MAX_LINES phasors, 768 B) make its variant the
+// largest; the mode lives in one static of the board and there is no heap to box it in.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Running {
     Step(VoltageStep, VoltageStepState<0>),
@@ -121,6 +128,8 @@ enum Running {
     Frequency(FrequencyResponse, FrequencyResponseState),
 }
 
+// As `Running`: the running routine's state is the largest variant, by design.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Mode {
     Idle,
