@@ -95,7 +95,7 @@ pub enum RoutineArg {
     },
     /// The current loop's frequency response on one axis at standstill (rotor held for
     /// q): margins and crossover against the design, the plant fitted to it, the retune;
-    /// writes DIR/frequency-response-<axis>.json and the capture's CSV.
+    /// writes DIR/frequency-response-d.json (or -q.json) and the capture's CSV.
     FrequencyResponse {
         /// The axis.
         #[arg(long, value_enum)]

@@ -136,7 +136,7 @@ enum Command {
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
         /// A `commission … frequency-response` output directory: its
-        /// frequency-response-<axis>.json are overlaid on the current-loop Bode plots.
+        /// frequency-response-d.json and -q.json are overlaid on the current-loop Bode plots.
         #[arg(long, value_name = "DIR")]
         measured: Option<PathBuf>,
     },
