@@ -90,6 +90,7 @@ pub fn kind_of(r: Routine) -> RecordingKind {
         Routine::ResolverOffset => RecordingKind::ResolverOffset,
         Routine::PolePairRatio => RecordingKind::PolePairRatio,
         Routine::Flux => RecordingKind::Flux,
+        Routine::FrequencyResponse => RecordingKind::FrequencyResponse,
     }
 }
 

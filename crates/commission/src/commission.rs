@@ -375,7 +375,7 @@ pub fn stamp(t: f64) -> String {
 }
 
 /// The failure of a session on `iface`, with the timeout as the user gave it.
-fn session_error(e: SessionError, iface: &str, timeout: &str) -> Error {
+pub fn session_error(e: SessionError, iface: &str, timeout: &str) -> Error {
     let iface = iface.to_string();
     match e {
         SessionError::Bus(m) => Error::BusUnavailable(Problem::new(

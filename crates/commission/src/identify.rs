@@ -377,8 +377,9 @@ fn blame_identified(e: Diagnostic, old: &str, new: &str, keys: &str) -> Diagnost
     }
 }
 
-/// `entries` written into `spec`, after checking that the new spec designs.
-fn update(spec: &Source<'_>, entries: &[Entry], origin: &Origin<'_>) -> Result<Update, Error> {
+/// `entries` written into `spec`, after checking that the new spec designs (identify's
+/// write-back, and `motorgen commission … frequency-response --write`).
+pub fn update(spec: &Source<'_>, entries: &[Entry], origin: &Origin<'_>) -> Result<Update, Error> {
     let text = spec.text;
     let new = writeback::apply(text, entries, origin).map_err(|r| {
         let at = writeback::value_span(text, &r.path).unwrap_or(0..0);

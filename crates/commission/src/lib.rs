@@ -40,6 +40,7 @@ pub mod candump;
 pub mod commission;
 pub mod error;
 pub mod flux;
+pub mod frequency_response;
 pub mod identify;
 pub mod recording;
 pub mod resolver;

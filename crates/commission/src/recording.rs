@@ -50,6 +50,9 @@ pub enum RecordingKind {
     ResolverOffset,
     /// Open-loop rotation (§6.4).
     PolePairRatio,
+    /// The current loop broken at the controller's output: u_PI and v = u_PI + d of the
+    /// injected axis over one multisine period (`crate::frequency_response`).
+    FrequencyResponse,
 }
 
 impl RecordingKind {
@@ -60,6 +63,7 @@ impl RecordingKind {
             RecordingKind::Flux => "flux",
             RecordingKind::ResolverOffset => "resolver_offset",
             RecordingKind::PolePairRatio => "pole_pair_ratio",
+            RecordingKind::FrequencyResponse => "frequency_response",
         }
     }
 
@@ -70,6 +74,7 @@ impl RecordingKind {
             RecordingKind::Flux => &["omega_e_rad_s", "u_q_v"],
             RecordingKind::ResolverOffset => &["u_alpha_v", "theta_r_rad"],
             RecordingKind::PolePairRatio => &["theta_e_rad", "theta_r_rad"],
+            RecordingKind::FrequencyResponse => &["u_pi_v", "v_v"],
         }
     }
 

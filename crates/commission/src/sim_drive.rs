@@ -98,6 +98,7 @@ impl SimulatedDrive {
                 theta_r: o.theta_r,
                 omega_e: o.omega_e,
                 u_q: o.u_dq.q,
+                u_d: o.u_dq.d,
             };
         }
         // The status frame has the slot at its period, as on the board.

@@ -12,11 +12,13 @@ use std::path::PathBuf;
 
 use clap::{Args, Subcommand};
 use motor_commission::commission::{self, FrameBus, Options, Plan, RoutineOptions};
+use motor_commission::frequency_response as fr;
+use motor_commission::sim_drive::SimulatedDrive;
 
 use crate::atomic;
 use crate::exit::{Exit, Failure};
 use crate::identify::AxisArg;
-use crate::output::outln;
+use crate::output::{out, outln};
 
 /// `motorgen commission`'s options.
 #[derive(Args)]
@@ -29,8 +31,16 @@ pub struct CommissionArgs {
     #[arg(long, value_name = "BOARD_FILE")]
     pub board: PathBuf,
     /// The SocketCAN interface the drive is on, up at the board's bit rate (Linux).
-    #[arg(long, value_name = "IFACE")]
-    pub can: String,
+    #[arg(long, value_name = "IFACE", required_unless_present = "sim", conflicts_with = "sim")]
+    pub can: Option<String>,
+    /// Run the session against the simulated drive instead of a bus: the firmware's
+    /// commissioning mode and control step on `verify`'s motor simulation, rotor held.
+    #[arg(long, global = true)]
+    pub sim: bool,
+    /// With `--sim`: a factor on the simulated plant, KEY=FACTOR with KEY one of R, Ld,
+    /// Lq, delay (repeatable), e.g. `--sim-scale Lq=0.7`.
+    #[arg(long, value_name = "KEY=FACTOR", global = true)]
+    pub sim_scale: Vec<String>,
     /// Directory for the CSV recording of the capture (created if missing).
     #[arg(long, value_name = "DIR")]
     pub out: PathBuf,
@@ -83,12 +93,37 @@ pub enum RoutineArg {
         #[arg(long)]
         voltage: String,
     },
+    /// The current loop's frequency response on one axis at standstill (rotor held for
+    /// q): margins and crossover against the design, the plant fitted to it, the retune;
+    /// writes DIR/frequency-response-d.json (or -q.json) and the capture's CSV.
+    FrequencyResponse {
+        /// The axis.
+        #[arg(long, value_enum)]
+        axis: AxisArg,
+        /// Peak of the injected multisine, e.g. "5 V" (default: 5 % of U_dc/√3).
+        #[arg(long)]
+        amplitude: Option<String>,
+        /// The lines, FIRST/PER_OCTAVE: the first harmonic of the capture period and the
+        /// lines per octave up to the Nyquist frequency, e.g. "4/3" (default: two octaves
+        /// below the designed crossover, as many per octave as 32 lines allow).
+        #[arg(long)]
+        frequencies: Option<String>,
+        /// Write the fitted L (and R, where the lines determine it) into the spec's
+        /// `[motor.identified]`.
+        #[arg(long)]
+        write: bool,
+    },
+}
+
+/// The interface's name in messages and logs: `--can`'s, or `sim` for `--sim`.
+fn iface(a: &CommissionArgs) -> String {
+    a.can.clone().unwrap_or_else(|| "sim".into())
 }
 
 /// The library's options of `a`.
 fn options(a: &CommissionArgs) -> Options {
     Options {
-        iface: a.can.clone(),
+        iface: iface(a),
         timeout: a.timeout.clone(),
         decimation: a.decimation,
         date: a.date.clone(),
@@ -105,16 +140,161 @@ fn options(a: &CommissionArgs) -> Options {
             RoutineArg::PolePairRatio { voltage } => RoutineOptions::PolePairRatio {
                 voltage: voltage.clone(),
             },
+            // Planned by `frequency_response::plan` (`run` takes that path first).
+            RoutineArg::FrequencyResponse { axis, .. } => RoutineOptions::Step {
+                axis: (*axis).into(),
+                voltage: String::new(),
+                trip: String::new(),
+            },
         },
     }
 }
 
 /// `motorgen commission`.
 pub fn run(a: &CommissionArgs) -> Result<(), Failure> {
+    if a.can.is_some() && !a.sim_scale.is_empty() {
+        return Err(motor_commission::Error::Option(motor_commission::Problem::new(
+            "--sim-scale",
+            "perturbs the simulated plant, and the session runs on a bus (--can)",
+            "--sim-scale with --sim",
+        ))
+        .into());
+    }
+    if let RoutineArg::FrequencyResponse {
+        axis,
+        amplitude,
+        frequencies,
+        write,
+    } = &a.routine
+    {
+        let o = fr::Options {
+            iface: iface(a),
+            timeout: a.timeout.clone(),
+            axis: (*axis).into(),
+            amplitude: amplitude.clone(),
+            frequencies: frequencies.clone(),
+        };
+        return frequency_response(a, &o, *write);
+    }
     // Everything that does not need the bus is checked first.
     let plan = plan(a)?;
-    let mut bus = motor_commission::socket::open(&a.can, plan.bit_rate)?;
-    run_planned(&mut bus, a, &plan)
+    match &a.can {
+        Some(can) => {
+            let mut bus = motor_commission::socket::open(can, plan.bit_rate)?;
+            run_planned(&mut bus, a, &plan)
+        }
+        None => {
+            let (design, spec) = sim_design(a)?;
+            let mut drive = sim_drive(a, &design, &spec)?;
+            run_planned(&mut drive, a, &plan)
+        }
+    }
+}
+
+/// The design of `a`'s spec on its board and the parsed spec (for the simulated drive).
+fn sim_design(a: &CommissionArgs) -> Result<(codegen::Design, codegen::spec::Spec), Failure> {
+    let spec = crate::read_input(&a.spec);
+    let board = crate::read_board_input(&a.board);
+    let (spec_text, board_text) = (spec.text()?, board.text()?);
+    let design = codegen::design_with_board(&spec.name, spec_text, &board.name, board_text)
+        .map_err(motor_commission::Error::from)?;
+    let parsed = codegen::spec::parse(codegen::Source {
+        file: &spec.name,
+        text: spec_text,
+    })
+    .map_err(motor_commission::Error::from)?;
+    Ok((design, parsed))
+}
+
+/// The simulated drive of `design` (`--sim`): the firmware's commissioning mode on
+/// `verify`'s bench at standstill, the plant perturbed by `--sim-scale`.
+fn sim_drive(
+    a: &CommissionArgs,
+    design: &codegen::Design,
+    spec: &codegen::spec::Spec,
+) -> Result<SimulatedDrive, Failure> {
+    let req = design.current_loop_request(motor_control::commissioning::Axis::D);
+    let delay = req.loop_delay_s / req.sample_period_s;
+    let scale = fr::SimScale::parse(&a.sim_scale, delay)?;
+    let setup = motor_verify::Setup::new(spec, design);
+    let mut bench = setup.bench(0.0);
+    scale.apply(&mut bench.plant, delay);
+    SimulatedDrive::new(design, bench, 0.0).ok_or_else(|| {
+        Failure::from(motor_commission::Error::Option(motor_commission::Problem::new(
+            "--board",
+            "the design has no CAN interface",
+            "a board file with a [can] section",
+        )))
+    })
+}
+
+/// `commission … frequency-response`: the session (on the bus or the simulated drive),
+/// the JSON and CSV into `--out`, the summary, and with `--write` the fitted values into
+/// the spec.
+fn frequency_response(a: &CommissionArgs, o: &fr::Options, write: bool) -> Result<(), Failure> {
+    atomic::check_out_dir(&a.out).map_err(|e| Failure::new(Exit::BadInput, e))?;
+    let spec = crate::read_input(&a.spec);
+    let board = crate::read_board_input(&a.board);
+    let plan = fr::plan(o, &spec, &board)?;
+    let m = match &a.can {
+        Some(can) => {
+            let mut bus = motor_commission::socket::open(can, plan.bit_rate)?;
+            plan.run(&mut bus)?
+        }
+        None => {
+            let (design, parsed) = sim_design(a)?;
+            let mut drive = sim_drive(a, &design, &parsed)?;
+            plan.run(&mut drive)?
+        }
+    };
+    let axis = match o.axis {
+        motor_control::commissioning::Axis::D => "d",
+        motor_control::commissioning::Axis::Q => "q",
+    };
+    let files = vec![
+        (
+            a.out.join(format!("frequency-response-{axis}.json")),
+            m.to_json().into_bytes(),
+        ),
+        (a.out.join(&m.csv.0), m.csv.1.clone().into_bytes()),
+    ];
+    let written = atomic::write_set(&a.out, &files)?;
+    for ((path, _), w) in files.iter().zip(written) {
+        outln!("{} {}", if w { "wrote" } else { "unchanged" }, path.display());
+    }
+    out!("{}", m.summary());
+    if write {
+        write_fitted(&a.spec, &m, &o.iface)?;
+    }
+    Ok(())
+}
+
+/// The fitted values into the spec's `[motor.identified]` (under the spec lock).
+fn write_fitted(spec: &std::path::Path, m: &fr::Measurement, iface: &str) -> Result<(), Failure> {
+    let mut lock = crate::atomic::LockedSpec::open(spec)?;
+    let name = spec.display().to_string();
+    let text = motor_commission::Input::from_bytes(name.clone(), std::mem::take(&mut lock.bytes))
+        .text?
+        .to_string();
+    let date = crate::identify::today();
+    let label = format!("frequency response {iface}");
+    let files = vec![m.csv.0.clone()];
+    let entries = m.entries();
+    let source = codegen::Source {
+        file: &name,
+        text: &text,
+    };
+    let origin = motor_commission::writeback::Origin {
+        date: &date,
+        label: &label,
+        files: &files,
+    };
+    // The updated spec must still design (as identify's write-back checks).
+    let new = motor_commission::identify::update(&source, &entries, &origin)?.text;
+    lock.replace(new.as_bytes())?;
+    let keys: Vec<&str> = entries.iter().map(|e| e.key).collect();
+    outln!("wrote [motor.identified] {} to {name}", keys.join(", "));
+    Ok(())
 }
 
 /// `--out` a directory, then the library's checks of the options, spec and board.
@@ -201,7 +381,9 @@ mod tests {
             CommissionArgs {
                 spec: self.spec.clone(),
                 board: repo().join(BOARD),
-                can: "sim0".into(),
+                can: Some("sim0".into()),
+                sim: false,
+                sim_scale: Vec::new(),
                 out: self.dir.path().join("out"),
                 timeout: "60 s".into(),
                 decimation: None,

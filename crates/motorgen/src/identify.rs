@@ -194,7 +194,7 @@ pub fn run(what: What) -> Result<(), Failure> {
 }
 
 /// Today (UTC) as YYYY-MM-DD.
-fn today() -> String {
+pub(crate) fn today() -> String {
     let secs = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| d.as_secs());

@@ -135,6 +135,10 @@ enum Command {
         /// Output directory (created if missing).
         #[arg(long, value_name = "DIR")]
         out: PathBuf,
+        /// A `commission … frequency-response` output directory: its
+        /// frequency-response-d.json and -q.json are overlaid on the current-loop Bode plots.
+        #[arg(long, value_name = "DIR")]
+        measured: Option<PathBuf>,
     },
     /// Identify R, L, ψ_M or the resolver offset from recorded commissioning runs
     /// (thesis A chapter 6) and write them into the spec's [motor.identified].
@@ -498,7 +502,7 @@ fn run(command: Command) -> Result<(), Failure> {
         Command::Verify { spec, board, format } => {
             verify::run(&locate(spec, "motors"), locate_board(board).as_deref(), format)
         }
-        Command::Report { spec, out } => report::run(&spec, &out),
+        Command::Report { spec, out, measured } => report::run(&spec, &out, measured.as_deref()),
         Command::Identify { what } => identify::run(what),
         Command::Capture {
             spec,

@@ -192,6 +192,12 @@ pub struct Plant {
     pub dc_link: f64,
     /// Duties loaded for the next period (computed at the previous sample); `None` = gates off.
     pub pending: Option<[f32; 3]>,
+    /// Extra loop delay as a fraction of T_s in [0, 1) (`motorgen commission --sim-scale
+    /// delay=…`): the pending duties act only after this part of the period, the
+    /// previous period's before; 0 is the bench's timing of thesis A §4.6.
+    pub extra_delay: f64,
+    /// The duties of the previous period (for [`Plant::extra_delay`]).
+    pub previous: Option<[f32; 3]>,
 }
 
 impl Plant {
@@ -210,6 +216,8 @@ impl Plant {
             theta_m: 0.0,
             dc_link,
             pending: None,
+            extra_delay: 0.0,
+            previous: None,
         }
     }
 
@@ -262,16 +270,26 @@ impl Plant {
     /// as long as the back EMF stays below U_dc; the rotor keeps turning).
     pub fn advance(&mut self) {
         let np = f64::from(self.motor.pole_pairs);
-        let u_ab = self.pending.map(|d| {
-            let ph = d.map(|x| (f64::from(x) - 0.5) * self.dc_link);
-            let k = 3f64.sqrt() / 2.0;
-            // Amplitude-invariant Clarke (thesis A (2.7)); the common mode drops out.
-            [
-                2.0 / 3.0 * (ph[0] - 0.5 * ph[1] - 0.5 * ph[2]),
-                2.0 / 3.0 * k * (ph[1] - ph[2]),
-            ]
-        });
-        if u_ab.is_none() {
+        let to_ab = |d: Option<[f32; 3]>| {
+            d.map(|d| {
+                let ph = d.map(|x| (f64::from(x) - 0.5) * self.dc_link);
+                let k = 3f64.sqrt() / 2.0;
+                // Amplitude-invariant Clarke (thesis A (2.7)); the common mode drops out.
+                [
+                    2.0 / 3.0 * (ph[0] - 0.5 * ph[1] - 0.5 * ph[2]),
+                    2.0 / 3.0 * k * (ph[1] - ph[2]),
+                ]
+            })
+        };
+        let u_ab = to_ab(self.pending);
+        let delay = if self.extra_delay > 0.0 && self.extra_delay < 1.0 {
+            self.extra_delay
+        } else {
+            0.0
+        };
+        let u_before = to_ab(self.previous);
+        self.previous = self.pending;
+        if u_ab.is_none() && (delay == 0.0 || u_before.is_none()) {
             self.i = [0.0, 0.0];
             if let Shaft::Imposed(p) = self.shaft {
                 // θ_m integrates the piecewise-linear speed exactly (Simpson's rule).
@@ -282,7 +300,7 @@ impl Plant {
             }
         }
         // State [i_d, i_q, θ_m, ω_m]; ω_m is a state only for the free shaft.
-        let f = |t: f64, s: [f64; 4]| -> [f64; 4] {
+        let f = |t: f64, s: [f64; 4], u_ab: Option<[f64; 2]>| -> [f64; 4] {
             let (wm, dw) = match self.shaft {
                 Shaft::Imposed(p) => (p.at(t), 0.0),
                 Shaft::Free { inertia, damping, .. } => (s[3], (self.torque([s[0], s[1]]) - damping * s[3]) / inertia),
@@ -300,18 +318,27 @@ impl Plant {
         };
         let add =
             |a: [f64; 4], b: [f64; 4], k: f64| [a[0] + k * b[0], a[1] + k * b[1], a[2] + k * b[2], a[3] + k * b[3]];
-        let h = self.ts / SUBSTEPS as f64;
-        let mut s = [self.i[0], self.i[1], self.theta_m, self.omega_m()];
-        let mut t = self.t;
-        for _ in 0..SUBSTEPS {
-            let k1 = f(t, s);
-            let k2 = f(t + h / 2.0, add(s, k1, h / 2.0));
-            let k3 = f(t + h / 2.0, add(s, k2, h / 2.0));
-            let k4 = f(t + h, add(s, k3, h));
-            for j in 0..4 {
-                s[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+        // RK4 on SUBSTEPS sub-steps over `length` from (t, s) with the voltage `u`.
+        let segment = |mut t: f64, mut s: [f64; 4], length: f64, u: Option<[f64; 2]>| {
+            let h = length / SUBSTEPS as f64;
+            for _ in 0..SUBSTEPS {
+                let k1 = f(t, s, u);
+                let k2 = f(t + h / 2.0, add(s, k1, h / 2.0), u);
+                let k3 = f(t + h / 2.0, add(s, k2, h / 2.0), u);
+                let k4 = f(t + h, add(s, k3, h), u);
+                for j in 0..4 {
+                    s[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
+                }
+                t += h;
             }
-            t += h;
+            s
+        };
+        let mut s = [self.i[0], self.i[1], self.theta_m, self.omega_m()];
+        if delay > 0.0 {
+            s = segment(self.t, s, delay * self.ts, u_before);
+            s = segment(self.t + delay * self.ts, s, (1.0 - delay) * self.ts, u_ab);
+        } else {
+            s = segment(self.t, s, self.ts, u_ab);
         }
         self.i = [s[0], s[1]];
         self.theta_m = s[2];

@@ -105,15 +105,21 @@ pub enum Routine {
     PolePairRatio = 3,
     /// ψ_M at zero current (§6.5): channels ω_e \[rad/s\], u_q \[V\].
     Flux = 4,
+    /// The current loop's frequency response (loop-breaking multisine,
+    /// [`crate::commissioning::FrequencyResponse`]): channels u_PI \[V\], v = u_PI + d \[V\]
+    /// of the injected axis. The command's decimation bytes carry the line set: byte 6 the
+    /// first harmonic, byte 7 the lines per octave (the capture is never decimated).
+    FrequencyResponse = 5,
 }
 
 impl Routine {
     /// All routines, in code order.
-    pub const ALL: [Routine; 4] = [
+    pub const ALL: [Routine; 5] = [
         Routine::Step,
         Routine::ResolverOffset,
         Routine::PolePairRatio,
         Routine::Flux,
+        Routine::FrequencyResponse,
     ];
 
     /// The routine with bus code `code`.
@@ -123,6 +129,7 @@ impl Routine {
             2 => Some(Routine::ResolverOffset),
             3 => Some(Routine::PolePairRatio),
             4 => Some(Routine::Flux),
+            5 => Some(Routine::FrequencyResponse),
             _ => None,
         }
     }
@@ -139,6 +146,7 @@ impl Routine {
             Routine::ResolverOffset => [Quantity::Voltage, Quantity::Angle],
             Routine::PolePairRatio => [Quantity::Angle, Quantity::Angle],
             Routine::Flux => [Quantity::Speed, Quantity::Voltage],
+            Routine::FrequencyResponse => [Quantity::Voltage, Quantity::Voltage],
         }
     }
 }
@@ -280,7 +288,7 @@ pub fn encode_status(layout: &Layout, state: State, reason: Reason, routine: u8,
 pub struct Command {
     /// Requested routine (`None`: abort / unknown code).
     pub routine: Option<Routine>,
-    /// Axis of a step: 0 d, 1 q.
+    /// Axis of a step or a frequency response: 0 d, 1 q.
     pub axis_q: bool,
     /// Voltage of the step or alignment \[V\].
     pub voltage: f32,

@@ -11,6 +11,9 @@
 //! 3. [`PolePairRatio`]: rotate the stator field open loop by whole electrical turns and
 //!    compare with the resolver angle travelled: n_p/n_r and direction (§6.4).
 //! 4. [`FluxLinkage`]: at zero current and steady speed, ψ_M ≈ u_q/ω_e (6.10).
+//! 5. [`FrequencyResponse`]: the current loop broken at the controller's output
+//!    (v = u_PI + d, d a periodic multisine) at standstill; u_PI and v captured so that
+//!    the host reads the open-loop response L(jω) = −U_PI(jω)/V(jω) at every line.
 
 use crate::step::Demand;
 use crate::transforms::{AlphaBeta, Dq};
@@ -465,6 +468,226 @@ impl FluxLinkage {
     }
 }
 
+// ---------------------------------------------------------------------------------
+// 5. Current-loop frequency response (loop-breaking injection)
+// ---------------------------------------------------------------------------------
+
+/// Largest number of lines of the multisine ([`multisine_lines`]).
+pub const MAX_LINES: usize = 32;
+
+/// Lines-per-octave ratios 2^(1/r) in Q10 (round(1024·2^(1/r)), r = 1…8): integer, so
+/// the drive and the host compute the same harmonic numbers.
+const OCTAVE_RATIO_Q10: [u32; 8] = [2048, 1448, 1290, 1218, 1176, 1149, 1131, 1117];
+
+/// The harmonics of a multisine: line `j` is at k_j/(N·T_s).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Lines {
+    /// Harmonic numbers k_j of the period N, increasing; the first `count` are used.
+    pub harmonics: [u16; MAX_LINES],
+    /// Number of lines.
+    pub count: usize,
+}
+
+impl Lines {
+    /// The harmonic numbers in use.
+    pub fn used(&self) -> &[u16] {
+        self.harmonics.get(..self.count).unwrap_or(&[])
+    }
+}
+
+/// The log-spaced harmonics of a period of `period` samples: from `first` (≥ 1), each
+/// the previous times 2^(1/`per_octave`) rounded (at least the next harmonic), below the
+/// Nyquist harmonic `period`/2, at most [`MAX_LINES`]. `None` when `first` is 0 or not
+/// below `period`/2, or `per_octave` is outside 1–8.
+pub fn multisine_lines(first: u16, per_octave: u8, period: u32) -> Option<Lines> {
+    let ratio = *OCTAVE_RATIO_Q10.get(usize::from(per_octave).checked_sub(1)?)?;
+    let nyquist = period / 2;
+    if first == 0 || u32::from(first) >= nyquist {
+        return None;
+    }
+    let mut lines = Lines {
+        harmonics: [0; MAX_LINES],
+        count: 0,
+    };
+    let mut k = u32::from(first);
+    while k < nyquist && lines.count < MAX_LINES {
+        if let Some(slot) = lines.harmonics.get_mut(lines.count) {
+            *slot = u16::try_from(k).unwrap_or(u16::MAX);
+        }
+        lines.count = lines.count.saturating_add(1);
+        let next = k.saturating_mul(ratio).saturating_add(512) >> 10;
+        k = next.max(k.saturating_add(1));
+    }
+    Some(lines)
+}
+
+/// Schroeder's phase of line `j` of `count` (φ_j = −π·j·(j + 1)/count, Schroeder 1970,
+/// "Synthesis of low-peak-factor signals"): a low crest factor for equal amplitudes.
+pub fn schroeder_phase(j: usize, count: usize) -> f32 {
+    let (j, m) = (j as f32, count.max(1) as f32);
+    -core::f32::consts::PI * j * (j + 1.0) / m
+}
+
+/// Loop-breaking frequency response of one current-loop axis at standstill: both
+/// currents are regulated to zero, and the injection d is added to the axis's
+/// controller output (PI and active damping) after its limit, v = u_PI + d
+/// ([`Demand::Injected`]). d is the multisine Σ a_j·sin(2π·k_j·n/N + φ_j) over the
+/// [`Lines`] ([`FrequencyResponse::line_amplitude`]), clamped to ±`amplitude`; it repeats every N periods exactly (each line's
+/// oscillator restarts from its initial phasor at every period boundary). After
+/// `settle_periods` periods of N, one period of N samples (u_PI, v) is captured.
+///
+/// On the q axis the rotor must be held (the injected current makes torque); on the d
+/// axis at the resolver's angle the current makes none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrequencyResponse {
+    /// Injected axis.
+    pub axis: Axis,
+    /// Peak of the injection \[V\] (d is clamped to it).
+    pub amplitude: f32,
+    /// Trip level on |i_dq| \[A\].
+    pub current_trip: f32,
+    /// The multisine's period N \[samples\] (the capture length).
+    pub period: u32,
+    /// Periods of N before the captured one (the loop reaching its periodic steady state).
+    pub settle_periods: u32,
+    /// The lines.
+    pub lines: Lines,
+}
+
+/// State of [`FrequencyResponse`]: per line the rotation e^(jω_jT_s), the initial phasor
+/// a·e^(jφ_j) and the running phasor (re, im).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FrequencyResponseState {
+    n: u32,
+    rotation: [(f32, f32); MAX_LINES],
+    initial: [(f32, f32); MAX_LINES],
+    phasor: [(f32, f32); MAX_LINES],
+    /// The injection of the previous period \[V\].
+    last: f32,
+}
+
+/// One captured period: the controller's output u_PI and the applied v = u_PI + d on the
+/// injected axis \[V\].
+pub type LoopSample = (f32, f32);
+
+impl FrequencyResponse {
+    /// The weight of line `j`: w_j = max(1, k_j/(4·k_0)), k_0 the first harmonic. The
+    /// host puts the first line two octaves below the designed crossover, so the lines
+    /// above the crossover grow with frequency as a first-order loop's |L| ≈ ω_c/ω falls:
+    /// each line's u_PI = −L·v stays about the same size, and the gain margin, read
+    /// where |L| is small, is measured with the crossover's resolution (the injected
+    /// current a/|R + jωL| stays about constant there too).
+    pub fn line_weight(&self, j: usize) -> f32 {
+        let first = f32::from(self.lines.harmonics.first().copied().unwrap_or(1).max(1));
+        let k = f32::from(self.lines.harmonics.get(j).copied().unwrap_or(0));
+        (k / (4.0 * first)).max(1.0)
+    }
+
+    /// The amplitude a_j of line `j` for a peak of `amplitude`:
+    /// a_j = amplitude·w_j/√(2·Σw²) (the sum's rms is amplitude/2; with Schroeder's
+    /// phases its peak stays near the amplitude, and the clamp takes the rest).
+    pub fn line_amplitude(&self, j: usize) -> f32 {
+        let mut sum = 0.0f32;
+        for i in 0..self.lines.count {
+            let w = self.line_weight(i);
+            sum += w * w;
+        }
+        self.amplitude * self.line_weight(j) / libm::sqrtf(2.0 * sum.max(1.0))
+    }
+
+    /// Periods the routine runs: (settle + 1)·N + 2 (the capture of period p is taken at
+    /// period p + 1, from the previous control step; one more period to finish).
+    pub fn total_periods(&self) -> u64 {
+        u64::from(self.settle_periods)
+            .saturating_add(1)
+            .saturating_mul(u64::from(self.period))
+            .saturating_add(2)
+    }
+
+    /// The initial state (the oscillators' rotations and phases; libm, once per run).
+    pub fn start(&self) -> FrequencyResponseState {
+        let mut st = FrequencyResponseState {
+            n: 0,
+            rotation: [(1.0, 0.0); MAX_LINES],
+            initial: [(0.0, 0.0); MAX_LINES],
+            phasor: [(0.0, 0.0); MAX_LINES],
+            last: 0.0,
+        };
+        let period = self.period.max(1) as f32;
+        for (j, &k) in self.lines.used().iter().enumerate() {
+            let a = self.line_amplitude(j);
+            let w = 2.0 * core::f32::consts::PI * f32::from(k) / period;
+            let phi = schroeder_phase(j, self.lines.count);
+            if let (Some(r), Some(i)) = (st.rotation.get_mut(j), st.initial.get_mut(j)) {
+                *r = (libm::cosf(w), libm::sinf(w));
+                *i = (a * libm::cosf(phi), a * libm::sinf(phi));
+            }
+        }
+        st
+    }
+
+    /// One period with the measured currents `i_dq` \[A\] and the previous step's
+    /// controller output on the injected axis `u_pi` \[V\]: the demand, and the
+    /// capture of the previous period when it falls in the captured one.
+    pub fn process(
+        &self,
+        st: &mut FrequencyResponseState,
+        i_dq: Dq,
+        u_pi: f32,
+    ) -> (Progress<Result<(), CommissioningError>>, Option<LoopSample>) {
+        let n = st.n;
+        let magnitude = libm::sqrtf(i_dq.d * i_dq.d + i_dq.q * i_dq.q);
+        if magnitude.is_nan() || magnitude > self.current_trip {
+            return (
+                Progress::Finished(Err(CommissioningError::Tripped {
+                    sample: n,
+                    current: magnitude,
+                })),
+                None,
+            );
+        }
+        let period = u64::from(self.period.max(1));
+        let from = u64::from(self.settle_periods).saturating_mul(period);
+        let capture = match u64::from(n).checked_sub(1) {
+            Some(p) if p >= from && p < from.saturating_add(period) => Some((u_pi, u_pi + st.last)),
+            _ => None,
+        };
+        if u64::from(n).saturating_add(1) >= self.total_periods() {
+            return (Progress::Finished(Ok(())), capture);
+        }
+        if u64::from(n).is_multiple_of(period) {
+            st.phasor = st.initial;
+        }
+        let mut sum = 0.0f32;
+        for ((re, im), &(c, s)) in st.phasor.iter_mut().zip(st.rotation.iter()).take(self.lines.count) {
+            sum += *im;
+            let (r, i) = (*re * c - *im * s, *im * c + *re * s);
+            *re = r;
+            *im = i;
+        }
+        // NaN (a NaN amplitude) becomes 0: no injection.
+        let d = if sum.is_nan() {
+            0.0
+        } else {
+            sum.max(-self.amplitude).min(self.amplitude)
+        };
+        st.last = d;
+        st.n = n.saturating_add(1);
+        let injection = match self.axis {
+            Axis::D => Dq { d, q: 0.0 },
+            Axis::Q => Dq { d: 0.0, q: d },
+        };
+        (
+            Progress::Running(Demand::Injected {
+                id: 0.0,
+                iq: 0.0,
+                injection,
+            }),
+            capture,
+        )
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -606,5 +829,73 @@ mod tests {
         // with the field): its travel is read on the 8 rotating periods, the
         // 1 hold period and the final call, 10 × 1/8 turn → ratio 2 turns/1.25 = 1.6.
         assert!((res.ratio - 1.6).abs() < 1e-6, "{}", res.ratio);
+    }
+
+    /// The line set by hand (ratio 1218/1024 for 4 per octave, rounded, at least one
+    /// harmonic up): 1, 2, …, 8, then 8·1.189 = 9.5 → 10, 11.9 → 12, 14.3 → 14,
+    /// 16.7 → 17, 20.2 → 20, 23.8 → 24, 28.5 → 29, and 34.5 is past the Nyquist
+    /// harmonic 32.
+    #[test]
+    fn multisine_lines_by_hand() {
+        let l = multisine_lines(1, 4, 64).expect("valid");
+        assert_eq!(l.used(), [1, 2, 3, 4, 5, 6, 7, 8, 10, 12, 14, 17, 20, 24, 29]);
+        assert_eq!(multisine_lines(0, 4, 64), None);
+        assert_eq!(multisine_lines(32, 4, 64), None);
+        assert_eq!(multisine_lines(1, 0, 64), None);
+        assert_eq!(multisine_lines(1, 9, 64), None);
+        // Capped at MAX_LINES.
+        assert_eq!(multisine_lines(1, 8, 1 << 15).expect("valid").count, MAX_LINES);
+    }
+
+    /// On a static loop u_PI = −0.5·v (no delay: u_PI of period p answers v of period
+    /// p), the capture holds N samples with u = −0.5·v, the injection repeats every N
+    /// periods to the bit and never leaves ±amplitude, and a current above the trip
+    /// ends the run.
+    #[test]
+    fn frequency_response_injects_a_periodic_bounded_multisine() {
+        let r = FrequencyResponse {
+            axis: Axis::Q,
+            amplitude: 2.0,
+            current_trip: 5.0,
+            period: 64,
+            settle_periods: 1,
+            lines: multisine_lines(2, 2, 64).expect("valid"),
+        };
+        let mut st = r.start();
+        let (mut u_pi, mut injected, mut captured) = (0.0f32, vec![], vec![]);
+        loop {
+            let (pr, c) = r.process(&mut st, Dq { d: 0.0, q: 1.0 }, u_pi);
+            captured.extend(c);
+            match pr {
+                Progress::Running(Demand::Injected { id, iq, injection }) => {
+                    assert_eq!((id, iq, injection.d), (0.0, 0.0, 0.0));
+                    assert!(injection.q.abs() <= 2.0);
+                    injected.push(injection.q);
+                    // u_PI = −0.5·(u_PI + d) → u_PI = −d/3.
+                    u_pi = -injection.q / 3.0;
+                }
+                Progress::Running(other) => panic!("{other:?}"),
+                Progress::Finished(done) => {
+                    assert_eq!(done, Ok(()));
+                    break;
+                }
+            }
+        }
+        assert_eq!(injected.len() as u64, r.total_periods() - 1);
+        assert_eq!(injected[..64], injected[64..128]);
+        assert!(injected.iter().any(|d| d.abs() > 0.5));
+        assert_eq!(captured.len(), 64);
+        for (k, (u, v)) in captured.iter().enumerate() {
+            assert!((u + 0.5 * v).abs() < 1e-6, "{k}: {u} {v}");
+            // v − u is d up to the rounding of v = u + d in f32.
+            assert!((*v - *u - injected[64 + k]).abs() < 1e-6);
+        }
+        let mut st = r.start();
+        let (pr, c) = r.process(&mut st, Dq { d: 4.0, q: 4.0 }, 0.0);
+        assert!(matches!(
+            pr,
+            Progress::Finished(Err(CommissioningError::Tripped { sample: 0, .. }))
+        ));
+        assert_eq!(c, None);
     }
 }

@@ -24,8 +24,8 @@
 use crate::angle::to_radians;
 use crate::can_protocol::{self as p, Command, End, Frame, Header, Layout, Reason, Routine, State};
 use crate::commissioning::{
-    Axis, CommissioningError, FluxLinkage, FluxLinkageState, PolePairRatio, PolePairRatioState, Progress,
-    ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState,
+    Axis, CommissioningError, FluxLinkage, FluxLinkageState, FrequencyResponse, FrequencyResponseState, PolePairRatio,
+    PolePairRatioState, Progress, ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState, multisine_lines,
 };
 use crate::step::Demand;
 use crate::transforms::Dq;
@@ -80,8 +80,29 @@ pub struct Measured {
     pub theta_r: i32,
     /// Electrical speed \[rad/s\].
     pub omega_e: f32,
-    /// Applied q voltage \[V\].
+    /// Applied q voltage \[V\] (the controller's output, without a frequency
+    /// response's injection).
     pub u_q: f32,
+    /// Applied d voltage \[V\] (the same).
+    pub u_d: f32,
+}
+
+/// Multisine periods the frequency response runs before the captured one: the loop's
+/// slowest mode (the plant pole R/L a first-order design cancels, at most some 20 ms
+/// for the motors here) has decayed to e⁻¹⁰ after one period of 4096 samples at 20 kHz.
+pub const FREQUENCY_RESPONSE_SETTLE_PERIODS: u32 = 1;
+
+/// The frequency response's multisine period N \[samples\] for a capture buffer of
+/// `capacity` samples: the largest power of two that fits (at most 2¹⁵, the u16
+/// sample count), so the lines are exact harmonics and the FFT-free DFT on the host
+/// sees whole periods; 0 for an empty buffer.
+pub fn frequency_response_period(capacity: usize) -> u32 {
+    let c = capacity.min(1 << 15) as u32;
+    if c == 0 {
+        0
+    } else {
+        1u32.checked_shl(31u32.saturating_sub(c.leading_zeros())).unwrap_or(0)
+    }
 }
 
 /// What the current-control step gets this period.
@@ -95,14 +116,20 @@ pub enum Control {
     Off,
 }
 
+// The frequency response's oscillators (3·MAX_LINES phasors, 768 B) make its variant the
+// largest; the mode lives in one static of the board and there is no heap to box it in.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Running {
     Step(VoltageStep, VoltageStepState<0>),
     Align(ResolverOffset, ResolverOffsetState),
     Rotate(PolePairRatio, PolePairRatioState),
     Flux(FluxLinkageState),
+    Frequency(FrequencyResponse, FrequencyResponseState),
 }
 
+// As `Running`: the running routine's state is the largest variant, by design.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Mode {
     Idle,
@@ -233,6 +260,9 @@ impl CommissioningMode {
         if routine != Routine::Flux && !within(omega_e, cfg.standstill_speed) {
             return Reason::NotAtStandstill;
         }
+        if routine == Routine::FrequencyResponse {
+            return self.accept_frequency_response(cfg, c, capacity);
+        }
         let decimation = match u8::try_from(c.decimation) {
             Ok(d) if d >= 1 => d,
             _ => return Reason::BadCommand,
@@ -283,15 +313,54 @@ impl CommissioningMode {
                 PolePairRatioState::default(),
             ),
             Routine::Flux => Running::Flux(FluxLinkageState::default()),
+            // Accepted above, never here.
+            Routine::FrequencyResponse => return Reason::BadCommand,
         };
+        let trip = if routine == Routine::Step { c.current_trip } else { 0.0 };
+        self.start(
+            cfg,
+            routine,
+            run,
+            routine == Routine::Step && c.axis_q,
+            decimation,
+            trip,
+        );
+        Reason::None
+    }
+
+    /// The frequency response: amplitude and trip positive, the line set valid for the
+    /// period the buffer holds.
+    fn accept_frequency_response(&mut self, cfg: &ModeConfig, c: &Command, capacity: usize) -> Reason {
+        let [first, per_octave] = c.decimation.to_le_bytes();
+        let period = frequency_response_period(capacity);
+        let Some(lines) = multisine_lines(u16::from(first), per_octave, period) else {
+            return Reason::BadCommand;
+        };
+        if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
+            return Reason::BadCommand;
+        }
+        let r = FrequencyResponse {
+            axis: if c.axis_q { Axis::Q } else { Axis::D },
+            amplitude: c.voltage,
+            current_trip: c.current_trip,
+            period,
+            settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
+            lines,
+        };
+        let run = Running::Frequency(r, r.start());
+        self.start(cfg, Routine::FrequencyResponse, run, c.axis_q, 1, c.current_trip);
+        Reason::None
+    }
+
+    fn start(&mut self, cfg: &ModeConfig, routine: Routine, run: Running, axis_q: bool, decimation: u8, trip: f32) {
         self.header = Header {
             routine,
-            axis_q: routine == Routine::Step && c.axis_q,
+            axis_q,
             tripped: false,
             decimation,
             sample_period_units: cfg.sample_period_units,
             count: 0,
-            current_trip: if routine == Routine::Step { c.current_trip } else { 0.0 },
+            current_trip: trip,
         };
         self.end = End {
             crc: 0,
@@ -300,7 +369,6 @@ impl CommissioningMode {
         };
         self.len = 0;
         self.mode = Mode::Running { routine, run, n: 0 };
-        Reason::None
     }
 
     /// One control period: what the current-control step gets; the routine's channels
@@ -323,6 +391,34 @@ impl CommissioningMode {
             self.mode = Mode::Fault;
             self.reason = Reason::Aborted;
             return Control::Off;
+        }
+        // The frequency response captures its own window (the previous period's u_PI
+        // and v), never decimated.
+        if let Running::Frequency(r, st) = &mut run {
+            let u_pi = match r.axis {
+                Axis::D => m.u_d,
+                Axis::Q => m.u_q,
+            };
+            let (pr, capture) = r.process(st, m.i_dq, u_pi);
+            if let Some(sample) = capture
+                && let Some(slot) = buffer.get_mut(self.len)
+                && self.len < usize::from(u16::MAX)
+            {
+                *slot = sample;
+                self.len = self.len.saturating_add(1);
+            }
+            return match pr {
+                Progress::Running(demand) => {
+                    self.mode = Mode::Running {
+                        routine,
+                        run,
+                        n: n.saturating_add(1),
+                    };
+                    Control::Demand(demand)
+                }
+                Progress::Finished(Ok(())) => self.finish(None),
+                Progress::Finished(Err(e)) => self.finish(Some(e)),
+            };
         }
         // The demand and the two captured channels of this period, or the outcome.
         let (progress, channels) = match &mut run {
@@ -369,6 +465,7 @@ impl CommissioningMode {
                 };
                 (outcome, (m.omega_e, m.u_q))
             }
+            Running::Frequency(..) => (Progress::Finished(None), (0.0, 0.0)),
         };
         match progress {
             Progress::Running(demand) => {
@@ -394,19 +491,22 @@ impl CommissioningMode {
                 };
                 Control::Demand(demand)
             }
-            Progress::Finished(error) => {
-                if let Some(CommissioningError::Tripped { sample, current }) = error {
-                    self.header.tripped = true;
-                    self.end.trip_sample = u16::try_from(sample).unwrap_or(u16::MAX);
-                    self.end.trip_current = current;
-                    self.reason = Reason::Tripped;
-                }
-                self.header.count = u16::try_from(self.len).unwrap_or(u16::MAX);
-                self.crc = p::Crc32::new();
-                self.mode = Mode::Streaming { next: 0 };
-                Control::Off
-            }
+            Progress::Finished(error) => self.finish(error),
         }
+    }
+
+    /// The routine ended (tripped with `error`): outputs off, the capture to be sent.
+    fn finish(&mut self, error: Option<CommissioningError>) -> Control {
+        if let Some(CommissioningError::Tripped { sample, current }) = error {
+            self.header.tripped = true;
+            self.end.trip_sample = u16::try_from(sample).unwrap_or(u16::MAX);
+            self.end.trip_current = current;
+            self.reason = Reason::Tripped;
+        }
+        self.header.count = u16::try_from(self.len).unwrap_or(u16::MAX);
+        self.crc = p::Crc32::new();
+        self.mode = Mode::Streaming { next: 0 };
+        Control::Off
     }
 
     /// The next capture frame (of `buffer`) to send while streaming (then idle again),
@@ -458,6 +558,9 @@ pub fn capture_periods(cfg: &ModeConfig, routine: Routine) -> u64 {
                 .saturating_add(sum(settle, settle, 2))
         }
         Routine::Flux => sum(cfg.flux.average_samples, 1, 0),
+        // One multisine period of the buffer ([`frequency_response_period`]), checked
+        // when the command is accepted.
+        Routine::FrequencyResponse => 0,
     }
 }
 

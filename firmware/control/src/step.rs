@@ -130,6 +130,18 @@ pub enum Demand {
     Torque(f32),
     /// Open-loop voltage in the rotor frame \[V\] (blocked-rotor step, 6.2).
     VoltageDq(Dq),
+    /// Closed-loop currents without the feed-forward, with `injection` \[V\] added to the
+    /// controller's limited output (the loop broken at the controller's output for the
+    /// frequency response, [`crate::commissioning::FrequencyResponse`]): v = u_PI + d,
+    /// where `StepOutput::u_dq` is u_PI.
+    Injected {
+        /// d-axis current reference \[A\].
+        id: f32,
+        /// q-axis current reference \[A\].
+        iq: f32,
+        /// The voltage added after the controller \[V\].
+        injection: Dq,
+    },
     /// Open-loop voltage in the stator frame \[V\] (alignment 6.3, rotation 6.4).
     VoltageAlphaBeta(AlphaBeta),
 }
@@ -189,7 +201,7 @@ impl ControllerConfig {
     /// dq output before the inverse Park transform, outside the PI (the injected carrier
     /// of thesis B Appendix D, `ud = ud + udhf`); `StepOutput::u_dq` excludes it, as the
     /// estimator's back-EMF error (4.38), (4.39) wants; it applies to `Demand::Current`
-    /// and `Demand::Torque` only. `theta_r`/`omega_r` of the output are 0 and the observer state is untouched.
+    /// and `Demand::Torque` only (and adds to a `Demand::Injected`'s injection). `theta_r`/`omega_r` of the output are 0 and the observer state is untouched.
     #[allow(clippy::too_many_arguments)]
     pub fn process_at_angle<T: Trig>(
         &self,
@@ -235,7 +247,20 @@ impl ControllerConfig {
                 state.current = CurrentPiState::default();
                 (Dq::default(), AlphaBeta::default())
             }
-            Demand::Current { id, iq, feed_forward } => {
+            Demand::Current { .. } | Demand::Injected { .. } => {
+                let (id, iq, feed_forward, added) = match demand {
+                    Demand::Current { id, iq, feed_forward } => (id, iq, feed_forward, added),
+                    Demand::Injected { id, iq, injection } => (
+                        id,
+                        iq,
+                        false,
+                        Dq {
+                            d: added.d + injection.d,
+                            q: added.q + injection.q,
+                        },
+                    ),
+                    _ => (0.0, 0.0, false, added),
+                };
                 let ff = if feed_forward {
                     self.feed_forward.decoupling(omega_e, i_dq)
                 } else {

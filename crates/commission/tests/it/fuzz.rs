@@ -231,6 +231,8 @@ fn judge_identification(d: &Design, kind: RecordingKind, text: &str) -> Result<b
             Ok(e) => finite(&[e.ratio, e.electrical_travel_rad, e.resolver_travel_rad]),
             Err(e) => located(&e, file).map(|()| false),
         },
+        // Not identified from a recording (the session computes it from the capture).
+        RecordingKind::FrequencyResponse => Err("the fuzz seeds have no frequency-response recording".into()),
     }
 }
 

@@ -2,5 +2,6 @@
 
 mod can_dbc;
 mod commission;
+mod frequency_response;
 mod fuzz;
 mod identify;

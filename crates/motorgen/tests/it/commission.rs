@@ -119,3 +119,86 @@ fn session_options_are_accepted_after_the_routine() {
     );
     assert!(!dir.join("out").exists());
 }
+
+/// `--sim … frequency-response` as README shows it: the JSON with the issue's keys and
+/// the capture's CSV in `--out`, the summary naming the perturbed L_q (`--sim-scale
+/// Lq=0.7`: −30 %); `--write` puts the fitted L_q into `[motor.identified]`; bad
+/// `--sim-scale`, `--frequencies` and `--amplitude` values exit 1 naming the option with
+/// nothing written, and `--sim-scale` with `--can` is refused.
+#[test]
+fn frequency_response_on_the_simulated_drive() {
+    let (dir, spec, out) = setup("frequency-response");
+    let before = std::fs::read_to_string(&spec).unwrap();
+    let base = [
+        "commission",
+        spec.as_str(),
+        "--board",
+        "boards/motorgen-reference.toml",
+        "--sim",
+        "--out",
+        out.as_str(),
+        "frequency-response",
+        "--axis",
+        "q",
+    ];
+    for (extra, option) in [
+        (&["--sim-scale", "Lq=0"][..], "--sim-scale"),
+        (&["--sim-scale", "Lx=0.7"][..], "--sim-scale"),
+        (&["--sim-scale", "delay=3"][..], "--sim-scale"),
+        (&["--frequencies", "0/3"][..], "--frequencies"),
+        (&["--frequencies", "4/9"][..], "--frequencies"),
+        (&["--amplitude", "900 V"][..], "--amplitude"),
+    ] {
+        let o = motorgen(&[&base[..], extra].concat());
+        assert_eq!(o.status.code(), Some(1), "{extra:?}: {}", text_of(&o));
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(err.starts_with(&format!("error: {option}: ")), "{err}");
+        assert!(!dir.join("out").exists());
+    }
+    let o = motorgen(&[
+        "commission",
+        &spec,
+        "--board",
+        "boards/motorgen-reference.toml",
+        "--can",
+        "mgnone0",
+        "--out",
+        &out,
+        "frequency-response",
+        "--axis",
+        "q",
+        "--sim-scale",
+        "Lq=0.7",
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", text_of(&o));
+    let o = motorgen(&[&base[..], &["--sim-scale", "Lq=0.7"]].concat());
+    assert_eq!(o.status.code(), Some(0), "{}", text_of(&o));
+    let stdout = String::from_utf8_lossy(&o.stdout);
+    assert!(stdout.contains("L_q is -30.0 % off the spec"), "{stdout}");
+    let json = std::fs::read_to_string(dir.join("out/frequency-response-q.json")).unwrap();
+    for key in [
+        "\"axis\": \"q\"",
+        "\"measured\": {\"gain_margin_db\": ",
+        "\"designed\": {\"gain_margin_db\": ",
+        "\"phase_margin_deg\"",
+        "\"crossover_rad_s\"",
+        "\"frequency_hz\"",
+        "\"magnitude_db\"",
+        "\"phase_deg\"",
+        "\"designed_magnitude_db\"",
+        "\"designed_phase_deg\"",
+    ] {
+        assert!(json.contains(key), "{key} missing: {json}");
+    }
+    let csvs = std::fs::read_dir(dir.join("out"))
+        .unwrap()
+        .filter(|e| e.as_ref().unwrap().path().extension().is_some_and(|x| x == "csv"))
+        .count();
+    assert_eq!(csvs, 1);
+    assert_eq!(std::fs::read_to_string(&spec).unwrap(), before);
+    let o = motorgen(&[&base[..], &["--sim-scale", "Lq=0.7", "--write"]].concat());
+    assert_eq!(o.status.code(), Some(0), "{}", text_of(&o));
+    let after = std::fs::read_to_string(&spec).unwrap();
+    // 0.7 × 0.393 mH = 0.2751 mH, written with 4 significant digits.
+    assert!(after.contains("q_inductance = \"0.27"), "{after}");
+}

@@ -247,3 +247,57 @@ fn bad_spec_is_reported_and_nothing_written() {
     }
     assert!(!out_dir.exists(), "report wrote into {}", out_dir.display());
 }
+
+/// `report --measured DIR` (issue 28): the Fischer d and q frequency responses measured
+/// on the simulated drive (`commission --sim … frequency-response`, L_q × 0.7 on q) are
+/// overlaid on the current-loop Bode plots — the loaded page's d and q figures carry the
+/// measured series' legend entry and a caption with the measured margins and the fitted
+/// plant beside the spec's; a directory without the files is bad input (exit 1).
+#[test]
+fn report_overlays_the_measured_frequency_response() {
+    let dir = tmp("measured");
+    let spec = "motors/fischer-ti085.toml";
+    let meas = dir.join("meas");
+    let meas_s = meas.to_str().unwrap();
+    for (axis, scale) in [("d", &[][..]), ("q", &["--sim-scale", "Lq=0.7"][..])] {
+        let args = [
+            "commission",
+            spec,
+            "--board",
+            "boards/motorgen-reference.toml",
+            "--sim",
+            "--out",
+            meas_s,
+            "frequency-response",
+            "--axis",
+            axis,
+        ];
+        let o = motorgen(&[&args[..], scale].concat());
+        assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    }
+    let out = dir.join("page");
+    let o = motorgen(&["report", spec, "--out", out.to_str().unwrap(), "--measured", meas_s]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let page = out.join("fischer-ti085.html");
+    let dom = String::from_utf8(run_chromium(&dir, &page, &["--dump-dom"]).stdout).unwrap();
+    for axis in ["d", "q"] {
+        let id = format!("<figure class=\"plot\" id=\"current-bode-{axis}\"");
+        let start = dom.find(&id).unwrap_or_else(|| panic!("no {id}"));
+        let fig = &dom[start..start + dom[start..].find("</figure>").unwrap()];
+        assert!(
+            fig.contains("open loop L (measured on the drive)"),
+            "{axis}: no measured series"
+        );
+        assert!(fig.contains("measured on the drive: gain margin"), "{axis}: no caption");
+        assert!(fig.contains("fitted plant R "), "{axis}: no fitted plant");
+    }
+    let o = motorgen(&[
+        "report",
+        spec,
+        "--out",
+        out.to_str().unwrap(),
+        "--measured",
+        dir.join("nothing").to_str().unwrap(),
+    ]);
+    assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
+}

@@ -18,6 +18,7 @@ use std::fmt::Write as _;
 use crate::{Verification, format_value, frequency};
 use codegen::constants::constants;
 use codegen::design::Design;
+use nalgebra::Complex;
 use plots::Line;
 
 /// One plot of the page.
@@ -181,8 +182,30 @@ pub fn corner_speed(d: &Design) -> f64 {
     d.current_loop.voltage_limit_v / (psi * psi + (m.q_inductance_h * m.peak_current_a).powi(2)).sqrt()
 }
 
+/// A current loop's open-loop response measured on the drive (`motorgen commission …
+/// frequency-response`), to overlay on the designed Bode plot of its axis.
+#[derive(Clone, Debug, PartialEq)]
+pub struct MeasuredLoop {
+    /// `d` or `q`.
+    pub axis: String,
+    /// The lines' ω [rad/s].
+    pub omega: Vec<f64>,
+    /// |L| at each line \[dB\].
+    pub magnitude_db: Vec<f64>,
+    /// arg L at each line [°].
+    pub phase_deg: Vec<f64>,
+    /// The measured margins and the fitted plant beside the spec's, for the caption.
+    pub summary: String,
+}
+
 /// Every plot of the report for `d` and its verification `v`, in page order.
 pub fn plots_of(d: &Design, v: &Verification) -> Result<Vec<Plot>, String> {
+    plots_with_measured(d, v, &[])
+}
+
+/// [`plots_of`] with measured current-loop responses overlaid on the Bode plots of their
+/// axes (the open loop L measured on the drive next to the discrete design's).
+pub fn plots_with_measured(d: &Design, v: &Verification, measured: &[MeasuredLoop]) -> Result<Vec<Plot>, String> {
     let mut out = Vec::new();
     let traces = |id: &'static str| {
         v.scenarios
@@ -211,22 +234,36 @@ pub fn plots_of(d: &Design, v: &Verification) -> Result<Vec<Plot>, String> {
         ("q", &d.current_loop.q, m.q_inductance_h),
     ] {
         let (open, closed) = frequency::current_loop(g, m.phase_resistance_ohm, l, ts, &grid);
+        let mut responses = vec![
+            ("open loop L (discrete)".to_string(), open),
+            ("closed loop T (discrete)".to_string(), closed),
+            ("closed loop (continuous design)".to_string(), designed.clone()),
+        ];
+        let mut caption = format!(
+            "{axis}-axis current loop: discrete open loop L = C·P and closed loop T (forward-difference PI, ZOH plant, one period of delay) against the continuous design, up to the Nyquist frequency π·f_s"
+        );
+        for meas in measured.iter().filter(|x| x.axis == axis) {
+            let values = meas
+                .magnitude_db
+                .iter()
+                .zip(&meas.phase_deg)
+                .map(|(db, deg)| Complex::from_polar(10f64.powf(db / 20.0), deg.to_radians()))
+                .collect();
+            responses.push((
+                "open loop L (measured on the drive)".to_string(),
+                frequency::Response {
+                    omega: meas.omega.clone(),
+                    values,
+                },
+            ));
+            caption.push_str(&format!("; measured on the drive: {}", meas.summary));
+        }
+        let refs: Vec<(String, &frequency::Response)> = responses.iter().map(|(l, r)| (l.clone(), r)).collect();
         out.push(Plot {
             id: format!("current-bode-{axis}"),
             section: "current-loop",
-            caption: format!(
-                "{axis}-axis current loop: discrete open loop L = C·P and closed loop T (forward-difference PI, ZOH plant, one period of delay) against the continuous design, up to the Nyquist frequency π·f_s"
-            ),
-            svg: plots::bode_chart(
-                &format!("{axis}-axis current loop"),
-                "ω [rad/s]",
-                &[
-                    ("open loop L (discrete)".into(), &open),
-                    ("closed loop T (discrete)".into(), &closed),
-                    ("closed loop (continuous design)".into(), &designed),
-                ],
-                true,
-            )?,
+            caption,
+            svg: plots::bode_chart(&format!("{axis}-axis current loop"), "ω [rad/s]", &refs, true)?,
         });
     }
     for (k, t) in traces("decoupling").chain(traces("dc_link_step")).enumerate() {
@@ -446,7 +483,12 @@ pub fn html(d: &Design, v: &Verification, plots: &[Plot]) -> String {
 
 /// The report page for `d` and `v`.
 pub fn report(d: &Design, v: &Verification) -> Result<String, String> {
-    let plots = plots_of(d, v)?;
+    report_with_measured(d, v, &[])
+}
+
+/// [`report`] with measured current-loop responses overlaid ([`plots_with_measured`]).
+pub fn report_with_measured(d: &Design, v: &Verification, measured: &[MeasuredLoop]) -> Result<String, String> {
+    let plots = plots_with_measured(d, v, measured)?;
     Ok(html(d, v, &plots))
 }
 

@@ -95,6 +95,7 @@ impl Control {
                 theta_r: 0,
                 omega_e: 0.0,
                 u_q: 0.0,
+                u_d: 0.0,
             },
         }
     }
@@ -151,6 +152,7 @@ impl Control {
             theta_r: out.theta_r,
             omega_e: out.omega_e,
             u_q: out.u_dq.q,
+            u_d: out.u_dq.d,
         };
         self.omega_e = out.omega_e;
         pwm::set_compare(&self.tim1, out.compare);

@@ -10,6 +10,7 @@ use std::f64::consts::PI;
 use serde::Serialize;
 
 use super::Context;
+use crate::design::Design;
 use crate::design::current_loop::analysis::{
     AxisGains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE,
 };
@@ -245,9 +246,39 @@ fn requests(spec: &Spec, r: f64, ts: f64) -> [Request; 2] {
         bandwidth_rad_s: c.bandwidth.value,
         damping: c.damping.as_ref().map_or(0.0, |d| d.value),
         sample_period_s: ts,
-        loop_delay_s: FIRMWARE_LOOP_DELAY_PERIODS * ts,
+        loop_delay_s: loop_delay_s(ts),
         compensate_delay: c.compensate_delay,
     })
+}
+
+/// The loop delay of the firmware's timing at sample period `ts` \[s\]
+/// ([`FIRMWARE_LOOP_DELAY_PERIODS`]·T_s), the one place the design takes it from.
+fn loop_delay_s(ts: f64) -> f64 {
+    FIRMWARE_LOOP_DELAY_PERIODS * ts
+}
+
+impl Design {
+    /// The request the design's `axis` was designed from (the spec's R, the axis's L,
+    /// α, ζ, T_s, the loop delay and delay compensation), for a consumer that compares
+    /// a measured loop with the designed one (`motor_commission::frequency_response`).
+    pub fn current_loop_request(&self, axis: Axis) -> Request {
+        let c = &self.current_loop;
+        let ts = self.drive.sample_period_s;
+        Request {
+            method: c.method,
+            axis,
+            resistance_ohm: self.motor.phase_resistance_ohm,
+            inductance_h: match axis {
+                Axis::D => self.motor.d_inductance_h,
+                Axis::Q => self.motor.q_inductance_h,
+            },
+            bandwidth_rad_s: c.bandwidth_rad_s,
+            damping: c.damping.unwrap_or(0.0),
+            sample_period_s: ts,
+            loop_delay_s: loop_delay_s(ts),
+            compensate_delay: c.compensate_delay,
+        }
+    }
 }
 
 /// The same gains for R_s at the maximum winding temperature (2.24), if `[thermal]` is given;
