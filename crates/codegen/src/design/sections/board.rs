@@ -43,10 +43,10 @@ pub struct BoardOut {
     /// Measurable current ± \[A\].
     pub current_full_scale_a: f64,
     /// Conversions per phase the image averages at start-up, gates off, for the measured
-    /// zero-current level ([`offset_samples`]).
+    /// zero-current level (`offset_samples` below).
     pub offset_samples: u32,
     /// Largest |measured − nominal| zero-current level the image accepts, in 16-bit
-    /// left-aligned codes ([`offset_bound_code`]).
+    /// left-aligned codes (`offset_bound_code` below).
     pub offset_bound_code: i32,
     /// Volts of DC link per 15-bit code: V_REF+/(ratio·2^15).
     pub dc_link_volts_per_lsb: f64,
