@@ -171,6 +171,7 @@ impl Rig {
             7 => "unhandled interrupt",
             8 => "panic",
             9 => "watchdog",
+            10 => "current offset",
             _ => "unknown",
         };
         Some(format!("{cause} ({name})"))

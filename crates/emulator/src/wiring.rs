@@ -47,12 +47,19 @@ pub const RESOLVER_AMPLITUDE: f64 = 0.4;
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sensing {
     hw: Hardware,
+    /// An error of each phase's zero-current level against the hardware description's
+    /// \[V\] (a defect a test injects: an offset resistor off its value, an amplifier's
+    /// input offset; zero for the board as described).
+    pub zero_error_v: [f64; 3],
 }
 
 impl Sensing {
     /// The sensing of `hw`.
     pub fn new(hw: &Hardware) -> Self {
-        Self { hw: hw.clone() }
+        Self {
+            hw: hw.clone(),
+            zero_error_v: [0.0; 3],
+        }
     }
 
     /// Voltage at the pin of `signal` with phase currents `currents` \[A\], DC link
@@ -68,7 +75,7 @@ impl Sensing {
         let half = self.hw.vref / 2.0;
         let sign = if excitation_high { 1.0 } else { -1.0 };
         match signal {
-            Signal::Current(k) => self.hw.current_volts(currents[k]),
+            Signal::Current(k) => self.hw.current_volts(currents[k]) + self.zero_error_v[k],
             Signal::DcLink => dc_link_v * self.hw.dc_link_ratio,
             Signal::Sin => half + RESOLVER_AMPLITUDE * half * sign * theta_r.sin(),
             Signal::Cos => half + RESOLVER_AMPLITUDE * half * sign * theta_r.cos(),
@@ -86,7 +93,8 @@ pub struct Standstill {
     pub currents: [f64; 3],
     /// DC-link voltage \[V\].
     pub dc_link_v: f64,
-    sensing: Sensing,
+    /// The board's sensing (its zero-level errors may be set).
+    pub sensing: Sensing,
 }
 
 impl Standstill {

@@ -9,7 +9,7 @@
 mod board;
 #[cfg(target_os = "none")]
 use motor_config::{
-    adc_frame, bringup, can_commissioning, can_frame, config, fault_frame, fault_record, hw, motor, registers,
+    adc_frame, bringup, can_commissioning, can_frame, config, fault_frame, fault_record, hw, motor, offset, registers,
 };
 
 // The RTT transport of the `defmt` log lines (README, "defmt logging").

@@ -106,8 +106,9 @@ pub fn assemble(adc1: &[u16; 4], signals1: &[u8], adc2: &[u16; 4], signals2: &[u
 /// The board's trip levels in the units of the conversions.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Trips {
-    /// 16-bit code at zero current.
-    pub current_offset: i32,
+    /// 16-bit code at zero current, per phase u, v, w: the board's nominal level until
+    /// the start-up measurement ([`crate::offset`]) replaces it.
+    pub current_offset: [i32; 3],
     /// |code − offset| above which a phase current trips (over-current level / A per code).
     pub current_codes: i32,
     /// 15-bit DC-link code above which the drive trips (over-voltage level / V per code).
@@ -123,11 +124,16 @@ impl Trips {
     /// DC link beyond the over-voltage level, the electrical speed beyond the over-speed
     /// level. `phases` is 2 or 3 (the third code is unused with two).
     pub fn tripped(&self, raw: &RawConversions, phases: usize, omega_e: f32) -> bool {
-        let current = raw.phases.iter().take(phases).any(|&c| {
-            let c = c & FULL;
-            let code16 = i32::from(left_aligned(c));
-            c == 0 || c == FULL || (code16 - self.current_offset).abs() > self.current_codes
-        });
+        let current = raw
+            .phases
+            .iter()
+            .zip(&self.current_offset)
+            .take(phases)
+            .any(|(&c, &offset)| {
+                let c = c & FULL;
+                let code16 = i32::from(left_aligned(c));
+                c == 0 || c == FULL || code16.saturating_sub(offset).saturating_abs() > self.current_codes
+            });
         let dc_link = (raw.dc_link & FULL) << (15 - ADC_BITS);
         current || dc_link > self.dc_link_code || omega_e.abs() > self.speed || omega_e.is_nan()
     }
@@ -166,7 +172,7 @@ mod tests {
     #[test]
     fn trips_at_the_board_levels() {
         let t = Trips {
-            current_offset: 32_768,
+            current_offset: [32_768; 3],
             current_codes: 8_000,
             dc_link_code: 20_000,
             speed: 4_000.0,
@@ -213,6 +219,36 @@ mod tests {
         assert!(t.tripped(&RawConversions { dc_link: 2501, ..ok }, 3, 0.0));
         assert!(t.tripped(&ok, 3, -4_001.0));
         assert!(t.tripped(&ok, 3, f32::NAN));
+        // A measured zero level per phase: v's at 40 000, so 2500 (40 000) is 0 A there
+        // and 2048 (32 768) is 7 232 away — inside; 1900 (30 400, 9 600 away) trips.
+        let moved = Trips {
+            current_offset: [32_768, 40_000, 32_768],
+            ..t
+        };
+        assert!(!moved.tripped(
+            &RawConversions {
+                phases: [2048, 2500, 2048],
+                ..ok
+            },
+            3,
+            0.0
+        ));
+        assert!(!moved.tripped(
+            &RawConversions {
+                phases: [2048, 2048, 2048],
+                ..ok
+            },
+            3,
+            0.0
+        ));
+        assert!(moved.tripped(
+            &RawConversions {
+                phases: [2048, 1900, 2048],
+                ..ok
+            },
+            3,
+            0.0
+        ));
     }
 
     /// The reference board's ranks: ADC1 [i_u, SIN, U_dc], ADC2 [i_v, i_w, COS].

@@ -262,11 +262,19 @@ pub const WATCHDOG: (u8, u16) = match timing::iwdg_for_timeout(board::WATCHDOG_T
 
 /// Trips on the measured values, as codes (see [`crate::adc_frame::Trips`]).
 pub const TRIPS: crate::adc_frame::Trips = crate::adc_frame::Trips {
-    current_offset: board::CURRENT_OFFSET_CODE,
+    current_offset: [board::CURRENT_OFFSET_CODE; 3],
     // |per-LSB|: the scale carries the sensing's sign (negative for low-side shunts).
     current_codes: (board::OVER_CURRENT_A / board::CURRENT_PER_LSB).abs() as i32,
     dc_link_code: (board::OVER_VOLTAGE_V / board::DC_LINK_PER_LSB) as u16,
     speed: board::OVER_SPEED_E_RAD_S,
+};
+
+/// The start-up measurement of the current sensing's zero level ([`crate::offset`]):
+/// the board's nominal level, the generated bound and number of conversions.
+pub const OFFSETS: crate::offset::OffsetBounds = crate::offset::OffsetBounds {
+    nominal: board::CURRENT_OFFSET_CODE,
+    bound: board::OFFSET_BOUND_CODE,
+    samples: board::OFFSET_SAMPLES,
 };
 
 /// Taps of the identification FIR.

@@ -60,6 +60,12 @@ pub enum FaultCause {
     Panic = 8,
     /// An independent-watchdog reset that no fault path recorded.
     Watchdog = 9,
+    /// The current sensing's zero level, averaged at start-up with the gates off
+    /// (`board::OFFSET_SAMPLES` conversions per phase), lies further from the board's
+    /// nominal level than `board::OFFSET_BOUND_CODE` on some phase: a wrong offset in
+    /// the board file, a sensor or amplifier without supply, a broken channel. The
+    /// outputs were never switched on. (Numbers 10–19 are issue 26's start-up checks.)
+    CurrentOffset = 10,
 }
 
 impl FaultCause {
@@ -76,6 +82,7 @@ impl FaultCause {
             UnhandledInterrupt,
             Panic,
             Watchdog,
+            CurrentOffset,
         ]
         .into_iter()
         .find(|c| *c as u32 == code)
@@ -327,12 +334,12 @@ mod tests {
             reported: true,
         };
         assert_eq!(FaultRecord::from_words(&bare.to_words()), Some(bare));
-        for code in 1..=9 {
-            let c = FaultCause::from_code(code).expect("codes 1–9 are causes");
+        for code in 1..=10 {
+            let c = FaultCause::from_code(code).expect("codes 1–10 are causes");
             assert_eq!(c as u32, code);
         }
         assert_eq!(FaultCause::from_code(0), None);
-        assert_eq!(FaultCause::from_code(10), None);
+        assert_eq!(FaultCause::from_code(11), None);
     }
 
     /// Layout: word 0 is the magic, word 1 the cause code, the last word the CRC of the

@@ -10,7 +10,8 @@
 //! [`adc_frame`] (ADC codes → the core's sample, resolver demodulation),
 //! [`can_frame`] (the setpoint frame), [`can_commissioning`] (the commissioning mode's
 //! configuration), [`fault_record`] (the fault record kept across a reset: encoding,
-//! CRC, validation at boot), [`fault_frame`] (its CAN report). The board layer
+//! CRC, validation at boot), [`fault_frame`] (its CAN report), [`offset`] (the current sensing's zero level measured
+//! at start-up). The board layer
 //! (`motor-firmware`, `../app`) owns
 //! the peripherals; it is a separate crate so that other bare-metal binaries (the QEMU
 //! benchmarks) link this logic without the STM32G4 vector table, the G474 `memory.x`
@@ -31,6 +32,7 @@ pub mod config;
 pub mod fault_frame;
 pub mod fault_record;
 pub mod hw;
+pub mod offset;
 pub mod registers;
 pub mod timing;
 

@@ -455,7 +455,7 @@ pub const FAULT_REPORT_LEN: u8 = 8;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaultReport {
     /// The cause code (1 HardFault, 2 stack overflow, 3 break, 4 trip, 5 lost
-    /// conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog).
+    /// conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog, 10 current offset).
     pub cause: u8,
     /// The stacked PC of a CPU fault.
     pub pc: Option<u32>,

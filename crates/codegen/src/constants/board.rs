@@ -157,6 +157,34 @@ impl<'a> OnBoard<'a> {
             json: Json::At("/board/current_full_scale_a"),
         },
         Decl {
+            name: "OFFSET_SAMPLES",
+            value: Custom(|c| count(c.o.offset_samples.into(), "u32", "uint32_t")),
+            formula: Lit(
+                "smallest power of two N with 3·σ/√N ≤ 1/4 LSB, σ = 1 LSB rms taken for the converter (conversions per phase averaged at start-up, gates off)",
+            ),
+            equation: Lit("standard error of a mean; design::sections::board::offset_samples"),
+            inputs: Lit("the ADC's 12-bit resolution"),
+            json: Json::At("/board/offset_samples"),
+        },
+        Decl {
+            name: "OFFSET_BOUND_CODE",
+            value: Custom(|c| {
+                let code = c.o.offset_bound_code;
+                let volts = f64::from(code) / 65_536.0 * c.b.adc_reference_v;
+                let physical = format!(
+                    "{volts:.4} V = {:.2} A from the nominal zero level",
+                    volts / c.b.current.gain_v_per_a.abs()
+                );
+                (intv(code.into(), "i32", "int32_t"), physical)
+            }),
+            formula: Lit(
+                "(min(V_0, V_REF+ − V_0) − |G|·I_oc)/V_REF+·2^16, rounded down: the room between the over-current ceiling and the nearer ADC rail (16-bit left-aligned codes)",
+            ),
+            equation: Lit("thesis A (4.16); design::sections::board::offset_bound_code"),
+            inputs: Of(|c| format!("{}, protection.over_current", c.current)),
+            json: Json::At("/board/offset_bound_code"),
+        },
+        Decl {
             name: "CURRENT_PHASES",
             value: Custom(|c| count(c.o.current_phases.into(), "u8", "uint8_t")),
             formula: Lit("phase currents measured (the third from i_u + i_v + i_w = 0 when 2)"),

@@ -2,6 +2,14 @@
 //! [`motor_control::ControllerConfig::process`] step per carrier period with the
 //! CORDIC as [`motor_control::Trig`].
 //!
+//! The first `board::OFFSET_SAMPLES` periods measure the current sensing's zero level
+//! with the outputs off (MOE = 0: no switch conducts, no phase current flows;
+//! [`crate::offset`]); a level beyond `board::OFFSET_BOUND_CODE` from the nominal one is
+//! a fault ([`FaultCause::CurrentOffset`]) and the drive never switches on, otherwise
+//! every later period's currents are taken about the measured levels (trips included).
+//! Meanwhile the step runs with [`Demand::Off`] (the angle observer locks on) and a
+//! commissioning routine sees a fault.
+//!
 //! Order: read and acknowledge the conversions; trip on the board's levels
 //! ([`crate::config::TRIPS`]: a phase current beyond the over-current level or at the
 //! converter's rail, the DC link beyond the over-voltage level, the last period's
@@ -30,11 +38,13 @@ use stm32g4::stm32g474::interrupt;
 
 use super::cordic::Cordic;
 use super::{adc, commissioning, fault, pins, pwm};
+use crate::adc_frame::Trips;
 use crate::adc_frame::{self, Excitation};
 use crate::bringup::{self, BreakControl};
-use crate::config::{CONTROLLER, SETPOINT, TRIPS};
+use crate::config::{CONTROLLER, OFFSETS, SETPOINT, TRIPS};
 use crate::fault_record::{ControlState, FaultCause};
 use crate::motor::board;
+use crate::offset::{self, OffsetCalibration, OffsetStatus};
 
 /// Control periods run (wrapping); the main loop refreshes the watchdog only when
 /// this advances.
@@ -72,6 +82,12 @@ pub struct Control {
     trip_cause: Option<FaultCause>,
     /// What the last step measured, for a commissioning routine.
     measured: Measured,
+    /// The start-up measurement of the current sensing's zero level.
+    calibration: OffsetCalibration,
+    /// The measured zero levels \[16-bit codes\], once measured and within the bound.
+    zero: Option<[i32; 3]>,
+    /// The trips, about the measured zero levels once known.
+    trips: Trips,
 }
 
 /// Passes the [`Control`] from `run` to the interrupt once.
@@ -97,6 +113,9 @@ impl Control {
                 u_q: 0.0,
                 u_d: 0.0,
             },
+            calibration: OffsetCalibration::new(),
+            zero: None,
+            trips: TRIPS,
         }
     }
 
@@ -119,18 +138,34 @@ impl Control {
             return self.record_trip();
         };
         let was_tripped = self.tripped;
-        if TRIPS.tripped(&raw, usize::from(board::CURRENT_PHASES), self.omega_e) {
+        let phases = usize::from(board::CURRENT_PHASES);
+        if self.zero.is_none() {
+            match self.calibration.add(&OFFSETS, &raw, phases) {
+                OffsetStatus::Measuring => {}
+                OffsetStatus::Measured(levels) => {
+                    self.zero = Some(levels);
+                    self.trips.current_offset = levels;
+                }
+                OffsetStatus::OutOfBound { .. } => self.trip(FaultCause::CurrentOffset),
+            }
+        }
+        if self.trips.tripped(&raw, phases, self.omega_e) {
             self.trip(FaultCause::Trip);
         }
+        // Measuring the zero level (or refused it): the outputs stay off.
+        let calibrating = self.zero.is_none();
         let excitation = if pins::excitation_high() {
             Excitation::Positive
         } else {
             Excitation::Negative
         };
-        let sample = adc_frame::to_sample(&raw, excitation);
+        let mut sample = adc_frame::to_sample(&raw, excitation);
+        if let Some(levels) = self.zero {
+            sample.phase_currents = offset::to_nominal(sample.phase_currents, levels, OFFSETS.nominal);
+        }
         let torque = SETPOINT.process(&mut self.setpoint, take_setpoint());
         let alive = !(self.setpoint.timed_out(&SETPOINT) && torque == 0.0);
-        let run = alive && !self.tripped;
+        let run = alive && !self.tripped && !calibrating;
         let normal = if run { Demand::Torque(torque) } else { Demand::Off };
         // A commissioning routine replaces the torque demand (or switches off). The break
         // as TIM1 latched it: TIM1_SR.BIF (bit 7) is set by hardware as soon as the break
@@ -140,12 +175,17 @@ impl Control {
         // `finish_period` reads BIF again before MOE.
         let guards = Guards {
             torque_setpoint: torque,
-            fault: self.tripped,
+            fault: self.tripped || calibrating,
             break_active: pwm::Break(&self.tim1).break_flag(),
             setpoint_timeout: self.setpoint.timed_out(&SETPOINT),
         };
         let (demand, run) =
             commissioning::control_step(&mut self.cordic, &self.measured, &guards, self.omega_e, normal, run);
+        let (demand, run) = if calibrating {
+            (Demand::Off, false)
+        } else {
+            (demand, run)
+        };
         let out = CONTROLLER.process(&mut self.state, &mut self.cordic, &sample, demand);
         self.measured = Measured {
             i_dq: out.i_dq,

@@ -42,6 +42,12 @@ pub struct BoardOut {
     pub amps_per_lsb: f64,
     /// Measurable current ± \[A\].
     pub current_full_scale_a: f64,
+    /// Conversions per phase the image averages at start-up, gates off, for the measured
+    /// zero-current level (`offset_samples` below).
+    pub offset_samples: u32,
+    /// Largest |measured − nominal| zero-current level the image accepts, in 16-bit
+    /// left-aligned codes (`offset_bound_code` below).
+    pub offset_bound_code: i32,
     /// Volts of DC link per 15-bit code: V_REF+/(ratio·2^15).
     pub dc_link_volts_per_lsb: f64,
     /// Measurable DC link \[V\].
@@ -330,6 +336,22 @@ pub(in crate::design) fn board(
             ),
         );
     }
+    if offset_bound_code(board) < OFFSET_BOUND_MIN_CODE {
+        let headroom_a = i_fs - board.over_current_a;
+        refuse(
+            "protection.over_current",
+            format!(
+                "the over-current ceiling {:.1} A leaves {headroom_a:.2} A between the trip and the ±{i_fs:.1} A the sensing measures: the zero-current level measured at start-up could not deviate by even one 12-bit code before the trip left the ADC's range",
+                board.over_current_a
+            ),
+            format!(
+                "an over-current ceiling up to {:.1} A (one 12-bit code, {:.3} A, below full scale), or sensing that measures more",
+                i_fs - f64::from(OFFSET_BOUND_MIN_CODE) / CODES_16 * board.adc_reference_v
+                    / board.current.gain_v_per_a.abs(),
+                f64::from(OFFSET_BOUND_MIN_CODE) / CODES_16 * board.adc_reference_v / board.current.gain_v_per_a.abs()
+            ),
+        );
+    }
     let can_timing = match firmware::can_bit_rate(firmware::FDCAN_CLOCK_HZ, board.can_bit_rate) {
         Ok(t) => Some(t),
         Err(r) => {
@@ -375,6 +397,8 @@ pub(in crate::design) fn board(
         current_offset_code: (board.current.offset_v / board.adc_reference_v * CODES_16).round() as i32,
         amps_per_lsb: board.adc_reference_v / (board.current.gain_v_per_a * CODES_16),
         current_full_scale_a: i_fs,
+        offset_samples: offset_samples(),
+        offset_bound_code: offset_bound_code(board),
         dc_link_volts_per_lsb: board.adc_reference_v / (board.dc_link_divider * CODES_15),
         dc_link_full_scale_v: u_fs,
         dead_time_ns: firmware::dead_time_ns(dead_s),
@@ -414,10 +438,80 @@ pub(in crate::design) fn board(
     Ok((out, warnings))
 }
 
+/// The ADC's noise taken for the offset average \[12-bit LSB rms\]: the ideal 12-bit
+/// quantisation noise is 1/√12 = 0.29 LSB; 1 LSB covers a real conversion's thermal and
+/// reference noise besides (an assumption of this design, not a datasheet figure).
+pub const OFFSET_NOISE_LSB: f64 = 1.0;
+/// Resolution the averaged zero level must reach at 3σ \[12-bit LSB\]: a quarter LSB
+/// (4 of the core's 16-bit codes).
+pub const OFFSET_RESOLUTION_LSB: f64 = 0.25;
+/// Smallest offset bound a board may leave \[16-bit codes\]: one 12-bit code.
+pub const OFFSET_BOUND_MIN_CODE: i32 = 16;
+
+/// Conversions averaged per phase at start-up: the smallest power of two N with
+/// 3·σ/√N ≤ [`OFFSET_RESOLUTION_LSB`] for σ = [`OFFSET_NOISE_LSB`] (standard error of a
+/// mean of N independent samples): N ≥ (3·1/0.25)² = 144 → 256 (moteus, an open STM32G474
+/// drive, averages 256 as well).
+pub fn offset_samples() -> u32 {
+    let n_min = (3.0 * OFFSET_NOISE_LSB / OFFSET_RESOLUTION_LSB).powi(2);
+    let mut n = 1u32;
+    while f64::from(n) < n_min {
+        n *= 2;
+    }
+    n
+}
+
+/// Largest deviation of the measured zero-current level from the board's nominal one
+/// \[16-bit codes\]: the room the sensing leaves between the board's over-current
+/// ceiling and the nearer ADC rail, `min(V_0, V_REF+ − V_0) − |G|·I_oc`, over V_REF+ ·
+/// 2^16 (rounded down). A zero level off by more moves the over-current level out of
+/// what the converter measures on one side (the trip would then see only the rail), and
+/// says the board is not what its file describes (a wrong offset, a dead amplifier, a
+/// sensor without supply).
+pub fn offset_bound_code(board: &Board) -> i32 {
+    let v0 = board.current.offset_v;
+    let room_v = v0.min(board.adc_reference_v - v0) - board.current.gain_v_per_a.abs() * board.over_current_a;
+    (room_v / board.adc_reference_v * CODES_16).floor().max(0.0) as i32
+}
+
 fn pin_code(board: &Board, s: Signal) -> u8 {
     board.pin(s).map_or(u8::MAX, PinUse::code)
 }
 
 fn pin_af(board: &Board, s: Signal) -> u8 {
     board.pin(s).and_then(|p| p.af).unwrap_or(u8::MAX)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn board_of(stem: &str) -> Board {
+        let file = format!("boards/{stem}.toml");
+        let text = std::fs::read_to_string(format!("{}/../../{file}", env!("CARGO_MANIFEST_DIR"))).unwrap();
+        crate::board::parse(crate::Source {
+            file: &file,
+            text: &text,
+        })
+        .unwrap()
+    }
+
+    /// N: (3·1 LSB/0.25 LSB)² = 144 → the next power of two, 256.
+    #[test]
+    fn offset_samples_by_hand() {
+        assert_eq!(offset_samples(), 256);
+    }
+
+    /// Hand calculation per board, 16-bit codes = V/3.3 V·65 536 rounded down:
+    /// * motorgen-reference: min(1.65, 1.65) − 15 mV/A·100 A = 0.150 V → 2978.9 → 2978
+    ///   (186 12-bit codes, 10 A);
+    /// * motorgen-reference-400a: 1.65 − 3.75 mV/A·400 A = 0.150 V → 2978 (40 A);
+    /// * nucleo-g474re-ihm08m1: min(1.71, 1.59) − 51.8 mV/A·25 A = 1.59 − 1.295 = 0.295 V
+    ///   → 5858.5 → 5858 (366 12-bit codes, 5.69 A).
+    #[test]
+    fn offset_bound_by_hand() {
+        assert_eq!(offset_bound_code(&board_of("motorgen-reference")), 2978);
+        assert_eq!(offset_bound_code(&board_of("motorgen-reference-400a")), 2978);
+        assert_eq!(offset_bound_code(&board_of("nucleo-g474re-ihm08m1")), 5858);
+    }
 }
