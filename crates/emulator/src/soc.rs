@@ -108,6 +108,9 @@ pub struct Patches {
     /// FLASH_OPTR reads as nSWBOOT0 = 0 whatever the chip holds: the image's check of
     /// the boot option bytes sees them programmed (the check removed).
     pub optr_reads_programmed: bool,
+    /// ADC_CR writes that start the injected conversions (JADSTART) carry ADEN = 1 as
+    /// well, as the image's former read-modify-write did (issue 26 item 5).
+    pub jadstart_rewrites_aden: bool,
 }
 
 /// A break pulse the test schedules on the comparator.
@@ -747,6 +750,9 @@ impl Soc {
                     if self.patches.single_aden_write && self.aden_writes[k] > 1 {
                         v &= !1;
                     }
+                }
+                if off == 0x08 && v & (1 << 3) != 0 && self.patches.jadstart_rewrites_aden {
+                    v |= 1;
                 }
                 if (off == 0x14 || off == 0x18) && self.patches.slow_channels_2_5_cycles {
                     // Every slow channel's field (all but IN1–IN5) to code 0, 2.5 cycles.

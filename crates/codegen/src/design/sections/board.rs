@@ -384,10 +384,11 @@ pub(in crate::design) fn board(
         io_pins: io.map(|s| pin_code(board, s)),
         io_afs: io.map(|s| pin_af(board, s)),
         adc_channels: board.adc.clone().map(|q| q.iter().map(|x| x.channel).collect()),
-        adc_signals: board
-            .adc
-            .clone()
-            .map(|q| q.iter().map(|x| x.signal.adc_code()).collect()),
+        adc_signals: board.adc.clone().map(|q| {
+            q.iter()
+                .map(|x| if x.padding { u8::MAX } else { x.signal.adc_code() })
+                .collect()
+        }),
         adc_smp: board
             .adc
             .clone()
