@@ -321,6 +321,7 @@ impl Soc {
             sleeping: false,
             wfi_at: None,
         };
+        soc.clocks.hse_crystal_hz = soc.wiring.hw.hse_crystal_hz;
         soc.update_clock();
         soc
     }
@@ -635,7 +636,7 @@ impl Soc {
         let v = match block {
             Block::Tim3 => self.tim3.read(off, t)?,
             Block::Iwdg => self.iwdg.read(off)?,
-            Block::Fdcan => self.fdcan.read(off)?,
+            Block::Fdcan => self.fdcan.read(off, ts)?,
             Block::FdcanRam => self.fdcan.ram[(off / 4) as usize],
             Block::Pwr => self.clocks.pwr_read(off)?,
             Block::Syscfg => self.syscfg.read(off)?,
@@ -719,7 +720,10 @@ impl Soc {
         match block {
             Block::Tim3 => self.tim3.write(off, value, t)?,
             Block::Iwdg => self.iwdg.write(off, value, ts)?,
-            Block::Fdcan => self.fdcan.write(off, value)?,
+            Block::Fdcan => {
+                let kernel = self.clocks.fdcan_kernel_hz();
+                self.fdcan.write(off, value, ts, kernel)?
+            }
             Block::FdcanRam => self.fdcan.ram[(off / 4) as usize] = value,
             Block::Pwr => self.clocks.pwr_write(off, value)?,
             Block::Syscfg => {

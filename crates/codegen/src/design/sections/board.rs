@@ -330,7 +330,7 @@ pub(in crate::design) fn board(
             ),
         );
     }
-    let can_timing = match firmware::can_bit_rate(firmware::FDCAN_CLOCK_HZ, board.can_bit_rate) {
+    let can_timing = match firmware::can_bit_rate(firmware::fdcan_kernel_clock_hz(board.hse_hz), board.can_bit_rate) {
         Ok(t) => Some(t),
         Err(r) => {
             refuse("can.bit_rate", r.problem, r.accepted);
