@@ -998,6 +998,7 @@ impl Soc {
         match e {
             TimerEvent::Trigger => {
                 self.tim1.triggers += 1;
+                self.tim1.last_trigger_at = Some(t);
                 self.tim3.trgo(t);
                 if self.tim1.trgo2_is_oc4ref() && !self.patches.drop_triggers {
                     let ts = t as f64 / UNITS_PER_S;
@@ -1012,7 +1013,7 @@ impl Soc {
                 if let Some(b) = self.tim1.repetition_broken() {
                     self.fail(b);
                 }
-                self.tim1.update();
+                self.tim1.update_at(t);
                 self.bridge_changed(t);
                 if self.tim1.moe() && !self.notes.iter().any(|n| matches!(n, Note::FirstEnabledPeriod(_))) {
                     self.notes.push(Note::FirstEnabledPeriod(t as f64 / UNITS_PER_S));
