@@ -201,8 +201,15 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
                 "{motor}: trigger → compare values active in {ticks} ticks, the design says {design_ticks}"
             );
         }
-        assert!(n as usize + 2 >= counts.len(), "{motor}: {n} measured updates of {} periods", counts.len());
-        assert_eq!(tim1.updates_disabled, 0, "{motor}: an update event fell inside the compare writes");
+        assert!(
+            n as usize + 2 >= counts.len(),
+            "{motor}: {n} measured updates of {} periods",
+            counts.len()
+        );
+        assert_eq!(
+            tim1.updates_disabled, 0,
+            "{motor}: an update event fell inside the compare writes"
+        );
         let loop_delay = rig.design.board.as_ref().unwrap().loop_delay_s;
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
