@@ -802,7 +802,10 @@ impl Soc {
     fn write_tim1(&mut self, off: u32, value: u32, t: u64, ts: f64) -> Result<(), Broken> {
         let moe = self.tim1.moe();
         let mut value = value;
-        if off == 0x00 && value & 1 != 0 {
+        // CR1 written with CEN already set (the image's UDIS around its compare writes)
+        // neither starts the counter again nor changes the outputs.
+        let cen_changes = off == 0x00 && (value ^ self.tim1.reg(0)) & 1 != 0;
+        if off == 0x00 && value & 1 != 0 && cen_changes {
             self.tim1.tick = (UNITS_PER_S / self.clocks.tim_apb2_hz()).round() as u64;
             self.tim1_cursor = [t; 2];
             self.bridge_armed = true;
@@ -829,7 +832,7 @@ impl Soc {
         }
         // Writes that change the outputs now: control, polarity, idle levels, BDTR, modes,
         // a forced update; compare values wait for the update event.
-        if matches!(off, 0x00 | 0x04 | 0x14 | 0x18 | 0x1C | 0x20 | 0x44) {
+        if cen_changes || matches!(off, 0x04 | 0x14 | 0x18 | 0x1C | 0x20 | 0x44) {
             self.bridge_changed(t);
         }
         Ok(())
