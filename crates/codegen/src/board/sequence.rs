@@ -9,7 +9,7 @@
 //! sequence lengths, ADC1 the longer one (the control interrupt runs on ADC1's end of
 //! sequence and then waits for ADC2).
 //!
-//! The two converters then run in lock-step ([`lock_step`]): ES0430 (STM32G47x errata,
+//! The two converters then run in lock-step (`lock_step`): ES0430 (STM32G47x errata,
 //! ADC) — two ADCs converting concurrently disturb each other unless they share the
 //! clock and the hardware trigger (the image's ADC1/ADC2 do: HCLK/4, TIM1_TRGO2) and
 //! every sampling phase of one starts and ends with the other's; moteus (an STM32G474
@@ -56,9 +56,9 @@ pub struct AdcSlot {
     /// Channel number (ADC_JSQR.JSQx).
     pub channel: u8,
     /// The sampling chosen for it: the shortest that settles it, or the longer one the
-    /// other converter's rank needs ([`lock_step`]).
+    /// other converter's rank needs (`lock_step`).
     pub sampling: Sampling,
-    /// A repeat that only keeps the sequences the same length ([`lock_step`]): its
+    /// A repeat that only keeps the sequences the same length (`lock_step`): its
     /// conversion is discarded (signal code `u8::MAX` in the firmware's tables).
     pub padding: bool,
 }

@@ -91,7 +91,7 @@ pub struct BoardOut {
     pub over_speed_electrical_rad_s: f64,
     /// TIM1 ticks from the ADC trigger (TRGO2 = OC4REF at the board's sampling instant)
     /// to the update event that loads the compare values the control step computed from
-    /// that trigger's conversions ([`control_timing`]).
+    /// that trigger's conversions (`control_timing`).
     pub trigger_to_update_ticks: u32,
     /// The loop delay this timing makes \[s\]: trigger → update plus half a period, the
     /// mean delay of the voltage held over the period after the update (thesis A §4.6).
@@ -484,7 +484,7 @@ pub fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64) -> ControlTim
     }
 }
 
-/// [`control_timing`]'s figures.
+/// `control_timing`'s figures.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ControlTiming {
     /// TIM1 ticks from the ADC trigger to the update that loads the step's compare values.
