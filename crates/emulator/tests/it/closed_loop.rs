@@ -241,7 +241,8 @@ fn bus_off_under_torque(rig: &mut Rig, name: &str, step: Option<&Outcome>, windo
     // Silence at least until the recovery (128 × 11 bits after the image clears INIT, at
     // its next main-loop pass) is over, however short the step's window.
     let recovery = motor_emulator::periph::fdcan::RECOVERY_BITS / board.can_bit_rate + 3.0 * rig.pwm_period_s();
-    rig.run(t_b + tau.max(recovery), |_| None, |_| false)
+    // Two periods beyond, so that a drive sample at or after t_b + τ exists.
+    rig.run(t_b + tau.max(recovery) + 2.0 * rig.pwm_period_s(), |_| None, |_| false)
         .unwrap_or_else(|e| panic!("{name}: bus-off: {e}"));
     let fdcan = &rig.machine.soc().fdcan;
     assert_eq!(
