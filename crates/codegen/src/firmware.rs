@@ -25,10 +25,20 @@ use serde::Serialize;
 /// `board::TIMER_CLOCK_HZ` equals it.
 pub const TIMER_CLOCK_HZ: u32 = 170_000_000;
 
-/// FDCAN kernel clock \[Hz\]: PCLK1 = 170 MHz (RCC_CCIPR.FDCANSEL = 0b10, RM0440 §7.4.26).
-/// An input of the bit-timing computation ([`can_bit_timing`]), not a literal inside it:
-/// a board whose FDCAN runs from another clock (its HSE crystal) passes that clock.
+/// FDCAN kernel clock \[Hz\] of a board without an HSE crystal: PCLK1 = 170 MHz
+/// (RCC_CCIPR.FDCANSEL = 0b10, RM0440 §7.4.26). An input of the bit-timing computation
+/// ([`can_bit_timing`]), not a literal inside it: see [`fdcan_kernel_clock_hz`].
 pub const FDCAN_CLOCK_HZ: u32 = 170_000_000;
+
+/// FDCAN1's kernel clock \[Hz\] on a board with the HSE crystal `hse_hz` (`None`: none):
+/// the crystal where there is one (RCC_CCIPR.FDCANSEL = 0b00, RM0440 §7.4.26) — an RC
+/// oscillator's tolerance (HSI16, behind the PLL in PCLK1) takes most of what CAN's bit
+/// timing tolerates at the 87.5 % sample point (ISO 11898-1), a crystal's tens of ppm
+/// almost none — else PCLK1 ([`FDCAN_CLOCK_HZ`]). The image makes the same choice
+/// (`firmware/config/src/hw.rs`, `FDCAN_FROM_HSE`).
+pub fn fdcan_kernel_clock_hz(hse_hz: Option<f64>) -> u32 {
+    hse_hz.map_or(FDCAN_CLOCK_HZ, |f| f.round() as u32)
+}
 
 /// LSI clock of the independent watchdog \[Hz\] (DS12288 Table 56, typical 32 kHz); the
 /// firmware's `hw::LSI_HZ`.
@@ -672,6 +682,17 @@ mod tests {
         assert_eq!(can_bit_timing(170_000_000, 500.5e3), None);
         // A kernel clock is an input: an 8 MHz HSE makes 500 kbit/s with 16 quanta
         // (prescaler 1): 1 + TSEG1 = 14 → 87.5 % exactly.
+        // A board with a crystal times FDCAN from it, one without from PCLK1; the
+        // NUCLEO-G474RE's 24 MHz at 500 kbit/s: 48 quanta, 1 + 41 + 6 → 87.5 %, NBTP
+        // 0x0A00_2805 (NSJW 5, NBRP 0, NTSEG1 40, NTSEG2 5).
+        assert_eq!(fdcan_kernel_clock_hz(None), 170_000_000);
+        assert_eq!(fdcan_kernel_clock_hz(Some(24e6)), 24_000_000);
+        let nucleo = can_bit_timing(24_000_000, 500e3).unwrap();
+        assert_eq!(
+            (nucleo.prescaler, nucleo.tq_per_bit, nucleo.tseg1, nucleo.tseg2),
+            (1, 48, 41, 6)
+        );
+        assert_eq!(nucleo.nbtp, 0x0A00_2805);
         let hse = can_bit_timing(8_000_000, 500e3).unwrap();
         assert_eq!((hse.prescaler, hse.tq_per_bit, hse.tseg1, hse.tseg2), (1, 16, 13, 2));
         assert!((hse.sample_point - 0.875).abs() < 1e-12);

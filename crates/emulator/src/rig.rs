@@ -19,6 +19,9 @@ pub const OPTR_FACTORY: u32 = 0xFFEF_F8AA;
 /// README, "Option bytes"): the delivered value with nSWBOOT0 (bit 26) programmed to 0 and
 /// nBOOT0 (bit 27) left at 1.
 pub const OPTR_BOOT_FROM_FLASH: u32 = OPTR_FACTORY & !OPTR_NSWBOOT0;
+/// First word of a valid fault record of layout version 2, "MFR2" (firmware README
+/// "Fault record"; version 2 added the CAN bus-off count).
+pub const FAULT_RECORD_MAGIC: u32 = 0x4D46_5232;
 
 /// What a rig runs: a motor's image built from a board file, on a board's hardware.
 #[derive(Clone, Debug)]
@@ -157,7 +160,7 @@ impl Rig {
     /// firmware README "Fault record"), if the record is valid.
     pub fn fault_cause(&self) -> Option<String> {
         let at = self.machine.symbol("MOTOR_FAULT_RECORD")?;
-        if self.machine.peek(at).ok()? != 0x4D46_5231 {
+        if self.machine.peek(at).ok()? != FAULT_RECORD_MAGIC {
             return None;
         }
         let cause = self.machine.peek(at + 4).ok()?;
@@ -175,6 +178,14 @@ impl Rig {
             _ => "unknown",
         };
         Some(format!("{cause} ({name})"))
+    }
+
+    /// The CAN bus-off count the control interrupt last wrote into its state
+    /// (`MOTOR_CONTROL_STATE` word 6, firmware README "Fault record"), if written.
+    pub fn bus_off_count(&self) -> Option<u32> {
+        let at = self.machine.symbol("MOTOR_CONTROL_STATE")?;
+        let flags = self.machine.peek(at + 4 * 7).ok()?;
+        (flags >> 31 == 1).then(|| self.machine.peek(at + 4 * 6).ok()).flatten()
     }
 
     /// The standstill analog source, to change currents or the DC link.
@@ -195,7 +206,8 @@ impl Rig {
 
     /// Puts a frame on the bus now.
     pub fn send(&mut self, f: &Frame) {
-        self.machine.soc_mut().fdcan.receive(f);
+        let now = self.machine.soc().time_s();
+        self.machine.soc_mut().fdcan.receive(f, now);
     }
 
     /// Runs to `until_s`, sending `torque(t)` every setpoint period (none while it

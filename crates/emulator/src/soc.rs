@@ -108,6 +108,9 @@ pub struct Patches {
     /// FLASH_OPTR reads as nSWBOOT0 = 0 whatever the chip holds: the image's check of
     /// the boot option bytes sees them programmed (the check removed).
     pub optr_reads_programmed: bool,
+    /// ADC_CR writes that start the injected conversions (JADSTART) carry ADEN = 1 as
+    /// well, as the image's former read-modify-write did (issue 26 item 5).
+    pub jadstart_rewrites_aden: bool,
 }
 
 /// A break pulse the test schedules on the comparator.
@@ -318,6 +321,7 @@ impl Soc {
             sleeping: false,
             wfi_at: None,
         };
+        soc.clocks.hse_crystal_hz = soc.wiring.hw.hse_crystal_hz;
         soc.update_clock();
         soc
     }
@@ -632,7 +636,7 @@ impl Soc {
         let v = match block {
             Block::Tim3 => self.tim3.read(off, t)?,
             Block::Iwdg => self.iwdg.read(off)?,
-            Block::Fdcan => self.fdcan.read(off)?,
+            Block::Fdcan => self.fdcan.read(off, ts)?,
             Block::FdcanRam => self.fdcan.ram[(off / 4) as usize],
             Block::Pwr => self.clocks.pwr_read(off)?,
             Block::Syscfg => self.syscfg.read(off)?,
@@ -716,7 +720,10 @@ impl Soc {
         match block {
             Block::Tim3 => self.tim3.write(off, value, t)?,
             Block::Iwdg => self.iwdg.write(off, value, ts)?,
-            Block::Fdcan => self.fdcan.write(off, value)?,
+            Block::Fdcan => {
+                let kernel = self.clocks.fdcan_kernel_hz();
+                self.fdcan.write(off, value, ts, kernel)?
+            }
             Block::FdcanRam => self.fdcan.ram[(off / 4) as usize] = value,
             Block::Pwr => self.clocks.pwr_write(off, value)?,
             Block::Syscfg => {
@@ -747,6 +754,9 @@ impl Soc {
                     if self.patches.single_aden_write && self.aden_writes[k] > 1 {
                         v &= !1;
                     }
+                }
+                if off == 0x08 && v & (1 << 3) != 0 && self.patches.jadstart_rewrites_aden {
+                    v |= 1;
                 }
                 if (off == 0x14 || off == 0x18) && self.patches.slow_channels_2_5_cycles {
                     // Every slow channel's field (all but IN1–IN5) to code 0, 2.5 cycles.
@@ -792,7 +802,10 @@ impl Soc {
     fn write_tim1(&mut self, off: u32, value: u32, t: u64, ts: f64) -> Result<(), Broken> {
         let moe = self.tim1.moe();
         let mut value = value;
-        if off == 0x00 && value & 1 != 0 {
+        // CR1 written with CEN already set (the image's UDIS around its compare writes)
+        // neither starts the counter again nor changes the outputs.
+        let cen_changes = off == 0x00 && (value ^ self.tim1.reg(0)) & 1 != 0;
+        if off == 0x00 && value & 1 != 0 && cen_changes {
             self.tim1.tick = (UNITS_PER_S / self.clocks.tim_apb2_hz()).round() as u64;
             self.tim1_cursor = [t; 2];
             self.bridge_armed = true;
@@ -819,7 +832,7 @@ impl Soc {
         }
         // Writes that change the outputs now: control, polarity, idle levels, BDTR, modes,
         // a forced update; compare values wait for the update event.
-        if matches!(off, 0x00 | 0x04 | 0x14 | 0x18 | 0x1C | 0x20 | 0x44) {
+        if cen_changes || matches!(off, 0x04 | 0x14 | 0x18 | 0x1C | 0x20 | 0x44) {
             self.bridge_changed(t);
         }
         Ok(())
@@ -988,6 +1001,7 @@ impl Soc {
         match e {
             TimerEvent::Trigger => {
                 self.tim1.triggers += 1;
+                self.tim1.last_trigger_at = Some(t);
                 self.tim3.trgo(t);
                 if self.tim1.trgo2_is_oc4ref() && !self.patches.drop_triggers {
                     let ts = t as f64 / UNITS_PER_S;
@@ -1002,7 +1016,7 @@ impl Soc {
                 if let Some(b) = self.tim1.repetition_broken() {
                     self.fail(b);
                 }
-                self.tim1.update();
+                self.tim1.update_at(t);
                 self.bridge_changed(t);
                 if self.tim1.moe() && !self.notes.iter().any(|n| matches!(n, Note::FirstEnabledPeriod(_))) {
                     self.notes.push(Note::FirstEnabledPeriod(t as f64 / UNITS_PER_S));

@@ -118,9 +118,13 @@ mod tests {
         assert_eq!(nbtp_bit_rate(170_000_000, 0x0A10_0E03), None);
         assert_eq!(nbtp_bit_rate(170_000_000, 0x0602_0E03), None);
         assert_eq!(
-            nbtp_bit_rate(170_000_000, board::CAN_NBTP),
+            nbtp_bit_rate(crate::hw::FDCAN_CLOCK_HZ, board::CAN_NBTP),
             Some(board::CAN_BIT_RATE),
-            "the generated timing makes the board's rate"
+            "the generated timing makes the board's rate from the image's kernel clock"
         );
+        // The NUCLEO-G474RE's 24 MHz HSE crystal at 500 kbit/s: 48 quanta, prescaler 1,
+        // 1 + 41 + 6 → sample point 42/48 = 87.5 % (CiA 601-3); NBTP = NSJW 5 << 25 |
+        // NBRP 0 << 16 | NTSEG1 40 << 8 | NTSEG2 5 = 0x0A00_2805 (hand calculation).
+        assert_eq!(nbtp_bit_rate(24_000_000, 0x0A00_2805), Some(500_000));
     }
 }

@@ -64,6 +64,7 @@ mod tests {
             omega_e: 0.0,
             u_dc: 600.0,
             periods: 1,
+            bus_off: 0,
             running: true,
             tripped: true,
         }

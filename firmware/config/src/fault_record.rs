@@ -25,10 +25,12 @@ use motor_control::can_protocol::Crc32;
 /// ([`STATE_WORDS`]), CRC.
 pub const RECORD_WORDS: usize = 6 + STATE_WORDS + 1;
 /// Words of the live control state.
-pub const STATE_WORDS: usize = 7;
-/// First word of a sealed record ("MFR1" in ASCII, little-endian bytes `1RFM`): a
-/// version of this layout; a record of another layout fails the check.
-pub const MAGIC: u32 = 0x4D46_5231;
+pub const STATE_WORDS: usize = 8;
+/// First word of a sealed record ("MFR2" in ASCII, little-endian bytes `2RFM`): a
+/// version of this layout; a record of another layout fails the check. Version 2 (issue
+/// 26) added the CAN bus-off count to the state; a version-1 record (`MFR1`, 14 words)
+/// left by an older image is not read.
+pub const MAGIC: u32 = 0x4D46_5232;
 
 /// Why the outputs were switched off. The numbers are the record's and the CAN
 /// frame's encoding (never reuse one).
@@ -104,6 +106,9 @@ pub struct ControlState {
     pub u_dc: f32,
     /// Control periods run since start-up (wrapping).
     pub periods: u32,
+    /// CAN bus-off events the drive recovered from since start-up (FDCAN_PSR.BO, RM0440
+    /// §44.3.1 "Bus-off recovery"; saturating).
+    pub bus_off: u32,
     /// The outputs were switched on in that period.
     pub running: bool,
     /// A trip or break was latched.
@@ -129,13 +134,14 @@ impl ControlState {
             self.omega_e.to_bits(),
             self.u_dc.to_bits(),
             self.periods,
+            self.bus_off,
             flags,
         ]
     }
 
     /// The state of written words, `None` if the control interrupt never wrote them.
     pub fn from_words(w: &[u32; STATE_WORDS]) -> Option<Self> {
-        let [i_d, i_q, theta_e, omega_e, u_dc, periods, flags] = *w;
+        let [i_d, i_q, theta_e, omega_e, u_dc, periods, bus_off, flags] = *w;
         (flags & STATE_WRITTEN != 0).then_some(Self {
             i_d: f32::from_bits(i_d),
             i_q: f32::from_bits(i_q),
@@ -143,6 +149,7 @@ impl ControlState {
             omega_e: f32::from_bits(omega_e),
             u_dc: f32::from_bits(u_dc),
             periods,
+            bus_off,
             running: flags & STATE_RUNNING != 0,
             tripped: flags & STATE_TRIPPED != 0,
         })
@@ -304,6 +311,7 @@ mod tests {
                 omega_e: 1234.5,
                 u_dc: 598.0,
                 periods: 40_000,
+                bus_off: 2,
                 running: true,
                 tripped: true,
             }),
@@ -347,11 +355,17 @@ mod tests {
     #[test]
     fn layout() {
         let w = record().to_words();
-        assert_eq!(w[0], 0x4D46_5231);
+        // "MFR2": 'M' 0x4D, 'F' 0x46, 'R' 0x52, '2' 0x32.
+        assert_eq!(w[0], 0x4D46_5232);
         assert_eq!(w[1], 4);
         assert_eq!(w[2], 0b011);
         assert_eq!(w[3], 0x0800_1234);
         assert_eq!(w[7], 212.25f32.to_bits());
+        // Words 6–13 the state (README "Fault record"): periods in 11, bus-off count in
+        // 12, the flags (bit 31 written) in 13, the CRC in 14.
+        assert_eq!(RECORD_WORDS, 15);
+        assert_eq!((w[11], w[12]), (40_000, 2));
+        assert_eq!(w[13] >> 31, 1);
         assert_eq!(w[RECORD_WORDS - 1], crc32_words(&w[..RECORD_WORDS - 1]));
     }
 

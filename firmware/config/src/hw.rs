@@ -19,10 +19,24 @@ pub const ADC_CLOCK_HZ: u32 = SYSCLK_HZ / 4;
 pub const ADC_BITS: u32 = 12;
 /// LSI clock of the independent watchdog \[Hz\] (DS12288 Table 56, typical).
 pub const LSI_HZ: u32 = 32_000;
-/// FDCAN kernel clock \[Hz\]: PCLK1 (RCC_CCIPR.FDCANSEL = 0b10). The generated
-/// `board::CAN_NBTP` is computed from it (`board::FDCAN_CLOCK_HZ`, checked equal at
-/// compile time).
-pub const FDCAN_CLOCK_HZ: u32 = SYSCLK_HZ;
+/// FDCAN kernel clock \[Hz\]: the board's HSE crystal where it has one (RCC_CCIPR.FDCANSEL
+/// = 0b00, RM0440 §7.4.26) — a crystal's tens of ppm against HSI16's percent-level
+/// accuracy over temperature (DS12288, HSI16 oscillator characteristics), which takes
+/// most of what CAN's bit timing tolerates at the 87.5 % sample point (ISO 11898-1's
+/// oscillator tolerance: min(SJW/(20·NBT), min(TSEG1, TSEG2)/(2·(13·NBT − TSEG2))) ≈
+/// 0.5 % for 500 kbit/s from 24 MHz, 48 quanta, TSEG2 = SJW = 6) — else PCLK1 (0b10; the
+/// PLL from HSI16). The generated `board::CAN_NBTP`
+/// is computed from the same choice (`board::FDCAN_CLOCK_HZ`, checked equal at compile
+/// time).
+pub const FDCAN_CLOCK_HZ: u32 = if FDCAN_FROM_HSE {
+    crate::motor::board::HSE_HZ
+} else {
+    SYSCLK_HZ
+};
+/// FDCAN timed from the board's HSE crystal (`motor::board::HSE_HZ` ≠ 0).
+pub const FDCAN_FROM_HSE: bool = crate::motor::board::HSE_HZ != 0;
+/// RCC_CCIPR.FDCANSEL: 0b00 HSE, 0b10 PCLK1 (RM0440 §7.4.26).
+pub const FDCANSEL: u8 = if FDCAN_FROM_HSE { 0b00 } else { 0b10 };
 
 /// PLL input divider M (HSI16/4 = 4 MHz, within RM0440's 2.66–8 MHz).
 pub const PLL_M: u32 = 4;

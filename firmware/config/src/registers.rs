@@ -230,6 +230,33 @@ pub const fn bdtr(dtg: u8, break_active_high: bool, break_filter: u8, lock: u8) 
     dtg | lock | ossi | ossr | bke | bkp | bkf
 }
 
+/// ADC_CR.ADEN (RM0440 §21.7.3).
+pub const ADC_CR_ADEN: u32 = 1;
+/// ADC_CR.JADSTART (RM0440 §21.7.3).
+pub const ADC_CR_JADSTART: u32 = 1 << 3;
+/// ADC_CR.ADCAL (RM0440 §21.7.3).
+pub const ADC_CR_ADCAL: u32 = 1 << 31;
+/// ADC_CR.DEEPPWD (RM0440 §21.7.3): deep power-down, 1 after reset.
+pub const ADC_CR_DEEPPWD: u32 = 1 << 29;
+/// ADC_CR.ADVREGEN (RM0440 §21.7.3): the ADC's voltage regulator.
+pub const ADC_CR_ADVREGEN: u32 = 1 << 28;
+/// ADC_CR.ADCALDIF (RM0440 §21.7.3): 0 calibrates the single-ended inputs.
+pub const ADC_CR_ADCALDIF: u32 = 1 << 30;
+/// ADC_CR's set-only ("rs") bits: ADCAL, JADSTP, ADSTP, JADSTART, ADSTART, ADDIS, ADEN
+/// (RM0440 §21.7.3; ST's LL calls the set `ADC_CR_BITS_PROPERTY_RS`).
+pub const ADC_CR_SET_ONLY: u32 = ADC_CR_ADCAL | 0x3F;
+
+/// The ADC_CR value that commands `bit` (one of the set-only bits) and nothing else, from
+/// the register's current value `cr`: the read/write bits (DEEPPWD, ADVREGEN, ADCALDIF)
+/// kept, every other set-only bit written 0 (a 0 has no effect on them, RM0440 §21.7.3).
+/// A read-modify-write instead writes back the ADEN that reads 1 next to the command —
+/// re-enabling an enabled converter, which ST's HAL warns against; ST's LL does the
+/// same masking (`MODIFY_REG(ADCx->CR, ADC_CR_BITS_PROPERTY_RS, bit)` in
+/// `LL_ADC_INJ_StartConversion`, `LL_ADC_Enable`, `LL_ADC_StartCalibration`).
+pub const fn adc_cr_command(cr: u32, bit: u32) -> u32 {
+    (cr & !ADC_CR_SET_ONLY) | (bit & ADC_CR_SET_ONLY)
+}
+
 /// TIMx_BDTR.LOCK level 1: DTG, BKE, BKP, AOE, OSSI, OSSR and BKF cannot be written
 /// again until reset (RM0440, TIMx_BDTR).
 pub const LOCK_LEVEL_1: u8 = 0b01;
@@ -309,6 +336,22 @@ pub const fn boots_from_flash_regardless_of_pb8(optr: u32) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An enabled, calibrated converter (DEEPPWD 0, ADVREGEN 1 = bit 28, ADCALDIF 0, ADEN
+    /// 1): JADSTART is written as 0x1000_0008 — the regulator kept, ADEN not written
+    /// again (hand-assembled from RM0440 §21.7.3's bit positions). A converter in deep
+    /// power-down with the differential-calibration bit (0x6000_0000) keeps both.
+    #[test]
+    fn adc_cr_commands_write_only_their_bit() {
+        assert_eq!(adc_cr_command(0x1000_0001, ADC_CR_JADSTART), 0x1000_0008);
+        assert_eq!(adc_cr_command(0x1000_0000, ADC_CR_ADEN), 0x1000_0001);
+        assert_eq!(adc_cr_command(0x1000_0000, ADC_CR_ADCAL), 0x9000_0000);
+        assert_eq!(adc_cr_command(0x6000_0000, 0), 0x6000_0000);
+        // A running injected sequence (JADSTART reads 1) is not re-started by ADEN.
+        assert_eq!(adc_cr_command(0x1000_0009, ADC_CR_ADEN), 0x1000_0001);
+        // Only set-only bits are commands: a read/write bit passed as `bit` is dropped.
+        assert_eq!(adc_cr_command(0x1000_0001, 1 << 29), 0x1000_0000);
+    }
 
     /// The reference board's gates PA8, PA9, PA10 (AF6), PB13, PB14 (AF6), PB15 (AF4):
     /// hand-assembled register values (RM0440 GPIO registers): port A MODER bits 16–21 = 10 10 10

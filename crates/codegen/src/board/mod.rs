@@ -642,7 +642,7 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
     let c = raw.can.get_ref();
     let bit_rate = q(cx, &mut spans, "can.bit_rate", &c.bit_rate, Kind::BitRate);
     if let Some(b) = &bit_rate
-        && let Err(r) = firmware::can_bit_rate(firmware::FDCAN_CLOCK_HZ, b.value)
+        && let Err(r) = firmware::can_bit_rate(firmware::fdcan_kernel_clock_hz(hse), b.value)
     {
         cx.err(b.span.clone(), "can.bit_rate", r.problem, r.accepted);
     }

@@ -8,6 +8,16 @@
 //! trigger, and low-side shunts carry the current only inside the low-side pulse); equal
 //! sequence lengths, ADC1 the longer one (the control interrupt runs on ADC1's end of
 //! sequence and then waits for ADC2).
+//!
+//! The two converters then run in lock-step (`lock_step`): ES0430 (STM32G47x errata,
+//! ADC) — two ADCs converting concurrently disturb each other unless they share the
+//! clock and the hardware trigger (the image's ADC1/ADC2 do: HCLK/4, TIM1_TRGO2) and
+//! every sampling phase of one starts and ends with the other's; moteus (an STM32G474
+//! drive, `fw/bldc_servo.cc`) cites ES0430 §2.7.11 for this and converts one rank on
+//! every ADC. So both sequences get the same number of ranks (the shorter padded with a
+//! repeat of its last channel whose code the firmware ignores) and each rank the longer
+//! of the two sampling times (longer sampling settles an input at least as well,
+//! DS12288 Table 67).
 
 use serde::Serialize;
 
@@ -45,8 +55,41 @@ pub struct AdcSlot {
     pub pin: &'static str,
     /// Channel number (ADC_JSQR.JSQx).
     pub channel: u8,
-    /// The sampling chosen for it.
+    /// The sampling chosen for it: the shortest that settles it, or the longer one the
+    /// other converter's rank needs (`lock_step`).
     pub sampling: Sampling,
+    /// A repeat that only keeps the sequences the same length (`lock_step`): its
+    /// conversion is discarded (signal code `u8::MAX` in the firmware's tables).
+    pub padding: bool,
+}
+
+/// ES0430's lock-step (module documentation): the shorter sequence padded with repeats
+/// of its last rank, each rank's sampling the longer of the two converters'.
+pub fn lock_step(mut seqs: [Vec<AdcSlot>; 2]) -> [Vec<AdcSlot>; 2] {
+    let n = seqs[0].len().max(seqs[1].len());
+    for q in &mut seqs {
+        while let Some(last) = q.last().filter(|_| q.len() < n) {
+            let pad = AdcSlot {
+                padding: true,
+                ..last.clone()
+            };
+            q.push(pad);
+        }
+    }
+    for k in 0..n {
+        let [a, b] = &mut seqs;
+        let (Some(x), Some(y)) = (a.get_mut(k), b.get_mut(k)) else {
+            continue;
+        };
+        if x.sampling.cycles < y.sampling.cycles {
+            x.sampling.smp_code = y.sampling.smp_code;
+            x.sampling.cycles = y.sampling.cycles;
+        } else {
+            y.sampling.smp_code = x.sampling.smp_code;
+            y.sampling.cycles = x.sampling.cycles;
+        }
+    }
+    seqs
 }
 
 /// Rank order within one converter: currents, resolver, DC link.
@@ -164,6 +207,7 @@ pub(super) fn plan(
                         pin: p.pin,
                         channel,
                         sampling: s,
+                        padding: false,
                     });
                 }
                 Err(e) => {
@@ -192,5 +236,49 @@ pub(super) fn plan(
         );
         ok = false;
     }
-    ok.then_some(out)
+    ok.then(|| lock_step(out))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn slot(signal: Signal, channel: u8, smp_code: u8, cycles: f64) -> AdcSlot {
+        AdcSlot {
+            signal,
+            pin: "PA0",
+            channel,
+            sampling: Sampling {
+                fast: true,
+                source_resistance_ohm: 100.0,
+                table_time_s: 0.0,
+                settling_time_s: 0.0,
+                smp_code,
+                cycles,
+            },
+            padding: false,
+        }
+    }
+
+    /// Three ranks against two (a board measuring two phase currents): ADC2 gets a
+    /// third rank repeating its last channel, marked padding; rank by rank both take the
+    /// longer sampling (codes of RM0440 §21.7.6: 3 = 24.5, 6 = 247.5
+    /// cycles).
+    #[test]
+    fn shorter_sequence_padded_and_longer_sampling_shared() {
+        let a = vec![
+            slot(Signal::CurrentU, 1, 3, 24.5),
+            slot(Signal::ResolverSin, 2, 3, 24.5),
+            slot(Signal::DcLink, 12, 6, 247.5),
+        ];
+        let b = vec![slot(Signal::CurrentV, 3, 3, 24.5), slot(Signal::ResolverCos, 4, 0, 2.5)];
+        let [a, b] = lock_step([a, b]);
+        assert_eq!(b.len(), 3);
+        assert!(b[2].padding && !b[1].padding && !a.iter().any(|s| s.padding));
+        assert_eq!((b[2].channel, b[2].signal), (4, Signal::ResolverCos));
+        let cycles = |q: &[AdcSlot]| q.iter().map(|s| s.sampling.cycles).collect::<Vec<_>>();
+        assert_eq!(cycles(&a), [24.5, 24.5, 247.5]);
+        assert_eq!(cycles(&b), [24.5, 24.5, 247.5]);
+        assert_eq!(b[2].sampling.smp_code, 6);
+    }
 }

@@ -111,9 +111,11 @@ impl<'a> OnBoard<'a> {
                 let f = c.o.can_timing.kernel_clock_hz;
                 (intv(f.into(), "u32", "uint32_t"), phys(f64::from(f), "Hz"))
             }),
-            formula: Lit("FDCAN kernel clock the bit timing is computed from: PCLK1 (RCC_CCIPR.FDCANSEL = 0b10)"),
+            formula: Lit(
+                "FDCAN kernel clock the bit timing is computed from: the board's HSE crystal (RCC_CCIPR.FDCANSEL = 0b00), else PCLK1 (0b10)",
+            ),
             equation: Lit("RM0440 §7.4.26"),
-            inputs: Lit("the firmware's clock tree"),
+            inputs: Of(|c| c.key("clock.hse")),
             json: Json::None,
         },
         Decl {

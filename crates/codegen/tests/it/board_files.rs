@@ -297,3 +297,24 @@ fn a_board_value_overflowing_with_the_motor_is_located_at_its_key() {
         );
     }
 }
+
+/// ES0430 (STM32G47x errata), ADC: two ADCs converting concurrently disturb each other's
+/// conversions unless they run in lock-step — same clock, same hardware trigger (as the
+/// image's ADC1/ADC2 on HCLK/4 and TIM1_TRGO2 are) and, with sequences, the same number
+/// of ranks with the same sampling time rank by rank, so that every sampling phase of
+/// one starts and ends with the other's (moteus, `fw/bldc_servo.cc`, cites ES0430
+/// §2.7.11 for the simultaneous trigger and converts one rank on every ADC). Property of
+/// every board's plan: equal lengths, equal cycles per rank.
+#[test]
+fn both_converters_run_in_lock_step() {
+    for stem in motor_test_support::board_stems() {
+        let path = repo().join(format!("boards/{stem}.toml"));
+        let (_, r) = parse(&path);
+        let b = r.unwrap_or_else(|d| panic!("{}: {d}", path.display()));
+        let [a1, a2] = &b.adc;
+        assert_eq!(a1.len(), a2.len(), "{stem}: ranks of ADC1 {a1:?} and ADC2 {a2:?}");
+        for (k, (x, y)) in a1.iter().zip(a2).enumerate() {
+            assert_eq!(x.sampling.cycles, y.sampling.cycles, "{stem}: rank {} sampling", k + 1);
+        }
+    }
+}

@@ -154,6 +154,9 @@ pub struct Hardware {
     /// PB8 (BOOT0) may be high at a reset: it carries a CAN transceiver's RXD, which
     /// idles high (recessive).
     pub boot0_may_be_high: bool,
+    /// The HSE crystal on OSC_IN/OSC_OUT \[Hz\], `None` where none is fitted: HSERDY
+    /// follows HSEON only with one (RM0440 §7.4.1).
+    pub hse_crystal_hz: Option<f64>,
 }
 
 /// The boards this crate has a hardware description of, by board-file stem.

@@ -120,6 +120,9 @@ pub fn hardware() -> Hardware {
         excitation_pin: "PC6", // add-on excitation amplifier on CN10-4
         // The add-on's CAN transceiver RXD on CN10-3 → PB8 idles high.
         boot0_may_be_high: true,
+        // NUCLEO-G474RE: X3, a 24 MHz crystal on PF0/PF1 (UM2505 §6.7.1 "HSE clock
+        // (high-speed external clock)": the 24 MHz crystal is fitted by default).
+        hse_crystal_hz: Some(24e6),
     }
 }
 

@@ -83,5 +83,7 @@ fn with_sensing(board: &'static str, variant_of: Option<&'static str>, sensitivi
         excitation_pin: "PC6",
         // CAN RX on PB8: the transceiver's RXD idles high.
         boot0_may_be_high: true,
+        // No crystal: the reference design clocks the MCU from HSI16 only.
+        hse_crystal_hz: None,
     }
 }

@@ -280,6 +280,18 @@ impl Adc {
         }
         // ADCAL, JADSTP, ADSTP, JADSTART, ADSTART, ADDIS, ADEN are set-only ("rs": writing
         // 0 has no effect, RM0440 §21.7.3); ADVREGEN, DEEPPWD, ADCALDIF read/write.
+        // Writing 1 again to one that reads 1 is a read-modify-write carrying an old
+        // command next to a new one (ADEN re-written with JADSTART, which ST's HAL warns
+        // against; ST's LL masks the set-only bits: `ADC_CR_BITS_PROPERTY_RS`).
+        let again = value & old & RS_BITS;
+        if again != 0 {
+            return Err(Broken::new(
+                reg,
+                format!(
+                    "ADC_CR written with set-only bits that already read 1 (0x{again:08X}, e.g. ADEN re-written with JADSTART): write only the command meant (RM0440 §21.7.3; ST's LL masks ADC_CR_BITS_PROPERTY_RS)"
+                ),
+            ));
+        }
         let mut v = (value & !RS_BITS) | (old & RS_BITS) | (value & RS_BITS);
         let set = v & !old;
         if set & ADVREGEN != 0 && value & DEEPPWD != 0 {

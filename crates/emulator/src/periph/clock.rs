@@ -25,6 +25,8 @@ pub struct Clocks {
     flash: [u32; 0x80 / 4],
     /// Time HPRE last changed and whether it was the /2 step \[s\].
     hpre_step_at: Option<f64>,
+    /// The board's HSE crystal \[Hz\], if fitted ([`crate::hardware::Hardware`]).
+    pub hse_crystal_hz: Option<f64>,
 }
 
 const fn word(off: u32) -> usize {
@@ -54,6 +56,7 @@ impl Clocks {
             pwr: [0; 0x100 / 4],
             flash: [0; 0x80 / 4],
             hpre_step_at: None,
+            hse_crystal_hz: None,
         };
         // RM0440 §7.4.1 RCC_CR reset 0x0000_0500: HSION, HSIRDY.
         c.rcc[0] = 0x0000_0500;
@@ -112,6 +115,23 @@ impl Clocks {
         let div = if hpre < 8 { 1 } else { 2u32 << (hpre - 8).min(3) };
         let div = if hpre >= 12 { 64u32 << (hpre - 12) } else { div };
         self.sysclk_hz() / f64::from(div)
+    }
+
+    /// FDCAN's kernel clock \[Hz\] from RCC_CCIPR.FDCANSEL (RM0440 §7.4.26): 0b00 HSE
+    /// (0 unless HSERDY), 0b10 PCLK1 (= HCLK: the image leaves APB1 undivided; PPRE1
+    /// divides it otherwise, §7.4.3); 0b01 PLL "Q" is not modelled (0).
+    pub fn fdcan_kernel_hz(&self) -> f64 {
+        let ppre1 = (self.rcc[word(0x08)] >> 8) & 7;
+        let pclk1 = if ppre1 < 4 {
+            self.hclk_hz()
+        } else {
+            self.hclk_hz() / f64::from(1u32 << (ppre1 - 3))
+        };
+        match (self.rcc[word(0x88)] >> 24) & 3 {
+            0 if self.rcc[0] & (1 << 17) != 0 => self.hse_crystal_hz.unwrap_or(0.0),
+            2 => pclk1,
+            _ => 0.0,
+        }
     }
 
     /// PCLK2 \[Hz\] and TIM1's kernel clock (×2 when APB2 is divided, RM0440 §7.2.17).
@@ -226,6 +246,11 @@ impl Clocks {
                 }
                 if v & (1 << 8) != 0 {
                     v |= 1 << 10;
+                }
+                // HSERDY follows HSEON with a crystal fitted (start-up time not
+                // modelled); without one it never comes.
+                if v & (1 << 16) != 0 && self.hse_crystal_hz.is_some() {
+                    v |= 1 << 17;
                 }
                 self.rcc[0] = v;
             }

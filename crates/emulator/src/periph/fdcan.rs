@@ -1,7 +1,12 @@
 //! FDCAN1 (RM0440 §44) as a receiver of classic frames: configuration protection
 //! (INIT/CCE), the global filter (RXGFC) and standard filter elements in the message RAM,
 //! RX FIFO 0 with its fill level, get/put indices and acknowledge. Frames come from the
-//! test ([`crate::Frame`]).
+//! test ([`crate::Frame`]). The bit timing the controller joins the bus with (NBTP and
+//! the kernel clock RCC_CCIPR.FDCANSEL selects) is recorded; a bus-off can be injected
+//! ([`Fdcan::bus_off`]): PSR.BO and CCCR.INIT set (RM0440 §44.3.2: INIT is set "by going
+//! Bus_Off"), no frame received until software clears INIT and 128 occurrences of 11
+//! recessive bits have passed at the bit rate (ISO 11898-1's bus-off recovery), then BO
+//! clears.
 
 use super::clock::unknown;
 use crate::violation::Broken;
@@ -18,6 +23,22 @@ const RX_ELEMENT_BYTES: u32 = 72;
 /// CCCR bits (RM0440 §44.4.7).
 const INIT: u32 = 1;
 const CCE: u32 = 1 << 1;
+/// PSR.BO (RM0440 §44.4.13).
+const BO: u32 = 1 << 7;
+/// Bits of the bus-off recovery: 128 occurrences of 11 consecutive recessive bits
+/// (ISO 11898-1).
+pub const RECOVERY_BITS: f64 = 128.0 * 11.0;
+
+/// The nominal bit timing the controller joined the bus with.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Joined {
+    /// Kernel clock \[Hz\] (RCC_CCIPR.FDCANSEL's source).
+    pub kernel_hz: f64,
+    /// Bit rate \[bit/s\]: kernel/((NBRP + 1)·(1 + NTSEG1 + 1 + NTSEG2 + 1)).
+    pub bit_rate: f64,
+    /// Sample point: (1 + NTSEG1 + 1)/quanta.
+    pub sample_point: f64,
+}
 
 /// Known registers (RM0440 §44.4 register map).
 const KNOWN: &[u32] = &[
@@ -55,6 +76,16 @@ pub struct Fdcan {
     pub rejected: u32,
     /// Frames lost to a full FIFO.
     pub lost: u32,
+    /// The last join (INIT cleared) with its bit timing.
+    pub joined: Option<Joined>,
+    /// Bus-offs injected.
+    pub bus_offs: u32,
+    /// Recoveries started by software (INIT cleared while PSR.BO).
+    pub recoveries: u32,
+    /// Frames the bus carried while the controller was bus-off or recovering.
+    pub missed_while_bus_off: u32,
+    /// End of the running bus-off recovery \[s\].
+    recovery_until: Option<f64>,
 }
 
 impl Default for Fdcan {
@@ -81,6 +112,11 @@ impl Fdcan {
             accepted: 0,
             rejected: 0,
             lost: 0,
+            joined: None,
+            bus_offs: 0,
+            recoveries: 0,
+            missed_while_bus_off: 0,
+            recovery_until: None,
         }
     }
 
@@ -88,11 +124,33 @@ impl Fdcan {
         self.regs[0x18 / 4]
     }
 
-    /// Register read.
-    pub fn read(&mut self, off: u32) -> Result<u32, Broken> {
+    /// Bus-off now (the test's fault on the bus): PSR.BO and CCCR.INIT set.
+    pub fn bus_off(&mut self) {
+        self.regs[0x44 / 4] |= BO;
+        self.regs[0x18 / 4] |= INIT;
+        self.recovery_until = None;
+        self.bus_offs += 1;
+    }
+
+    /// The controller is bus-off (PSR.BO), recovering or waiting for software.
+    pub fn is_bus_off(&self) -> bool {
+        self.regs[0x44 / 4] & BO != 0
+    }
+
+    /// Ends a recovery whose 128 × 11 recessive bits have passed by `now` \[s\].
+    fn advance(&mut self, now: f64) {
+        if self.recovery_until.is_some_and(|t| now >= t) {
+            self.recovery_until = None;
+            self.regs[0x44 / 4] &= !BO;
+        }
+    }
+
+    /// Register read at `now` \[s\].
+    pub fn read(&mut self, off: u32, now: f64) -> Result<u32, Broken> {
         if !KNOWN.contains(&off) {
             return Err(unknown("FDCAN1", off));
         }
+        self.advance(now);
         Ok(match off {
             // RXF0S: F0FL, F0GI, F0PI, F0F (RM0440 §44.4.21).
             0x90 => {
@@ -103,11 +161,12 @@ impl Fdcan {
         })
     }
 
-    /// Register write.
-    pub fn write(&mut self, off: u32, value: u32) -> Result<(), Broken> {
+    /// Register write at `now` \[s\] with the kernel clock `kernel_hz` (0: none running).
+    pub fn write(&mut self, off: u32, value: u32, now: f64, kernel_hz: f64) -> Result<(), Broken> {
         if !KNOWN.contains(&off) {
             return Err(unknown("FDCAN1", off));
         }
+        self.advance(now);
         if PROTECTED.contains(&off) && self.cccr() & (INIT | CCE) != (INIT | CCE) {
             return Err(Broken::new(
                 format!("FDCAN1+{off:#04x}"),
@@ -123,6 +182,28 @@ impl Fdcan {
                 }
                 if self.cccr() & INIT == 0 && v & INIT == 0 && v & CCE != 0 {
                     v &= !CCE;
+                }
+                if self.cccr() & INIT != 0 && v & INIT == 0 {
+                    let nbtp = self.regs[0x1C / 4];
+                    let prescaler = f64::from(((nbtp >> 16) & 0x1FF) + 1);
+                    let tseg1 = f64::from(((nbtp >> 8) & 0xFF) + 1);
+                    let quanta = 1.0 + tseg1 + f64::from((nbtp & 0x7F) + 1);
+                    if kernel_hz <= 0.0 {
+                        return Err(Broken::new(
+                            "FDCAN1_CCCR",
+                            "INIT cleared with no FDCAN kernel clock running (RCC_CCIPR.FDCANSEL: HSE without HSERDY, or the PLL Q output; RM0440 §7.4.26)",
+                        ));
+                    }
+                    let bit_rate = kernel_hz / (prescaler * quanta);
+                    self.joined = Some(Joined {
+                        kernel_hz,
+                        bit_rate,
+                        sample_point: (1.0 + tseg1) / quanta,
+                    });
+                    if self.is_bus_off() {
+                        self.recoveries += 1;
+                        self.recovery_until = Some(now + RECOVERY_BITS / bit_rate);
+                    }
                 }
                 self.regs[0x18 / 4] = v;
             }
@@ -200,7 +281,12 @@ impl Fdcan {
     /// A frame on the bus: stored in RX FIFO 0 if the controller is on the bus (INIT =
     /// 0) and the filters accept it into FIFO 0 (element format RM0440 §44.3.3, "Rx FIFO
     /// element": R0 = XTD/RTR/ID, R1 = DLC, then the data bytes little-endian).
-    pub fn receive(&mut self, f: &Frame) {
+    pub fn receive(&mut self, f: &Frame, now: f64) {
+        self.advance(now);
+        if self.is_bus_off() {
+            self.missed_while_bus_off += 1;
+            return;
+        }
         if self.cccr() & INIT != 0 {
             return;
         }

@@ -28,6 +28,8 @@ const CCER_POLARITY_BITS: u32 = 0xAAAA | (1 << 17) | (1 << 21);
 pub const BIF: u32 = 1 << 7;
 /// SR.UIF.
 const UIF: u32 = 1;
+/// TIMx_CR1.UDIS (RM0440 §29.6.1).
+const UDIS: u32 = 1 << 1;
 
 /// Known TIM1 registers (RM0440 §28.6, register map).
 const KNOWN: &[u32] = &[
@@ -76,6 +78,17 @@ pub struct Tim1 {
     /// Started with RCR = 0 (REP_CNT = 0): RCR = 1 must be written before this first
     /// overflow (bus units), or every overflow and underflow would be an update event.
     rcr_due: Option<u64>,
+    /// The last trigger (OC4REF rising: TRGO/TRGO2) \[bus units\].
+    pub last_trigger_at: Option<u64>,
+    /// The trigger before the first CCR1–3 write since the last update: the conversions
+    /// the written compare values were computed from.
+    written_after_trigger: Option<u64>,
+    /// Measured loop timing: bus units from a trigger to the update that made the
+    /// compare values written after it active (min, max, count).
+    pub trigger_to_update: Option<(u64, u64, u64)>,
+    /// Update events TIMx_CR1.UDIS suppressed (RM0440 §29.6.1: no UEV, the shadow
+    /// registers keep their values).
+    pub updates_disabled: u64,
 }
 
 impl Default for Tim1 {
@@ -104,6 +117,10 @@ impl Tim1 {
             rep_cnt: 0,
             update_at_overflow: false,
             rcr_due: None,
+            last_trigger_at: None,
+            written_after_trigger: None,
+            trigger_to_update: None,
+            updates_disabled: 0,
         }
     }
 
@@ -232,6 +249,24 @@ impl Tim1 {
         let k = from.saturating_sub(start + offset).div_ceil(p);
         let t = start + offset + k * p;
         Some(if t < from { t + p } else { t })
+    }
+
+    /// The update event at `t` (bus units), unless TIMx_CR1.UDIS holds it off (then
+    /// nothing is loaded: RM0440 §29.6.1); records the trigger → effective delay of
+    /// compare values written since the last one.
+    pub fn update_at(&mut self, t: u64) {
+        if self.regs[0] & UDIS != 0 {
+            self.updates_disabled += 1;
+            return;
+        }
+        if let Some(tr) = self.written_after_trigger.take() {
+            let d = t.saturating_sub(tr);
+            self.trigger_to_update = Some(match self.trigger_to_update {
+                None => (d, d, 1),
+                Some((lo, hi, n)) => (lo.min(d), hi.max(d), n + 1),
+            });
+        }
+        self.update();
     }
 
     /// The update event: preloaded compare values become active (OCxPE, RM0440
@@ -458,6 +493,12 @@ impl Tim1 {
                 }
             }
             0x44 => self.write_bdtr(value)?,
+            0x34 | 0x38 | 0x3C => {
+                if self.started_at.is_some() && self.written_after_trigger.is_none() {
+                    self.written_after_trigger = self.last_trigger_at;
+                }
+                self.regs[i] = value;
+            }
             // CR2: OISx/OISxN (bits 8–14, 16, 18) are frozen from LOCK level 1 on, the CCER
             // polarity bits from level 2 (RM0440 TIMx_BDTR LOCK[1:0]): the timer ignores
             // such a write, so the image's idle levels must be written before BDTR.

@@ -182,10 +182,43 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
             (*max as f64) < cycles,
             "{motor}: {max} instructions, {cycles} cycles per period"
         );
+        // Issue 26: the loop timing the design assumes, measured — every period in
+        // which the image wrote compare values, from the ADC trigger whose conversions
+        // it computed them from to the update event that made them active, against the
+        // design's trigger → update figure (codegen `sections::board::control_timing`:
+        // the update one carrier period after the trigger, plus one tick for the
+        // low-side trigger) within one timer tick; no update held off by UDIS.
+        let tim1 = &rig.machine.soc().tim1;
+        let (lo, hi, n) = tim1
+            .trigger_to_update
+            .unwrap_or_else(|| panic!("{motor}: no compare value written after a trigger took effect"));
+        let units_per_tick = tim1.tick as f64;
+        let design_ticks = f64::from(rig.design.board.as_ref().unwrap().trigger_to_update_ticks);
+        for d in [lo, hi] {
+            let ticks = d as f64 / units_per_tick;
+            assert!(
+                (ticks - design_ticks).abs() <= 1.0,
+                "{motor}: trigger → compare values active in {ticks} ticks, the design says {design_ticks}"
+            );
+        }
+        assert!(
+            n as usize + 2 >= counts.len(),
+            "{motor}: {n} measured updates of {} periods",
+            counts.len()
+        );
+        assert_eq!(
+            tim1.updates_disabled, 0,
+            "{motor}: an update event fell inside the compare writes"
+        );
+        let loop_delay = rig.design.board.as_ref().unwrap().loop_delay_s;
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
-             {:.1} % of the {cycles:.0} cycles of a period",
-            mean / cycles * 100.0
+             {:.1} % of the {cycles:.0} cycles of a period; trigger → compare values active {}–{} ticks over {n} periods (design {design_ticks}), loop delay {:.2} µs = {:.4}·T_s",
+            mean / cycles * 100.0,
+            lo as f64 / units_per_tick,
+            hi as f64 / units_per_tick,
+            loop_delay * 1e6,
+            loop_delay / rig.design.drive.sample_period_s
         );
         measured.push(motor_test_support::budget::Figure {
             figure: "control_interrupt".into(),

@@ -46,6 +46,26 @@ fn setpoints_drive_and_silence_ramps_to_off_in_the_designed_time() {
         let period = rig.pwm_period_s();
         let half = f64::from(rig.machine.soc().tim1.compare()[0]);
 
+        // Issue 26: FDCAN joined the bus at the board's rate, timed from the emulated
+        // board's HSE crystal where it has one (its hardware description, not the board
+        // file), at the 87.5 % sample point of CiA 601-3 to within one quantum.
+        let joined = rig
+            .machine
+            .soc()
+            .fdcan
+            .joined
+            .unwrap_or_else(|| panic!("{motor}: never joined the bus"));
+        let soc = rig.machine.soc();
+        let kernel = soc.wiring.hw.hse_crystal_hz.unwrap_or_else(|| soc.clocks.hclk_hz());
+        assert_eq!(joined.kernel_hz, kernel, "{motor}: FDCAN kernel clock");
+        assert_eq!(joined.bit_rate, b.can_bit_rate, "{motor}: bit rate");
+        let quantum = joined.bit_rate / joined.kernel_hz;
+        assert!(
+            (joined.sample_point - 0.875).abs() <= quantum,
+            "{motor}: sample point {}",
+            joined.sample_point
+        );
+
         // A torque setpoint every period for 50 ms: with the motor at standstill and no
         // current flowing, the current controller raises its voltage: the compare
         // values leave 50 %.
@@ -81,6 +101,12 @@ fn setpoints_drive_and_silence_ramps_to_off_in_the_designed_time() {
         assert!(
             dt <= b.setpoint_timeout_s + b.setpoint_ramp_s + 2.0 * period + b.setpoint_period_s,
             "{motor}: off only {dt} s after the last frame"
+        );
+        println!(
+            "{motor}: FDCAN from {:.0} MHz at {:.0} kbit/s, sample point {:.2} %",
+            joined.kernel_hz / 1e6,
+            joined.bit_rate / 1e3,
+            joined.sample_point * 100.0
         );
         println!(
             "{motor}: compare moved {moved:.0} ticks under {torque} N·m; silence → off after {:.2} ms (timeout {:.0} ms + ramp ≤ {:.0} ms)",

@@ -40,6 +40,10 @@ pub struct Outcome {
     pub target: f64,
     /// Every criterion as (name, pass, line for the report).
     pub checks: Vec<(String, bool, String)>,
+    /// Time of the step's frame \[s\].
+    pub at: f64,
+    /// The step's torque setpoint \[N·m\] (quantised as the frame carries it).
+    pub torque: f64,
 }
 
 impl Outcome {
@@ -113,6 +117,12 @@ fn step_torque(rig: &mut Rig, torque_nm: f64, periods: f64) -> Result<f64, Strin
 /// stops before (a strict-mode rule, the boot, a trip at zero torque). `Ok(None)` for a
 /// motor without a torque constant, after checking that it stays on at zero current.
 pub fn current_step_on(bench: Bench) -> Result<Option<Outcome>, String> {
+    current_step_rig(bench).map(|(out, _)| out)
+}
+
+/// [`current_step_on`], keeping the rig (at the step's end, the step torque's frames
+/// still going out) for a scenario after it.
+fn current_step_rig(bench: Bench) -> Result<(Option<Outcome>, Rig), String> {
     let name = bench.name();
     let (mut rig, spec) = closed_loop(bench)?;
     let design = rig.design.clone();
@@ -145,7 +155,7 @@ pub fn current_step_on(bench: Bench) -> Result<Option<Outcome>, String> {
              (one ADC step {lsb_a:.3} A) over {} periods",
             after.len()
         );
-        return Ok(None);
+        return Ok((None, rig));
     };
     // verify's step height, as a torque setpoint; the reference the image gets is the
     // frame's quantised torque times K_t⁻¹.
@@ -196,7 +206,87 @@ pub fn current_step_on(bench: Bench) -> Result<Option<Outcome>, String> {
             (c.quantity.clone(), c.pass, line)
         })
         .collect();
-    Ok(Some(Outcome { target, checks }))
+    Ok((
+        Some(Outcome {
+            target,
+            checks,
+            at,
+            torque: f64::from(raw) * board.torque_resolution_nm,
+        }),
+        rig,
+    ))
+}
+
+/// True i_q \[A\] of the drive at the first sample at or after `t` \[s\].
+fn iq_at(rig: &mut Rig, t: f64) -> f64 {
+    let drive = rig.analog_as::<Drive>().unwrap();
+    drive.samples.iter().find(|x| x.t >= t).map_or(f64::NAN, |x| x.i[1])
+}
+
+/// Issue 26: a CAN bus-off under torque. After the step, the bus fails (the FDCAN goes
+/// bus-off, no frame arrives); the image must go to zero torque at once — not after the
+/// setpoint timeout — start the recovery and count it; frames after the recovery drive
+/// again. Zero torque from the step's torque is the step mirrored: by the current loop's
+/// linearity i_q(t_b + τ) ≈ target − y(τ), y the step's own measured response τ after its
+/// frame; the return, frames again after the recovery, is the step again: i_q ≈ y(τ). τ
+/// = the lesser of 90 % of the setpoint timeout (before it could act) and the step's
+/// window (12/α). Tolerance: 5 % of the target plus 3 ADC steps (the step's final-error
+/// criterion's scale, and the bus-off seen at the next main-loop pass as a frame is).
+/// Returns the report line.
+fn bus_off_under_torque(rig: &mut Rig, name: &str, step: Option<&Outcome>, window_s: f64, lsb_a: f64) -> String {
+    let board = rig.design.board.as_ref().unwrap().board.clone();
+    let t_b = rig.machine.soc().time_s();
+    rig.machine.soc_mut().fdcan.bus_off();
+    let tau = (0.9 * board.setpoint_timeout_s).min(window_s);
+    // Silence at least until the recovery (128 × 11 bits after the image clears INIT, at
+    // its next main-loop pass) is over, however short the step's window.
+    let recovery = motor_emulator::periph::fdcan::RECOVERY_BITS / board.can_bit_rate + 3.0 * rig.pwm_period_s();
+    // Two periods beyond, so that a drive sample at or after t_b + τ exists.
+    rig.run(t_b + tau.max(recovery) + 2.0 * rig.pwm_period_s(), |_| None, |_| false)
+        .unwrap_or_else(|e| panic!("{name}: bus-off: {e}"));
+    let fdcan = &rig.machine.soc().fdcan;
+    assert_eq!(
+        fdcan.recoveries, 1,
+        "{name}: the image did not start the bus-off recovery"
+    );
+    assert!(!fdcan.is_bus_off(), "{name}: still bus-off {tau} s later");
+    assert_eq!(
+        rig.bus_off_count(),
+        Some(1),
+        "{name}: bus-off not counted in the control state"
+    );
+    assert!(rig.machine.soc().tim1.moe(), "{name}: switched off at a bus-off");
+    let tol = |target: f64| 0.05 * target.abs() + 3.0 * lsb_a;
+    let Some(step) = step else {
+        // No torque constant: i_q stays 0 whatever the torque; the count and the
+        // recovery are what is checked.
+        return format!("{name}: bus-off → recovered, counted 1");
+    };
+    let (target, at) = (step.target, step.at);
+    let y_tau = iq_at(rig, at + tau);
+    let down = iq_at(rig, t_b + tau);
+    assert!(
+        (down - (target - y_tau)).abs() <= tol(target),
+        "{name}: {tau} s after the bus-off i_q = {down} A, the step mirrored {} A (± {} A): not zero torque at once",
+        target - y_tau,
+        tol(target)
+    );
+    let again = step_torque(rig, step.torque, tau / rig.pwm_period_s() + 1.0)
+        .unwrap_or_else(|e| panic!("{name}: after the recovery: {e}"));
+    let up = iq_at(rig, again + tau);
+    // From the residual r at the frame instead of 0: y(τ) + r·(1 − y(τ)/target), within
+    // |r| of the step's own y(τ).
+    let residual = iq_at(rig, again);
+    assert!(
+        (up - y_tau).abs() <= tol(target) + residual.abs(),
+        "{name}: {tau} s after the first frame past the recovery i_q = {up} A, the step {y_tau} A"
+    );
+    assert_eq!(rig.bus_off_count(), Some(1));
+    format!(
+        "{name}: bus-off under {target:.3} A → i_q {down:.3} A after {:.1} ms (step mirrored: {:.3} A), recovered, counted 1; frames again → {up:.3} A (step: {y_tau:.3} A)",
+        tau * 1e3,
+        target - y_tau
+    )
 }
 
 #[test]
@@ -204,7 +294,18 @@ fn current_step_through_a_can_torque_setpoint_meets_verifys_criteria() {
     for (motor, board) in benches() {
         let bench = Bench::new(&motor, &board).unwrap();
         let name = bench.name();
-        let Some(out) = current_step_on(bench).unwrap_or_else(|e| panic!("{name}: {e}")) else {
+        let (out, mut rig) = current_step_rig(bench).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let setup_window = {
+            let spec = motor_emulator::wiring::spec(&motor).unwrap();
+            current_step_samples(&Setup::new(&spec, &rig.design)) as f64 * rig.design.drive.sample_period_s
+        };
+        let b = rig.design.board.as_ref().unwrap().board.clone();
+        let lsb_a = b.adc_reference_v / 4096.0 / b.current.gain_v_per_a.abs();
+        println!(
+            "{}",
+            bus_off_under_torque(&mut rig, &name, out.as_ref(), setup_window, lsb_a)
+        );
+        let Some(out) = out else {
             continue;
         };
         println!("{name}: i_q step 0 → {:.3} A", out.target);

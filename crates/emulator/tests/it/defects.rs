@@ -120,6 +120,23 @@ fn slow_channels_at_2_5_cycles_do_not_settle() {
     }
 }
 
+/// Issue 26 item 5: the injected conversions started by a read-modify-write of ADC_CR
+/// that writes the ADEN reading 1 again next to JADSTART (the image's former
+/// `modify(|_, w| w.jadstart().set_bit())`): named as a set-only bit re-written. The
+/// image itself writes JADSTART alone (every other test boots it).
+#[test]
+fn aden_rewritten_with_jadstart_is_named() {
+    for bench in one_per_board() {
+        let name = format!("{} (ADEN with JADSTART)", bench.name());
+        let patches = Patches {
+            jadstart_rewrites_aden: true,
+            ..Patches::default()
+        };
+        let (_, v) = run_patched(bench, patches, 5.0);
+        assert_rule(&name, v, &["set-only bits that already read 1", "ADC1_CR", "§21.7.3"]);
+    }
+}
+
 /// The control interrupt's priority raised to 0x80 (a byte write to NVIC_IPR) and
 /// BASEPRI left at 0x80: the interrupt never runs.
 #[test]

@@ -12,7 +12,19 @@ use crate::bringup::{self, AdcEnable};
 use crate::config::{JSQR, SMPR};
 use crate::hw;
 use crate::motor::board;
-use crate::registers::Field;
+use crate::registers::{
+    ADC_CR_ADCAL, ADC_CR_ADCALDIF, ADC_CR_ADEN, ADC_CR_ADVREGEN, ADC_CR_DEEPPWD, ADC_CR_JADSTART, Field, adc_cr_command,
+};
+
+/// Writes ADC_CR with the set-only command `bit` alone ([`adc_cr_command`]: ADEN, ADCAL,
+/// JADSTART … are set-only, RM0440 §21.7.3; a `modify` would write the ADEN that reads 1
+/// again next to the command), the read/write bits as they read with `clear` cleared.
+fn cr_command(adc: &pac::adc1::RegisterBlock, clear: u32, bit: u32) {
+    // SAFETY: host-tested value (motor_config::registers::adc_cr_command): the read/write
+    // bits as read (less `clear`), one set-only bit.
+    adc.cr()
+        .modify(|r, w| unsafe { w.bits(adc_cr_command(r.bits() & !clear, bit)) });
+}
 
 /// One converter's ADEN/ADRDY, for the host-tested enable sequence.
 struct Enable<'a>(&'a pac::adc1::RegisterBlock);
@@ -22,7 +34,7 @@ impl AdcEnable for Enable<'_> {
         self.0.cr().read().aden().bit_is_set()
     }
     fn set_aden(&mut self) {
-        self.0.cr().modify(|_, w| w.aden().set_bit());
+        cr_command(self.0, 0, ADC_CR_ADEN);
     }
     fn adrdy(&mut self) -> bool {
         self.0.isr().read().adrdy().bit_is_set()
@@ -34,11 +46,15 @@ impl AdcEnable for Enable<'_> {
 /// until ADRDY (defect 1: an ADEN written less than 4 ADC cycles after ADCAL clears is
 /// reset by the calibration logic; ST's `ADC_Enable` retries the same way).
 fn power_up(adc: &pac::adc1::RegisterBlock) -> bool {
-    // CR bits must be changed one at a time with read-modify-write: DEEPPWD resets to 1.
-    adc.cr().modify(|_, w| w.deeppwd().clear_bit());
-    adc.cr().modify(|_, w| w.advregen().set_bit());
+    // CR bits must be changed one at a time: DEEPPWD resets to 1. No set-only bit is
+    // written with them (`cr_command` with none).
+    cr_command(adc, ADC_CR_DEEPPWD, 0);
+    // SAFETY: host-tested value (adc_cr_command): the read/write bits as read plus
+    // ADVREGEN, no set-only bit.
+    adc.cr()
+        .modify(|r, w| unsafe { w.bits(adc_cr_command(r.bits() | ADC_CR_ADVREGEN, 0)) });
     delay_us(hw::ADC_VREG_STARTUP_US);
-    adc.cr().modify(|_, w| w.adcaldif().clear_bit().adcal().set_bit());
+    cr_command(adc, ADC_CR_ADCALDIF, ADC_CR_ADCAL);
     if !wait_for(POLL_LIMIT, || adc.cr().read().adcal().bit_is_clear()) {
         return false;
     }
@@ -74,8 +90,9 @@ pub fn init(common: &pac::ADC12_COMMON, adc1: &pac::ADC1, adc2: &pac::ADC2) -> b
     adc2.isr()
         .write(|w| w.jeos().clear_bit_by_one().jeoc().clear_bit_by_one());
     adc1.ier().write(|w| w.jeosie().set_bit());
-    adc1.cr().modify(|_, w| w.jadstart().set_bit());
-    adc2.cr().modify(|_, w| w.jadstart().set_bit());
+    // JADSTART alone: ADEN is not written again (ST's LL_ADC_INJ_StartConversion).
+    cr_command(adc1, 0, ADC_CR_JADSTART);
+    cr_command(adc2, 0, ADC_CR_JADSTART);
     true
 }
 

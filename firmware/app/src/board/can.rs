@@ -57,6 +57,22 @@ impl Can {
         Some(Self { regs })
     }
 
+    /// Bus-off recovery. On bus-off (transmit error count past 255, ISO 11898-1) the
+    /// FDCAN sets FDCAN_PSR.BO and CCCR.INIT and stops taking part in bus traffic
+    /// (RM0440 §44.3.2 "Software initialization": INIT is set "by going Bus_Off"; the
+    /// M_CAN core it is built on behaves the same); it stays so until software clears
+    /// INIT, after which it counts 128 occurrences of 11 recessive bits (ISO 11898-1's
+    /// recovery) before PSR.BO clears and it joins the bus again with its configuration
+    /// kept. Clears INIT when bus-off left it set; `true` if it did (one bus-off, recovery
+    /// started). The configuration registers are not touched (CCE is cleared with INIT).
+    pub fn recover_bus_off(&mut self) -> bool {
+        if self.regs.psr().read().bo().bit_is_clear() || self.regs.cccr().read().init().bit_is_clear() {
+            return false;
+        }
+        self.regs.cccr().modify(|_, w| w.init().clear_bit());
+        true
+    }
+
     /// The oldest received frame, if any (acknowledged, so the FIFO never fills).
     pub fn poll(&mut self) -> Option<RxFrame> {
         let status = self.regs.rxf0s().read();

@@ -12,6 +12,12 @@ pub fn wait_for(limit: u32, mut ready: impl FnMut() -> bool) -> bool {
 /// Polls for clock and peripheral ready flags: generous for the µs-scale waits.
 pub const POLL_LIMIT: u32 = hw::SYSCLK_HZ / 1_000;
 
+/// Polls for HSERDY: each poll is a volatile read and a branch (≥ 3 cycles at 170 MHz),
+/// so 20 × POLL_LIMIT polls last ≥ 60 ms — many times the t_SU(HSE) of DS12288's HSE
+/// oscillator characteristics (2 ms typical; no maximum stated: it depends on the
+/// crystal and its load).
+const HSE_POLLS: u32 = 20 * POLL_LIMIT;
+
 /// Busy-waits `us` microseconds at SYSCLK.
 pub fn delay_us(us: u32) {
     cortex_m::asm::delay(hw::SYSCLK_HZ / hw::US_PER_S * us);
@@ -82,8 +88,17 @@ pub fn enable_gate_peripherals(rcc: &pac::RCC) {
     let _ = rcc.apb2enr().read();
 }
 
-/// Enables the clocks of every peripheral the board uses.
-pub fn enable_peripherals(rcc: &pac::RCC) {
+/// Enables the clocks of every peripheral the board uses, FDCAN1's kernel clock from the
+/// board's HSE crystal where it has one ([`hw::FDCAN_FROM_HSE`]); `false` if the HSE
+/// oscillator does not become ready (RCC_CR.HSERDY, RM0440 §7.4.1; its start-up time is
+/// a few ms: DS12288, HSE oscillator characteristics, t_SU(HSE) 2 ms typical).
+pub fn enable_peripherals(rcc: &pac::RCC) -> bool {
+    if hw::FDCAN_FROM_HSE {
+        rcc.cr().modify(|_, w| w.hseon().set_bit());
+        if !wait_for(HSE_POLLS, || rcc.cr().read().hserdy().bit_is_set()) {
+            return false;
+        }
+    }
     rcc.ahb1enr().modify(|_, w| w.cordicen().set_bit().fmacen().set_bit());
     rcc.ahb2enr().modify(|_, w| {
         w.gpioaen()
@@ -97,11 +112,12 @@ pub fn enable_peripherals(rcc: &pac::RCC) {
     });
     rcc.apb2enr().modify(|_, w| w.tim1en().set_bit().syscfgen().set_bit());
     rcc.apb1enr1().modify(|_, w| w.tim3en().set_bit().fdcanen().set_bit());
-    // SAFETY: FDCANSEL 0b10 selects PCLK1 (RM0440 §7.4.26).
-    rcc.ccipr().modify(|_, w| unsafe { w.fdcansel().bits(0b10) });
+    // SAFETY: FDCANSEL 0b00 selects HSE, 0b10 PCLK1 (RM0440 §7.4.26).
+    rcc.ccipr().modify(|_, w| unsafe { w.fdcansel().bits(hw::FDCANSEL) });
     // RM0440 RCC: after a peripheral clock is enabled, allow two clock cycles before
     // touching the peripheral — read an enable register back (ST's
     // __HAL_RCC_*_CLK_ENABLE does the same with a dummy read).
     let _ = rcc.apb2enr().read();
     let _ = rcc.apb1enr1().read();
+    true
 }

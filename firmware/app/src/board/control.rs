@@ -54,6 +54,16 @@ static SETPOINT_BITS: AtomicU32 = AtomicU32::new(0);
 /// A setpoint arrived since the interrupt last looked.
 static SETPOINT_FRESH: AtomicBool = AtomicBool::new(false);
 
+/// CAN bus-off events recovered from since start-up (saturating); the main loop counts,
+/// the control interrupt copies it into the state it keeps for the fault record.
+static BUS_OFF: AtomicU32 = AtomicU32::new(0);
+
+/// Counts one bus-off (main loop only: one writer, so load and store do not race).
+pub fn count_bus_off() {
+    let n = BUS_OFF.load(Ordering::Relaxed);
+    BUS_OFF.store(n.saturating_add(1), Ordering::Relaxed);
+}
+
 /// Hands a received torque setpoint \[N·m\] to the control interrupt.
 pub fn publish_setpoint(torque: f32) {
     SETPOINT_BITS.store(torque.to_bits(), Ordering::Relaxed);
@@ -208,6 +218,7 @@ impl Control {
             omega_e: out.omega_e,
             u_dc: out.u_dc,
             periods,
+            bus_off: BUS_OFF.load(Ordering::Relaxed),
             running: on,
             tripped: self.tripped,
         });

@@ -37,7 +37,7 @@ use stm32g4::stm32g474 as pac;
 
 use crate::motor::board;
 use crate::{can_frame, config, registers};
-use control::{Control, HANDOFF, TICKS, publish_setpoint};
+use control::{Control, HANDOFF, TICKS, count_bus_off, publish_setpoint};
 use fault::halt;
 
 /// Brings the board up, starts the control interrupt and runs the main loop:
@@ -70,7 +70,9 @@ pub fn run() -> ! {
     if board::BOOT0_OPTION_BYTES == 1 && !registers::boots_from_flash_regardless_of_pb8(dp.FLASH.optr().read().bits()) {
         halt()
     }
-    clocks::enable_peripherals(&dp.RCC);
+    if !clocks::enable_peripherals(&dp.RCC) {
+        halt()
+    }
     fault::route_faults_to_break(&dp.SYSCFG, &dp.DBGMCU);
     pwm::init(&dp.TIM1);
     pins::init(&dp.GPIOA, &dp.GPIOB, &dp.GPIOC);
@@ -103,6 +105,14 @@ pub fn run() -> ! {
     let mut last = TICKS.load(Ordering::Relaxed);
     let mut last_status = last;
     loop {
+        // A bus-off (FDCAN_PSR.BO) silences the setpoint: zero torque at once rather
+        // than after the setpoint timeout — the vehicle unit can no longer reach the
+        // drive — then the recovery is started and counted (fault record, state word
+        // `bus_off`). A setpoint after the recovery drives again.
+        if can.recover_bus_off() {
+            publish_setpoint(0.0);
+            count_bus_off();
+        }
         if let Some(frame) = can.poll() {
             match can_frame::decode_torque(frame.standard_id, frame.bytes()) {
                 Some(torque) => {

@@ -123,12 +123,21 @@ pub fn start(tim1: &pac::TIM1) {
     }
 }
 
-/// Compare values for the next period (preloaded, applied at the next update).
+/// Compare values for the next period (preloaded, applied at the next update), written
+/// atomically with respect to the update event: TIMx_CR1.UDIS is held for the three
+/// writes (RM0440 §29.6.1, UDIS: "the update event is not generated, shadow registers
+/// keep their value"), so an update can never load one new and two old values — it loads
+/// all three of this period, or, held off, the previous three for one more period. The
+/// writes follow the conversions well before the update one period after the trigger
+/// (`codegen` `sections::board::control_timing`); the emulator counts updates held off
+/// and its test requires none.
 pub fn set_compare(tim1: &pac::TIM1, compare: [u16; 3]) {
     let [u, v, w] = compare;
+    tim1.cr1().modify(|_, r| r.udis().set_bit());
     tim1.ccr1().write(|r| r.ccr().set(u32::from(u)));
     tim1.ccr2().write(|r| r.ccr().set(u32::from(v)));
     tim1.ccr3().write(|r| r.ccr().set(u32::from(w)));
+    tim1.cr1().modify(|_, r| r.udis().clear_bit());
 }
 
 /// Disables the gates at once (MOE = 0, outputs to their off level).

@@ -21,6 +21,7 @@ use crate::board::{
     samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle, warning_at,
 };
 use crate::design::Design;
+use crate::design::current_loop::FIRMWARE_LOOP_DELAY_PERIODS;
 use crate::diagnostic::{Diagnostic, Source};
 use crate::firmware::{self, CanBitTiming};
 
@@ -94,6 +95,13 @@ pub struct BoardOut {
     pub trips: Trips,
     /// Over-speed trip as electrical speed n_p·ω_m \[rad/s\] (of `trips.over_speed_rad_s`).
     pub over_speed_electrical_rad_s: f64,
+    /// TIM1 ticks from the ADC trigger (TRGO2 = OC4REF at the board's sampling instant)
+    /// to the update event that loads the compare values the control step computed from
+    /// that trigger's conversions (`control_timing`).
+    pub trigger_to_update_ticks: u32,
+    /// The loop delay this timing makes \[s\]: trigger → update plus half a period, the
+    /// mean delay of the voltage held over the period after the update (thesis A §4.6).
+    pub loop_delay_s: f64,
     /// CAN nominal bit rate \[bit/s\].
     pub can_bit_rate: u32,
     /// FDCAN1's nominal bit timing for that rate from the FDCAN kernel clock
@@ -352,15 +360,48 @@ pub(in crate::design) fn board(
             ),
         );
     }
-    let can_timing = match firmware::can_bit_rate(firmware::FDCAN_CLOCK_HZ, board.can_bit_rate) {
+    let can_timing = match firmware::can_bit_rate(firmware::fdcan_kernel_clock_hz(board.hse_hz), board.can_bit_rate) {
         Ok(t) => Some(t),
         Err(r) => {
             refuse("can.bit_rate", r.problem, r.accepted);
             None
         }
     };
-    let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
     let t_conv = sequence_time(board, ADC_CLOCK_HZ);
+    let timing = firmware::pwm_period(1.0 / ts)
+        .ok()
+        .map(|arr| control_timing(samples_at_carrier_maximum(board), arr, ts));
+    if let Some(t) = &timing {
+        let tick = 1.0 / f64::from(firmware::TIMER_CLOCK_HZ);
+        let designed = FIRMWARE_LOOP_DELAY_PERIODS * ts;
+        // The conversions must end (and the step run) before the update that is to
+        // load its compare values; past it they would act a period later: 2.5·T_s.
+        if t_conv >= t.trigger_to_update_s {
+            refuse(
+                "sensing.source_resistance.current",
+                format!(
+                    "the conversions take {:.2} µs after the trigger, beyond the {:.2} µs to the update event that loads the step's compare values: the loop delay would be 2.5·T_s, not the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s the current loop of {} ({spec}) is designed for",
+                    t_conv * 1e6,
+                    t.trigger_to_update_s * 1e6,
+                    d.name
+                ),
+                "source resistances whose sampling times fit well inside one control period".into(),
+            );
+        } else if (t.loop_delay_s - designed).abs() > 2.0 * tick + 1e-12 {
+            // Two ticks: the low-side trigger's one before its extreme, and ARR rounded
+            // to whole ticks (the carrier period 2·ARR ticks against 1/f_s).
+            refuse(
+                "sensing.sample_instant",
+                format!(
+                    "the sampling instant and TIM1's update scheme make a loop delay of {:.3} µs, not the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s = {:.3} µs the current loop is designed for",
+                    t.loop_delay_s * 1e6,
+                    designed * 1e6
+                ),
+                "high_side_centre or low_side_centre (the update event at the sampling instant)".into(),
+            );
+        }
+    }
+    let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
     if t_conv > 0.25 * ts {
         warn(
             "sensing.source_resistance.current",
@@ -386,7 +427,7 @@ pub(in crate::design) fn board(
         Signal::CanRx,
         Signal::CanTx,
     ];
-    let (Some(can_timing), true) = (can_timing, errors.is_empty()) else {
+    let (Some(can_timing), Some(timing), true) = (can_timing, timing, errors.is_empty()) else {
         return Err(errors);
     };
     let board_dead = board.dead_time_s;
@@ -408,10 +449,11 @@ pub(in crate::design) fn board(
         io_pins: io.map(|s| pin_code(board, s)),
         io_afs: io.map(|s| pin_af(board, s)),
         adc_channels: board.adc.clone().map(|q| q.iter().map(|x| x.channel).collect()),
-        adc_signals: board
-            .adc
-            .clone()
-            .map(|q| q.iter().map(|x| x.signal.adc_code()).collect()),
+        adc_signals: board.adc.clone().map(|q| {
+            q.iter()
+                .map(|x| if x.padding { u8::MAX } else { x.signal.adc_code() })
+                .collect()
+        }),
         adc_smp: board
             .adc
             .clone()
@@ -427,6 +469,8 @@ pub(in crate::design) fn board(
         boot0_option_bytes: u8::from(checks_option_bytes(board)),
         over_speed_electrical_rad_s: trips.over_speed_rad_s.value * f64::from(d.motor.pole_pairs),
         trips,
+        trigger_to_update_ticks: timing.trigger_to_update_ticks,
+        loop_delay_s: timing.loop_delay_s,
         can_bit_rate: can_timing.bit_rate,
         can_timing,
         warnings: Vec::new(),
@@ -472,6 +516,43 @@ pub fn offset_bound_code(board: &Board) -> i32 {
     let v0 = board.current.offset_v;
     let room_v = v0.min(board.adc_reference_v - v0) - board.current.gain_v_per_a.abs() * board.over_current_a;
     (room_v / board.adc_reference_v * CODES_16).floor().max(0.0) as i32
+}
+
+/// The control interrupt's timing, derived from the board's sampling instant and TIM1's
+/// update scheme (firmware `registers::trigger_channel`, `registers::repetition`):
+///
+/// * the ADC trigger TRGO2 = OC4REF rises at the carrier minimum (CNT = 0, PWM mode 1
+///   with CCR4 = 1), or for low-side shunts one tick before the maximum (PWM mode 2,
+///   CCR4 = ARR − 1) so the conversions start inside the low-side pulse;
+/// * the update event, which loads the preloaded compare values (TIMx_CCMRx.OCxPE, RM0440
+///   §29.3.10), falls at the same carrier extreme, once per period (RCR = 1 with
+///   REP_CNT set at the start, RM0440 §29.3.5);
+/// * the control interrupt writes the compare values after the conversions, within the
+///   period: the next update, one carrier period 2·ARR ticks after the one at the
+///   trigger, loads them — for the low-side trigger one tick later, as the trigger
+///   precedes its extreme by one tick.
+///
+/// The loop delay is that plus half a period: the voltage is held for the period after
+/// the update, its mean half a period later (thesis A §4.6: 1.5·T_s).
+pub fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64) -> ControlTiming {
+    let ticks = 2 * u32::from(arr) + u32::from(at_carrier_maximum);
+    let s = f64::from(ticks) / f64::from(firmware::TIMER_CLOCK_HZ);
+    ControlTiming {
+        trigger_to_update_ticks: ticks,
+        trigger_to_update_s: s,
+        loop_delay_s: s + 0.5 * ts,
+    }
+}
+
+/// `control_timing`'s figures.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ControlTiming {
+    /// TIM1 ticks from the ADC trigger to the update that loads the step's compare values.
+    pub trigger_to_update_ticks: u32,
+    /// The same in seconds.
+    pub trigger_to_update_s: f64,
+    /// Trigger → update plus T_s/2 \[s\].
+    pub loop_delay_s: f64,
 }
 
 fn pin_code(board: &Board, s: Signal) -> u8 {
