@@ -85,6 +85,8 @@ pub struct Rig {
     pub bench: Bench,
     /// The next setpoint frame is due at this time \[s\].
     next_frame_s: f64,
+    /// When [`Rig::run`] sent its last setpoint frame \[s\].
+    last_frame_s: Option<f64>,
 }
 
 impl Rig {
@@ -114,6 +116,7 @@ impl Rig {
             hardware: bench.hardware.clone(),
             bench,
             next_frame_s: 0.0,
+            last_frame_s: None,
         })
     }
 
@@ -132,6 +135,11 @@ impl Rig {
             remote: false,
             data: raw.to_le_bytes().to_vec(),
         }
+    }
+
+    /// When [`Rig::run`] (or [`Rig::boot`]) sent its last setpoint frame \[s\], if it sent one.
+    pub fn last_frame_s(&self) -> Option<f64> {
+        self.last_frame_s
     }
 
     /// The setpoint period \[s\] (board `[can].setpoint_period`).
@@ -228,6 +236,7 @@ impl Rig {
                 if let Some(nm) = torque(self.next_frame_s) {
                     let f = self.setpoint(nm);
                     self.send(&f);
+                    self.last_frame_s = Some(self.machine.soc().time_s());
                 }
                 self.next_frame_s += self.setpoint_period_s();
             }

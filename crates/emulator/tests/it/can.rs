@@ -8,12 +8,16 @@ use crate::BOOT_LIMIT_S;
 use motor_emulator::rig::{Bench, Rig, benches};
 use motor_emulator::{Frame, Machine};
 
-/// Time from the last valid frame until MOE clears, driving `frames` (sent every
-/// setpoint period) after it; the drive must stay on until the timeout.
+/// Time from the last valid frame (the last setpoint [`Rig::run`] sent, boot's included)
+/// until MOE clears, driving `frames` (sent every setpoint period) from now on; the
+/// drive must stay on until the timeout.
 fn off_after_silence(rig: &mut Rig, motor: &str, frames: &[Frame]) -> f64 {
     let b = rig.design.board.as_ref().unwrap().board.clone();
-    let last = rig.machine.soc().time_s();
+    let last = rig
+        .last_frame_s()
+        .unwrap_or_else(|| panic!("{motor}: no setpoint was ever sent"));
     let end = last + b.setpoint_timeout_s + b.setpoint_ramp_s + 0.02;
+    let start = rig.machine.soc().time_s();
     let mut off_at = None;
     let mut k = 0;
     while rig.machine.soc().time_s() < end && off_at.is_none() {
@@ -21,7 +25,7 @@ fn off_after_silence(rig: &mut Rig, motor: &str, frames: &[Frame]) -> f64 {
             rig.send(f);
         }
         k += 1;
-        let next = last + k as f64 * b.setpoint_period_s;
+        let next = start + k as f64 * b.setpoint_period_s;
         rig.machine
             .run_while(next.min(end), |m: &Machine| {
                 if !m.soc().tim1.moe() {
