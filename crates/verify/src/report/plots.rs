@@ -124,8 +124,8 @@ fn segment_hits(r: (f64, f64, f64, f64), p: (f64, f64), q: (f64, f64)) -> bool {
     true
 }
 
-/// Where the legend goes, from the drawn data: the first corner (then the top and bottom
-/// middles) of the plotting area `plot` (pixels: x0, y0, x1, y1) whose legend box of
+/// Where the legend goes, from the drawn data: the first corner (then the middles of the
+/// top, bottom, right and left sides) of the plotting area `plot` (pixels: x0, y0, x1, y1) whose legend box of
 /// `size`, 6 px clear all round, meets none of the `polylines` (pixels); `None` if every
 /// such place covers data.
 fn free_corner(plot: (i32, i32, i32, i32), size: (i32, i32), polylines: &[Vec<(i32, i32)>]) -> Option<(i32, i32)> {
@@ -137,8 +137,8 @@ fn free_corner(plot: (i32, i32, i32, i32), size: (i32, i32), polylines: &[Vec<(i
     }
     let (l, r) = (x0 + inset, x1 - inset - w);
     let (t, b) = (y0 + inset, y1 - inset - h);
-    let mid = (x0 + x1 - w) / 2;
-    [(r, t), (l, t), (r, b), (l, b), (mid, t), (mid, b)].into_iter().find(|&(x, y)| {
+    let (mid, middle) = ((x0 + x1 - w) / 2, (y0 + y1 - h) / 2);
+    [(r, t), (l, t), (r, b), (l, b), (mid, t), (mid, b), (r, middle), (l, middle)].into_iter().find(|&(x, y)| {
         let rect = (
             f64::from(x - inset),
             f64::from(y - inset),
