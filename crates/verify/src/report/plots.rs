@@ -434,3 +434,61 @@ pub fn plane_chart(title: &str, x_desc: &str, y_desc: &str, lines: &[Line], half
     }
     Ok(svg)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The text of every `<text>` element of `svg`.
+    fn texts(svg: &str) -> Vec<String> {
+        svg.split("<text")
+            .skip(1)
+            .map(|t| {
+                let body = &t[t.find('>').unwrap() + 1..];
+                body[..body.find("</text>").unwrap()].trim().to_string()
+            })
+            .collect()
+    }
+
+    /// Issue 28: a tick at zero reached by adding steps (−0.3 + 3 × 0.1 is 5.6·10⁻¹⁷ in
+    /// binary) prints as 0; no tick of these charts is in exponent form at all, and none is
+    /// a non-zero value smaller than a millionth of the axis span.
+    #[test]
+    fn near_zero_ticks_print_as_zero() {
+        assert_eq!(tick(-6e-17, 2.0), "0");
+        assert_eq!(tick(5.551115123125783e-17, 1.0), "0");
+        assert_eq!(tick(-0.30000000000000004, 1.0), "-0.3");
+        assert_eq!(tick(0.1 + 0.2, 1.0), "0.3");
+        assert_eq!(tick(2500.0000000001, 10000.0), "2500");
+        assert_eq!(tick(1.5e6, 1e7), "1.5e6");
+        let mut zeros = 0;
+        for (lo, hi) in [(-0.3, 0.7), (-0.25, 0.65), (-0.7, 0.3), (-1.3, 0.9), (-0.035, 0.045), (-3.1, 2.9)] {
+            let line = ("y".to_string(), vec![(lo, lo), (hi, hi)]);
+            let svg = line_chart("t", "x", "y", &[line]).unwrap();
+            for t in texts(&svg) {
+                if let Ok(v) = t.parse::<f64>() {
+                    assert!(!t.contains('e'), "{lo}..{hi}: tick {t}");
+                    assert!(v == 0.0 || v.abs() > 1e-6 * (hi - lo), "{lo}..{hi}: tick {t}");
+                    zeros += usize::from(t == "0");
+                }
+            }
+        }
+        // Zero is a tick of both axes of every chart.
+        assert_eq!(zeros, 12);
+    }
+
+    /// The legend goes to a corner free of data, and nowhere when the data fill the plot.
+    #[test]
+    fn legend_avoids_the_data() {
+        let plot = (0, 0, 400, 200);
+        // A line across the top: the legend goes to the bottom right.
+        let top = vec![vec![(0, 10), (400, 10)]];
+        assert_eq!(free_corner(plot, (100, 50), &top), Some((294, 144)));
+        // A diagonal from bottom left to top right: the top left corner is free.
+        let diagonal = vec![vec![(0, 200), (400, 0)]];
+        assert_eq!(free_corner(plot, (100, 50), &diagonal), Some((6, 6)));
+        // Horizontal lines every 20 px: no place.
+        let full: Vec<Vec<(i32, i32)>> = (0..=10).map(|k| vec![(0, 20 * k), (400, 20 * k)]).collect();
+        assert_eq!(free_corner(plot, (100, 50), &full), None);
+    }
+}
