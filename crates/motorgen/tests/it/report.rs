@@ -366,7 +366,12 @@ fn probe_plots(dir: &Path, page: &Path) -> Vec<(String, f64, usize, usize)> {
     body.lines()
         .map(|l| {
             let f: Vec<&str> = l.split(' ').collect();
-            (f[0].to_string(), f[1].parse().unwrap(), f[2].parse().unwrap(), f[3].parse().unwrap())
+            (
+                f[0].to_string(),
+                f[1].parse().unwrap(),
+                f[2].parse().unwrap(),
+                f[3].parse().unwrap(),
+            )
         })
         .collect()
 }
@@ -413,9 +418,15 @@ fn report_plots_are_legible_at_1400_px() {
         let got = probe_plots(&dir, &page);
         assert!(got.len() >= PLOTS.len(), "{stem}: {got:?}");
         for (id, font, boxes, covered) in &got {
-            assert!(*font >= 13.0, "{stem}: plot {id}: smallest text {font:.2} px at 1400 px");
+            assert!(
+                *font >= 13.0,
+                "{stem}: plot {id}: smallest text {font:.2} px at 1400 px"
+            );
             assert!(*boxes >= 1, "{stem}: plot {id}: no legend box");
-            assert_eq!(*covered, 0, "{stem}: plot {id}: {covered} of {boxes} legend boxes on the data");
+            assert_eq!(
+                *covered, 0,
+                "{stem}: plot {id}: {covered} of {boxes} legend boxes on the data"
+            );
         }
     }
 }

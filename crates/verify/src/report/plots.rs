@@ -64,13 +64,21 @@ pub fn tick(x: f64, span: f64) -> String {
     if !(1e-3..1e5).contains(&a) {
         let s = format!("{x:.2e}");
         let (m, e) = s.split_once('e').unwrap_or((&s, "0"));
-        let m = if m.contains('.') { m.trim_end_matches('0').trim_end_matches('.') } else { m };
+        let m = if m.contains('.') {
+            m.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            m
+        };
         return format!("{m}e{e}");
     }
     let resolution = if span > 0.0 { 1e-3 * span.min(1e3 * a) } else { 1e-3 * a };
     let decimals = (-resolution.log10()).ceil().clamp(0.0, 9.0) as usize;
     let s = format!("{x:.decimals$}");
-    let s = if s.contains('.') { s.trim_end_matches('0').trim_end_matches('.') } else { &s };
+    let s = if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.')
+    } else {
+        &s
+    };
     if s == "-0" { "0".into() } else { s.to_string() }
 }
 
@@ -97,7 +105,10 @@ fn legend_size(lines: &[Line]) -> (i32, i32) {
     let em = f64::from(FONT) / 1.24;
     let chars = lines.iter().map(|l| l.0.chars().count()).max().unwrap_or(0);
     let text = (chars as f64 * 0.62 * em).ceil() as i32;
-    (PAD + SWATCH + PAD + text + PAD, PAD + ROW * lines.len() as i32 + PAD / 2)
+    (
+        PAD + SWATCH + PAD + text + PAD,
+        PAD + ROW * lines.len() as i32 + PAD / 2,
+    )
 }
 
 /// Whether the segment p–q meets the rectangle `r` = (x0, y0, x1, y1) (Liang–Barsky).
@@ -138,7 +149,18 @@ fn free_corner(plot: (i32, i32, i32, i32), size: (i32, i32), polylines: &[Vec<(i
     let (l, r) = (x0 + inset, x1 - inset - w);
     let (t, b) = (y0 + inset, y1 - inset - h);
     let (mid, middle) = ((x0 + x1 - w) / 2, (y0 + y1 - h) / 2);
-    [(r, t), (l, t), (r, b), (l, b), (mid, t), (mid, b), (r, middle), (l, middle)].into_iter().find(|&(x, y)| {
+    [
+        (r, t),
+        (l, t),
+        (r, b),
+        (l, b),
+        (mid, t),
+        (mid, b),
+        (r, middle),
+        (l, middle),
+    ]
+    .into_iter()
+    .find(|&(x, y)| {
         let rect = (
             f64::from(x - inset),
             f64::from(y - inset),
@@ -164,8 +186,11 @@ fn draw_legend(area: &DrawingArea<SVGBackend<'_>, Shift>, at: (i32, i32), lines:
     let (x, y) = at;
     area.draw(&Rectangle::new([(x, y), (x + w, y + h)], WHITE.mix(0.9).filled()))
         .map_err(err)?;
-    area.draw(&Rectangle::new([(x, y), (x + w, y + h)], BLACK.mix(0.4).stroke_width(1)))
-        .map_err(err)?;
+    area.draw(&Rectangle::new(
+        [(x, y), (x + w, y + h)],
+        BLACK.mix(0.4).stroke_width(1),
+    ))
+    .map_err(err)?;
     for (k, (label, _)) in lines.iter().enumerate() {
         let top = y + PAD + ROW * k as i32;
         let mid = top + ROW / 2 - 2;
@@ -417,8 +442,8 @@ pub fn plane_chart(title: &str, x_desc: &str, y_desc: &str, lines: &[Line], half
     let mut svg = String::new();
     {
         // The plane square, the legend in a column to its right (it would cover the curves).
-        let root = SVGBackend::with_string(&mut svg, (PLANE + legend_size(lines).0 as u32 + 12, PLANE))
-            .into_drawing_area();
+        let root =
+            SVGBackend::with_string(&mut svg, (PLANE + legend_size(lines).0 as u32 + 12, PLANE)).into_drawing_area();
         root.fill(&WHITE).map_err(err)?;
         panel(
             &root,
@@ -462,7 +487,14 @@ mod tests {
         assert_eq!(tick(2500.0000000001, 10000.0), "2500");
         assert_eq!(tick(1.5e6, 1e7), "1.5e6");
         let mut zeros = 0;
-        for (lo, hi) in [(-0.3, 0.7), (-0.25, 0.65), (-0.7, 0.3), (-1.3, 0.9), (-0.035, 0.045), (-3.1, 2.9)] {
+        for (lo, hi) in [
+            (-0.3, 0.7),
+            (-0.25, 0.65),
+            (-0.7, 0.3),
+            (-1.3, 0.9),
+            (-0.035, 0.045),
+            (-3.1, 2.9),
+        ] {
             let line = ("y".to_string(), vec![(lo, lo), (hi, hi)]);
             let svg = line_chart("t", "x", "y", &[line]).unwrap();
             for t in texts(&svg) {
