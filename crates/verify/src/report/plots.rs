@@ -12,7 +12,7 @@ pub const SIZE: (u32, u32) = (800, 420);
 /// Height of a two-panel (magnitude/phase) chart \[px\].
 pub const BODE_HEIGHT: u32 = 600;
 /// Height of the (square) plotting side of a dq-plane chart \[px\].
-pub const PLANE: u32 = 680;
+pub const PLANE: u32 = 640;
 
 const COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
