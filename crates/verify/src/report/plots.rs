@@ -239,10 +239,15 @@ enum LegendAt {
     Auto,
     /// In a column to the right of the plotting area.
     Outside,
+    /// Nowhere, the chart on the whole area (another panel of the figure has the legend).
+    Hidden,
+    /// Nowhere, the chart leaving the column [`LegendAt::Outside`] would take empty (so
+    /// stacked panels keep one x scale).
+    Reserved,
+    /// Draw nothing: only find the free corner [`LegendAt::Auto`] would take.
+    Probe,
 }
 
-/// Draws `lines` on `area` with linear or logarithmic x, and their legend where it
-/// covers no data ([`free_corner`]), else in a column right of the plot.
 #[allow(clippy::too_many_arguments)]
 fn panel(
     area: &DrawingArea<SVGBackend<'_>, Shift>,
@@ -253,7 +258,7 @@ fn panel(
     log_x: bool,
     fixed: Option<((f64, f64), (f64, f64))>,
     legend: LegendAt,
-) -> Result<(), String> {
+) -> Result<Option<(i32, i32)>, String> {
     let ((x0, x1), (y0, y1)) = fixed.unwrap_or_else(|| {
         (
             range(lines.iter().flat_map(|l| l.1.iter().map(|p| p.0))),
@@ -316,7 +321,7 @@ fn panel(
         }};
     }
     // The corner, within `area`, the data leave free for the legend.
-    let corner = if legend == LegendAt::Auto {
+    let corner = if matches!(legend, LegendAt::Auto | LegendAt::Probe) {
         with_chart!(&area, |chart| {
             let base = area.get_base_pixel();
             let (xr, yr) = chart.plotting_area().get_pixel_range();
@@ -341,18 +346,24 @@ fn panel(
     } else {
         None
     };
-    match corner {
-        Some(at) => {
+    match (legend, corner) {
+        (LegendAt::Probe, _) => {}
+        (_, Some(at)) => {
             with_chart!(&area, |chart| draw!(chart, Some(at)))?;
         }
-        None => {
+        (LegendAt::Hidden, None) => {
+            with_chart!(&area, |chart| draw!(chart, None))?;
+        }
+        (_, None) => {
             let (w, _) = area.dim_in_pixel();
             let (left, _) = area.split_horizontally(w as i32 - size.0 - 12);
             let (right, top) = with_chart!(&left, |chart| draw!(chart, None))?;
-            draw_legend(&area, (right + 12, top), lines)?;
+            if legend != LegendAt::Reserved {
+                draw_legend(&area, (right + 12, top), lines)?;
+            }
         }
     }
-    Ok(())
+    Ok(corner)
 }
 
 /// One chart of `lines` over linear x.
@@ -411,17 +422,21 @@ pub fn bode_chart(title: &str, x_desc: &str, responses: &[(String, &Response)], 
         } else {
             (0.0f64.max(xr.0), xr.1)
         };
-        panel(
-            &top,
-            None,
-            x_desc,
-            "magnitude [dB]",
-            &mag,
-            log_x,
-            Some((xr, (lo.max(-120.0), hi))),
-            LegendAt::Auto,
-        )?;
         let pr = range(phase.iter().flat_map(|l| l.1.iter().map(|p| p.1)));
+        let mag_range = Some((xr, (lo.max(-120.0), hi)));
+        let phase_range = Some((xr, pr));
+        // One legend for both panels (same lines, same colours): in a free corner of the
+        // magnitude panel, else of the phase panel, else in a column right of both.
+        let probe =
+            |area, desc, lines: &[Line], fixed| panel(area, None, x_desc, desc, lines, log_x, fixed, LegendAt::Probe);
+        let (top_legend, bottom_legend) = if probe(&top, "magnitude [dB]", &mag, mag_range)?.is_some() {
+            (LegendAt::Auto, LegendAt::Hidden)
+        } else if probe(&bottom, "phase [°]", &phase, phase_range)?.is_some() {
+            (LegendAt::Hidden, LegendAt::Auto)
+        } else {
+            (LegendAt::Outside, LegendAt::Reserved)
+        };
+        panel(&top, None, x_desc, "magnitude [dB]", &mag, log_x, mag_range, top_legend)?;
         panel(
             &bottom,
             None,
@@ -429,8 +444,8 @@ pub fn bode_chart(title: &str, x_desc: &str, responses: &[(String, &Response)], 
             "phase [°]",
             &phase,
             log_x,
-            Some((xr, pr)),
-            LegendAt::Auto,
+            phase_range,
+            bottom_legend,
         )?;
         root.present().map_err(err)?;
     }
