@@ -301,3 +301,132 @@ fn report_overlays_the_measured_frequency_response() {
     ]);
     assert_eq!(o.status.code(), Some(1), "{}", String::from_utf8_lossy(&o.stderr));
 }
+
+/// Measures every plot of `page` as Chromium lays it out at a 1400 px wide viewport: a
+/// copy of the page with a script appended (the report itself has none) writes, per
+/// figure, `id`, the smallest rendered font size of its SVG text [px] (computed
+/// `font-size` × the SVG's on-screen scale) and the number of legend boxes (stroked
+/// `<rect>`s) met by a data line (`<polyline>` segment, both in the SVG's units), into a
+/// `<pre id="probe">` read back from `--dump-dom`.
+fn probe_plots(dir: &Path, page: &Path) -> Vec<(String, f64, usize, usize)> {
+    const SCRIPT: &str = r#"<script>
+(function () {
+  function hits(r, p, q) {
+    var t0 = 0, t1 = 1, dx = q[0] - p[0], dy = q[1] - p[1];
+    var c = [[-dx, p[0] - r.x0], [dx, r.x1 - p[0]], [-dy, p[1] - r.y0], [dy, r.y1 - p[1]]];
+    for (var i = 0; i < 4; i++) {
+      var den = c[i][0], num = c[i][1];
+      if (den === 0) { if (num < 0) return false; }
+      else { var t = num / den; if (den < 0) t0 = Math.max(t0, t); else t1 = Math.min(t1, t); if (t0 > t1) return false; }
+    }
+    return true;
+  }
+  var out = [];
+  document.querySelectorAll('figure.plot').forEach(function (fig) {
+    var svg = fig.querySelector('svg');
+    var scale = svg.getBoundingClientRect().width / svg.viewBox.baseVal.width;
+    var min = Infinity;
+    svg.querySelectorAll('text').forEach(function (t) {
+      if (t.textContent.trim() === '') return;
+      min = Math.min(min, parseFloat(getComputedStyle(t).fontSize) * scale);
+    });
+    var boxes = [];
+    svg.querySelectorAll('rect').forEach(function (r) {
+      var s = r.getAttribute('stroke');
+      if (s && s !== 'none') {
+        var x = +r.getAttribute('x'), y = +r.getAttribute('y');
+        boxes.push({x0: x, y0: y, x1: x + +r.getAttribute('width'), y1: y + +r.getAttribute('height')});
+      }
+    });
+    var covered = 0;
+    boxes.forEach(function (b) {
+      var met = false;
+      svg.querySelectorAll('polyline').forEach(function (pl) {
+        var pts = pl.getAttribute('points').trim().split(/\s+/).map(function (s) { return s.split(',').map(Number); });
+        for (var i = 0; i < pts.length; i++) {
+          if (hits(b, pts[i], pts[Math.min(i + 1, pts.length - 1)])) { met = true; break; }
+        }
+      });
+      if (met) covered++;
+    });
+    out.push(fig.id + ' ' + min + ' ' + boxes.length + ' ' + covered);
+  });
+  var pre = document.createElement('pre');
+  pre.id = 'probe';
+  pre.textContent = out.join('\n');
+  document.body.appendChild(pre);
+})();
+</script>"#;
+    let html = std::fs::read_to_string(page).unwrap();
+    let probe = dir.join("probe.html");
+    std::fs::write(&probe, html.replace("</body>", &format!("{SCRIPT}</body>"))).unwrap();
+    let dom = String::from_utf8(run_chromium(dir, &probe, &["--window-size=1400,3000", "--dump-dom"]).stdout).unwrap();
+    let start = dom.find("<pre id=\"probe\">").expect("the probe ran") + "<pre id=\"probe\">".len();
+    let body = &dom[start..start + dom[start..].find("</pre>").unwrap()];
+    body.lines()
+        .map(|l| {
+            let f: Vec<&str> = l.split(' ').collect();
+            (
+                f[0].to_string(),
+                f[1].parse().unwrap(),
+                f[2].parse().unwrap(),
+                f[3].parse().unwrap(),
+            )
+        })
+        .collect()
+}
+
+/// The probe's legend check can fail: a legend box drawn over a line is counted, one
+/// beside it is not, and an 8 px font in an SVG shown at its own width measures 8 px.
+#[test]
+fn legend_and_font_probe_detects_problems() {
+    let dir = tmp("probe-self-test");
+    let page = dir.join("p.html");
+    std::fs::write(
+        &page,
+        "<!DOCTYPE html><html><body>\
+         <figure class=\"plot\" id=\"over\"><svg width=\"200\" height=\"100\" viewBox=\"0 0 200 100\">\
+         <polyline points=\"0,50 200,50\" stroke=\"red\" fill=\"none\"/>\
+         <rect x=\"80\" y=\"40\" width=\"40\" height=\"20\" fill=\"none\" stroke=\"#000000\"/>\
+         <text x=\"10\" y=\"10\" font-size=\"8\">a</text></svg></figure>\
+         <figure class=\"plot\" id=\"beside\"><svg width=\"200\" height=\"100\" viewBox=\"0 0 200 100\">\
+         <polyline points=\"0,50 200,50\" stroke=\"red\" fill=\"none\"/>\
+         <rect x=\"80\" y=\"60\" width=\"40\" height=\"20\" fill=\"none\" stroke=\"#000000\"/>\
+         <text x=\"10\" y=\"10\" font-size=\"16\">a</text></svg></figure>\
+         </body></html>",
+    )
+    .unwrap();
+    let got = probe_plots(&dir, &page);
+    assert_eq!(got.len(), 2, "{got:?}");
+    assert_eq!((got[0].0.as_str(), got[0].2, got[0].3), ("over", 1, 1), "{got:?}");
+    assert!((got[0].1 - 8.0).abs() < 0.01, "{got:?}");
+    assert_eq!((got[1].0.as_str(), got[1].2, got[1].3), ("beside", 1, 0), "{got:?}");
+    assert!((got[1].1 - 16.0).abs() < 0.01, "{got:?}");
+}
+
+/// Issue 28: the plots are legible as a user sees them, at a 1400 px wide window —
+/// every tick label, axis label and legend text renders at 13 px or more, every plot has
+/// a legend box, and no legend box meets a plotted line.
+#[test]
+fn report_plots_are_legible_at_1400_px() {
+    for stem in motor_stems() {
+        let dir = tmp(&format!("legible-{stem}"));
+        let spec = format!("motors/{stem}.toml");
+        let out = motorgen(&["report", &spec, "--out", dir.to_str().unwrap()]);
+        let page = dir.join(format!("{stem}.html"));
+        assert!(page.exists(), "{stem}: {}", String::from_utf8_lossy(&out.stderr));
+        let got = probe_plots(&dir, &page);
+        assert!(got.len() >= PLOTS.len(), "{stem}: {got:?}");
+        for (id, font, boxes, covered) in &got {
+            assert!(
+                *font >= 13.0,
+                "{stem}: plot {id}: smallest text {font:.2} px at 1400 px"
+            );
+            assert!(*boxes >= 1, "{stem}: plot {id}: no legend box");
+            assert_eq!(
+                *covered, 0,
+                "{stem}: plot {id}: {covered} of {boxes} legend boxes on the data"
+            );
+        }
+    }
+}
