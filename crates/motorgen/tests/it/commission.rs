@@ -155,21 +155,12 @@ fn frequency_response_on_the_simulated_drive() {
         assert!(err.starts_with(&format!("error: {option}: ")), "{err}");
         assert!(!dir.join("out").exists());
     }
-    let o = motorgen(&[
-        "commission",
+    let o = commission(
         &spec,
-        "--board",
-        "boards/motorgen-reference.toml",
-        "--can",
         "mgnone0",
-        "--out",
         &out,
-        "frequency-response",
-        "--axis",
-        "q",
-        "--sim-scale",
-        "Lq=0.7",
-    ]);
+        &["frequency-response", "--axis", "q", "--sim-scale", "Lq=0.7"],
+    );
     assert_eq!(o.status.code(), Some(1), "{}", text_of(&o));
     let o = motorgen(&[&base[..], &["--sim-scale", "Lq=0.7"]].concat());
     assert_eq!(o.status.code(), Some(0), "{}", text_of(&o));
