@@ -105,6 +105,47 @@ pub fn frequency_response_period(capacity: usize) -> u32 {
     }
 }
 
+/// What a command needs computed before the supervisor takes it: a frequency
+/// response's oscillators ([`FrequencyResponse::start`]: libm's sine and cosine of every
+/// line's rotation and phase, and the lines' weights). The board runs the supervisor's
+/// [`CommissioningMode::command_prepared`] inside a critical section that masks the
+/// control interrupt; computed there, the oscillators held the interrupt off for longer
+/// than a carrier period at 40 kHz (the emulated G474 names it: 25.1 µs masked, one
+/// instruction per cycle, a lower bound). [`prepare`] runs before, interrupts enabled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prepared {
+    command: Command,
+    run: Option<(FrequencyResponse, FrequencyResponseState)>,
+}
+
+/// Prepares `c` for [`CommissioningMode::command_prepared`]: for a valid frequency
+/// response (lines valid for the period a buffer of `capacity` holds, amplitude and trip
+/// positive and finite) the routine and its oscillators' initial state; nothing for
+/// any other command.
+pub fn prepare(cfg: &ModeConfig, c: &Command, capacity: usize) -> Prepared {
+    let _ = cfg;
+    let run = (c.routine == Some(Routine::FrequencyResponse))
+        .then(|| {
+            let [first, per_octave] = c.decimation.to_le_bytes();
+            let period = frequency_response_period(capacity);
+            let lines = multisine_lines(u16::from(first), per_octave, period)?;
+            if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
+                return None;
+            }
+            let r = FrequencyResponse {
+                axis: if c.axis_q { Axis::Q } else { Axis::D },
+                amplitude: c.voltage,
+                current_trip: c.current_trip,
+                period,
+                settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
+                lines,
+            };
+            Some((r, r.start()))
+        })
+        .flatten();
+    Prepared { command: *c, run }
+}
+
 /// What the current-control step gets this period.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Control {
@@ -220,14 +261,39 @@ impl CommissioningMode {
     }
 
     /// A received command; returns the reason it was refused ([`Reason::None`]:
-    /// accepted). `capacity` is the capture buffer's length.
+    /// accepted). `capacity` is the capture buffer's length. [`prepare`] and
+    /// [`CommissioningMode::command_prepared`] in one call.
     pub fn command(&mut self, cfg: &ModeConfig, c: &Command, guards: &Guards, omega_e: f32, capacity: usize) -> Reason {
-        let reason = self.accept(cfg, c, guards, omega_e, capacity);
+        let prepared = prepare(cfg, c, capacity);
+        self.command_prepared(cfg, c, &prepared, guards, omega_e, capacity)
+    }
+
+    /// [`CommissioningMode::command`] with what [`prepare`] computed for `c` beforehand
+    /// (outside the board's critical section: see [`prepare`]); a `prepared` made from
+    /// another command refuses a frequency response ([`Reason::BadCommand`]).
+    pub fn command_prepared(
+        &mut self,
+        cfg: &ModeConfig,
+        c: &Command,
+        prepared: &Prepared,
+        guards: &Guards,
+        omega_e: f32,
+        capacity: usize,
+    ) -> Reason {
+        let reason = self.accept(cfg, c, prepared, guards, omega_e, capacity);
         self.reason = reason;
         reason
     }
 
-    fn accept(&mut self, cfg: &ModeConfig, c: &Command, guards: &Guards, omega_e: f32, capacity: usize) -> Reason {
+    fn accept(
+        &mut self,
+        cfg: &ModeConfig,
+        c: &Command,
+        prepared: &Prepared,
+        guards: &Guards,
+        omega_e: f32,
+        capacity: usize,
+    ) -> Reason {
         let Some(routine) = c.routine else {
             // Abort: outputs off, capture dropped; clears a latched abort once safe.
             return match self.mode {
@@ -261,7 +327,7 @@ impl CommissioningMode {
             return Reason::NotAtStandstill;
         }
         if routine == Routine::FrequencyResponse {
-            return self.accept_frequency_response(cfg, c, capacity);
+            return self.accept_frequency_response(cfg, c, prepared);
         }
         let decimation = match u8::try_from(c.decimation) {
             Ok(d) if d >= 1 => d,
@@ -328,27 +394,20 @@ impl CommissioningMode {
         Reason::None
     }
 
-    /// The frequency response: amplitude and trip positive, the line set valid for the
-    /// period the buffer holds.
-    fn accept_frequency_response(&mut self, cfg: &ModeConfig, c: &Command, capacity: usize) -> Reason {
-        let [first, per_octave] = c.decimation.to_le_bytes();
-        let period = frequency_response_period(capacity);
-        let Some(lines) = multisine_lines(u16::from(first), per_octave, period) else {
+    /// The frequency response [`prepare`]d from `c` (amplitude and trip positive, the
+    /// line set valid for the period the buffer holds).
+    fn accept_frequency_response(&mut self, cfg: &ModeConfig, c: &Command, prepared: &Prepared) -> Reason {
+        let Some((r, st)) = prepared.run.filter(|_| prepared.command == *c) else {
             return Reason::BadCommand;
         };
-        if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
-            return Reason::BadCommand;
-        }
-        let r = FrequencyResponse {
-            axis: if c.axis_q { Axis::Q } else { Axis::D },
-            amplitude: c.voltage,
-            current_trip: c.current_trip,
-            period,
-            settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
-            lines,
-        };
-        let run = Running::Frequency(r, r.start());
-        self.start(cfg, Routine::FrequencyResponse, run, c.axis_q, 1, c.current_trip);
+        self.start(
+            cfg,
+            Routine::FrequencyResponse,
+            Running::Frequency(r, st),
+            c.axis_q,
+            1,
+            c.current_trip,
+        );
         Reason::None
     }
 
