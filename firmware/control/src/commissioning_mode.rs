@@ -50,6 +50,11 @@ pub struct ModeConfig {
     pub rotation: (i32, u32, u32),
     /// ψ_M run (§6.5).
     pub flux: FluxLinkage,
+    /// Largest injection peak of the frequency response \[V\] (the generated
+    /// `INJECTION_LIMIT`: the injected current within half the routine's trip and the
+    /// applied voltage within the linear modulation range); a command above it is
+    /// refused with [`Reason::AmplitudeAboveLimit`].
+    pub injection_limit: f32,
 }
 
 /// Safety inputs, every period.
@@ -115,7 +120,8 @@ pub fn frequency_response_period(capacity: usize) -> u32 {
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Prepared {
     command: Command,
-    run: Option<(FrequencyResponse, FrequencyResponseState)>,
+    /// The routine and its oscillators, or the reason the command is refused.
+    run: Result<(FrequencyResponse, FrequencyResponseState), Reason>,
 }
 
 /// Prepares `c` for [`CommissioningMode::command_prepared`]: for a valid frequency
@@ -123,27 +129,44 @@ pub struct Prepared {
 /// positive and finite) the routine and its oscillators' initial state; nothing for
 /// any other command.
 pub fn prepare(cfg: &ModeConfig, c: &Command, capacity: usize) -> Prepared {
-    let _ = cfg;
-    let run = (c.routine == Some(Routine::FrequencyResponse))
-        .then(|| {
-            let [first, per_octave] = c.decimation.to_le_bytes();
-            let period = frequency_response_period(capacity);
-            let lines = multisine_lines(u16::from(first), per_octave, period)?;
-            if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
-                return None;
-            }
-            let r = FrequencyResponse {
-                axis: if c.axis_q { Axis::Q } else { Axis::D },
-                amplitude: c.voltage,
-                current_trip: c.current_trip,
-                period,
-                settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
-                lines,
-            };
-            Some((r, r.start()))
-        })
-        .flatten();
-    Prepared { command: *c, run }
+    Prepared {
+        command: *c,
+        run: prepare_frequency_response(cfg, c, capacity),
+    }
+}
+
+/// The frequency response of `c`: its line set valid for the period a buffer of
+/// `capacity` holds, amplitude and trip positive and finite ([`Reason::BadCommand`]
+/// otherwise), the amplitude at most the configuration's `injection_limit` (refused, not
+/// clamped: [`Reason::AmplitudeAboveLimit`], so a capture never carries another
+/// amplitude than the host asked for).
+fn prepare_frequency_response(
+    cfg: &ModeConfig,
+    c: &Command,
+    capacity: usize,
+) -> Result<(FrequencyResponse, FrequencyResponseState), Reason> {
+    if c.routine != Some(Routine::FrequencyResponse) {
+        return Err(Reason::BadCommand);
+    }
+    let [first, per_octave] = c.decimation.to_le_bytes();
+    let period = frequency_response_period(capacity);
+    let lines = multisine_lines(u16::from(first), per_octave, period).ok_or(Reason::BadCommand)?;
+    if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
+        return Err(Reason::BadCommand);
+    }
+    // NaN limit (never generated) refuses every amplitude.
+    if !(c.voltage <= cfg.injection_limit) {
+        return Err(Reason::AmplitudeAboveLimit);
+    }
+    let r = FrequencyResponse {
+        axis: if c.axis_q { Axis::Q } else { Axis::D },
+        amplitude: c.voltage,
+        current_trip: c.current_trip,
+        period,
+        settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
+        lines,
+    };
+    Ok((r, r.start()))
 }
 
 /// What the current-control step gets this period.
@@ -397,8 +420,12 @@ impl CommissioningMode {
     /// The frequency response [`prepare`]d from `c` (amplitude and trip positive, the
     /// line set valid for the period the buffer holds).
     fn accept_frequency_response(&mut self, cfg: &ModeConfig, c: &Command, prepared: &Prepared) -> Reason {
-        let Some((r, st)) = prepared.run.filter(|_| prepared.command == *c) else {
+        if prepared.command != *c {
             return Reason::BadCommand;
+        }
+        let (r, st) = match prepared.run {
+            Ok(run) => run,
+            Err(reason) => return reason,
         };
         self.start(
             cfg,
@@ -649,6 +676,7 @@ mod tests {
                 average_samples: 2,
                 min_speed: 10.0,
             },
+            injection_limit: 3.0,
         }
     }
 

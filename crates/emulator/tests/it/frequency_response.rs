@@ -33,7 +33,7 @@ fn options(axis: Axis) -> Options {
         iface: "emu0".into(),
         timeout: "10 s".into(),
         axis,
-        amplitude: None,
+        amplitude: std::env::var("FR_AMPLITUDE").ok(),
         frequencies: None,
     }
 }
@@ -69,11 +69,15 @@ fn measure(motor: &str, board: &str, axes: &[Axis]) -> Result<Vec<Pair>, String>
     for &axis in axes {
         let plan = fr::plan_design(&options(axis), design.clone(), &rel).map_err(|e| format!("{e:?}"))?;
         let (wall, t0) = (Instant::now(), rig.machine.soc().time_s());
-        let emulated = plan
-            .run(&mut CanBus::new(&mut rig))
-            .map_err(|e| format!("{motor} on {board}, {axis:?} axis, emulated: {e:?} (fault record: {:?})", rig.fault_cause()))?;
+        let emulated = plan.run(&mut CanBus::new(&mut rig)).map_err(|e| {
+            format!(
+                "{motor} on {board}, {axis:?} axis, emulated: {e:?} (fault record: {:?})",
+                rig.fault_cause()
+            )
+        })?;
         let (emulated_wall_s, emulated_s) = (wall.elapsed().as_secs_f64(), rig.machine.soc().time_s() - t0);
-        let mut sim = SimulatedDrive::new(&design, Setup::new(&spec, &design).bench(0.0), 0.0).ok_or("no CAN interface")?;
+        let mut sim =
+            SimulatedDrive::new(&design, Setup::new(&spec, &design).bench(0.0), 0.0).ok_or("no CAN interface")?;
         let simulated = plan
             .run(&mut sim)
             .map_err(|e| format!("{motor} on {board}, {axis:?} axis, --sim: {e:?}"))?;
@@ -104,7 +108,12 @@ fn agree(a: &Margins, b: &Margins) -> Result<(f64, f64, f64), String> {
     if e.0.abs() <= 0.5 && e.1.abs() <= 3.0 && e.2.abs() <= 0.05 {
         Ok(e)
     } else {
-        Err(format!("{a:?} vs {b:?}: ΔGM {:.3} dB, ΔPM {:.3}°, Δω_c {:.3} %", e.0, e.1, 100.0 * e.2))
+        Err(format!(
+            "{a:?} vs {b:?}: ΔGM {:.3} dB, ΔPM {:.3}°, Δω_c {:.3} %",
+            e.0,
+            e.1,
+            100.0 * e.2
+        ))
     }
 }
 
@@ -144,12 +153,14 @@ fn emulated_bench_measures_the_margins_of_the_simulated_bench() {
                     let axis = p.emulated.axis;
                     let r = agree(&p.emulated.measured, &p.simulated.measured);
                     println!(
-                        "{motor} on {board}, {axis:?} axis (A = {:.3} V, {} lines): designed {}; --sim {}; emulated {} ({:.3} s emulated in {:.1} s); {r:?}",
+                        "{motor} on {board}, {axis:?} axis (A = {:.3} V, {} lines): designed {}; --sim {} (fitted delay {:.4} T_s); emulated {} (fitted delay {:.4} T_s; {:.3} s emulated in {:.1} s); {r:?}",
                         p.emulated.amplitude_v,
                         p.emulated.points.len(),
                         figures(&p.emulated.designed),
                         figures(&p.simulated.measured),
+                        p.simulated.fit.plant.delay_periods,
                         figures(&p.emulated.measured),
+                        p.emulated.fit.plant.delay_periods,
                         p.emulated_s,
                         p.emulated_wall_s,
                     );
