@@ -5,15 +5,18 @@
 //! (`motor_commission::frequency_response::Plan::run` on [`CanBus`]) — the code
 //! `motorgen commission --can` runs. The same plan then runs on `--sim`'s simulated
 //! drive (`motor_commission::sim_drive`); the margins read from the two captures agree
-//! within ±0.5 dB, ±3° and ±5 % of the crossover per axis.
+//! within ±0.5 dB, ±3° and ±5 % of the crossover per axis. Before, the image refuses an
+//! amplitude above its generated `INJECTION_LIMIT` (`Reason::AmplitudeAboveLimit`).
 //!
 //! Cost: one multisine period is the capture buffer's 4096 samples, run twice (settle,
 //! capture) and streamed over CAN; a few pairs only (README, "Frequency response").
 
-use std::time::Instant;
+use std::time::{Duration, Instant};
 
+use motor_commission::commission::{SessionError, run_session};
 use motor_commission::frequency_response::{self as fr, Margins, Measurement, Options};
 use motor_commission::sim_drive::SimulatedDrive;
+use motor_control::can_protocol::{Quantity, Reason};
 use motor_control::commissioning::Axis;
 use motor_emulator::can_bus::CanBus;
 use motor_emulator::drive::Drive;
@@ -33,7 +36,7 @@ fn options(axis: Axis) -> Options {
         iface: "emu0".into(),
         timeout: "10 s".into(),
         axis,
-        amplitude: std::env::var("FR_AMPLITUDE").ok(),
+        amplitude: None,
         frequencies: None,
     }
 }
@@ -65,6 +68,7 @@ fn measure(motor: &str, board: &str, axes: &[Axis]) -> Result<Vec<Pair>, String>
         .map_err(|e| format!("zero torque: {e}; {}", rig.machine.summary()))?;
     let design = rig.design.clone();
     let rel = format!("motors/{motor}.toml");
+    refuses_above_the_limit(&mut rig, &design, &rel)?;
     let mut out = Vec::new();
     for &axis in axes {
         let plan = fr::plan_design(&options(axis), design.clone(), &rel).map_err(|e| format!("{e:?}"))?;
@@ -89,6 +93,33 @@ fn measure(motor: &str, board: &str, axes: &[Axis]) -> Result<Vec<Pair>, String>
         });
     }
     Ok(out)
+}
+
+/// The image's own bound: the host's command with the amplitude one voltage LSB above
+/// the generated `INJECTION_LIMIT` (the host itself refuses to send it, so the frame is
+/// built here) is refused by the image with `Reason::AmplitudeAboveLimit`, and nothing
+/// runs (the outputs stay as they were: the drive at zero torque).
+fn refuses_above_the_limit(rig: &mut Rig, design: &codegen::Design, rel: &str) -> Result<(), String> {
+    let plan = fr::plan_design(&options(Axis::D), design.clone(), rel).map_err(|e| format!("{e:?}"))?;
+    let (cfg, _) = motor_commission::candump::mode_config(design).ok_or("no CAN interface")?;
+    let per = cfg.layout.per_lsb(Quantity::Voltage);
+    let mut command = plan.command;
+    // The default is the limit (in whole LSBs); two LSBs more decode above it.
+    command.voltage = plan.command.voltage + 2.0 * per;
+    if command.voltage <= cfg.injection_limit {
+        return Err(format!(
+            "the test's amplitude {} V is not above the limit {} V",
+            command.voltage, cfg.injection_limit
+        ));
+    }
+    let mut bus = CanBus::new(rig);
+    match run_session(&mut bus, "emu0", &cfg.layout, &command, Duration::from_millis(100)) {
+        Err(SessionError::Refused(Reason::AmplitudeAboveLimit)) => Ok(()),
+        other => Err(format!(
+            "amplitude {} V above INJECTION_LIMIT = {} V: {other:?}, not refused with AmplitudeAboveLimit",
+            command.voltage, cfg.injection_limit
+        )),
+    }
 }
 
 /// The differences (gain margin \[dB\], phase margin \[°\], crossover ratio − 1) of
