@@ -680,6 +680,40 @@ mod tests {
         }
     }
 
+    /// A frequency response on the d axis with `voltage` as its amplitude: lines from
+    /// harmonic 4, 3 per octave of the period an 8192-sample buffer holds.
+    fn frequency_cmd(voltage: f32) -> Command {
+        Command {
+            routine: Some(Routine::FrequencyResponse),
+            axis_q: false,
+            voltage,
+            current_trip: 10.0,
+            decimation: u16::from_le_bytes([4, 3]),
+        }
+    }
+
+    /// The injection limit (3 V in `cfg`): an amplitude at it runs, one above it is
+    /// refused with its own reason and nothing starts; a command taken with what was
+    /// prepared for another is refused.
+    #[test]
+    fn frequency_response_amplitude_is_bounded_by_the_injection_limit() {
+        let c = cfg();
+        let g = Guards::default();
+        let mut m = CommissioningMode::new();
+        assert_eq!(
+            m.command(&c, &frequency_cmd(3.01), &g, 0.0, 8192),
+            Reason::AmplitudeAboveLimit
+        );
+        assert_eq!(m.state(), (State::Idle, Reason::AmplitudeAboveLimit));
+        let prepared = prepare(&c, &frequency_cmd(2.0), 8192);
+        assert_eq!(
+            m.command_prepared(&c, &frequency_cmd(2.5), &prepared, &g, 0.0, 8192),
+            Reason::BadCommand
+        );
+        assert_eq!(m.command(&c, &frequency_cmd(3.0), &g, 0.0, 8192), Reason::None);
+        assert_eq!(m.state().0, State::Commissioning);
+    }
+
     fn step_cmd() -> Command {
         Command {
             routine: Some(Routine::Step),
