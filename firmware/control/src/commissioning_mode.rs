@@ -154,8 +154,8 @@ fn prepare_frequency_response(
     if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
         return Err(Reason::BadCommand);
     }
-    // NaN limit (never generated) refuses every amplitude.
-    if !(c.voltage <= cfg.injection_limit) {
+    // The voltage is finite here; a NaN limit (never generated) refuses every amplitude.
+    if c.voltage > cfg.injection_limit || cfg.injection_limit.is_nan() {
         return Err(Reason::AmplitudeAboveLimit);
     }
     let r = FrequencyResponse {
