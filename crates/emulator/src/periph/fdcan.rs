@@ -448,3 +448,59 @@ impl Fdcan {
         self.accepted += 1;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Joins at 500 kbit/s from a 170 MHz kernel clock: NBRP = 19 (÷20), 17 quanta
+    /// (NTSEG1 = 13 → 14 + 1 sync, NTSEG2 = 1 → 2): 170 MHz/(20·17) = 500 kbit/s.
+    fn joined() -> Fdcan {
+        let mut f = Fdcan::new();
+        f.write(0x18, INIT | CCE, 0.0, 170e6).unwrap();
+        f.write(0x1C, (19 << 16) | (13 << 8) | 1, 0.0, 170e6).unwrap();
+        f.write(0x18, 0, 0.0, 170e6).unwrap();
+        f
+    }
+
+    /// Writes a standard frame (id, 8 bytes) into Tx buffer `k` as the image's
+    /// `tx_element` does (RM0440 §44.3.3: T0 = ID << 18, T1 = DLC << 16).
+    fn element(f: &mut Fdcan, k: u32, id: u32) {
+        let base = ((TXBUF + k * TX_ELEMENT_BYTES) / 4) as usize;
+        f.ram[base] = id << 18;
+        f.ram[base + 1] = 8 << 16;
+        f.ram[base + 2] = 0x0403_0201;
+        f.ram[base + 3] = 0x0807_0605;
+    }
+
+    /// Two requests in FIFO order: TXFQS counts them, the bus carries them one after the
+    /// other, 111 bits (47 + 64) each at 500 kbit/s = 222 µs; a request of a buffer other
+    /// than the put index is a violation.
+    #[test]
+    fn tx_fifo_sends_in_order_at_the_bit_rate() {
+        let mut f = joined();
+        assert_eq!(f.read(0xC4, 0.0).unwrap(), 3, "reset: 3 free, put 0");
+        element(&mut f, 0, 0x123);
+        f.write(0xCC, 1, 1e-3, 170e6).unwrap();
+        element(&mut f, 1, 0x124);
+        f.write(0xCC, 2, 1e-3, 170e6).unwrap();
+        let s = f.read(0xC4, 1e-3).unwrap();
+        assert_eq!((s & 7, (s >> 8) & 3, (s >> 16) & 3, (s >> 21) & 1), (1, 0, 2, 0));
+        assert_eq!(f.read(0xC8, 1e-3).unwrap(), 0b11);
+        assert!(
+            f.write(0xCC, 1, 1e-3, 170e6).is_err(),
+            "buffer 0 is not the put index 2"
+        );
+        let first_end = 1e-3 + 111.0 / 500e3;
+        assert!(!f.has_sent_by(first_end - 1e-9));
+        let (t, frame) = f.take_sent(first_end + 1e-9).unwrap();
+        assert!((t - first_end).abs() < 1e-12);
+        assert_eq!((frame.id, frame.data.len(), frame.data[7]), (0x123, 8, 8));
+        assert!(f.take_sent(first_end + 1e-9).is_none());
+        let (t, frame) = f.take_sent(1.0).unwrap();
+        assert!((t - (first_end + 222e-6)).abs() < 1e-12);
+        assert_eq!(frame.id, 0x124);
+        assert_eq!(f.read(0xC4, 1.0).unwrap() & 7, 3);
+        assert_eq!(f.read(0xD4, 1.0).unwrap(), 0b11, "TXBTO: both transmitted");
+    }
+}
