@@ -78,6 +78,7 @@ pub fn mode_config(d: &Design) -> Option<(ModeConfig, usize)> {
                 average_samples: u("FLUX_AVERAGE_SAMPLES")?,
                 min_speed: num(g, "FLUX_MIN_SPEED")? as f32,
             },
+            injection_limit: num(g, "INJECTION_LIMIT")? as f32,
         },
         u("CAPTURE_CAPACITY")? as usize,
     ))

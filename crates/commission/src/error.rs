@@ -150,5 +150,6 @@ pub fn reason_text(r: Reason) -> &'static str {
         Reason::Busy => "a routine or capture is already in progress",
         Reason::Aborted => "aborted: a fault, the break or a setpoint timeout switched the outputs off",
         Reason::Tripped => "the routine's current trip fired",
+        Reason::AmplitudeAboveLimit => "the injection amplitude is above the drive's INJECTION_LIMIT",
     }
 }

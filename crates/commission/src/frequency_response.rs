@@ -38,7 +38,7 @@ use std::time::Duration;
 
 use codegen::Design;
 use codegen::units::{self, Kind};
-use motor_control::can_protocol::{Command, Layout, Routine};
+use motor_control::can_protocol::{Command, Layout, Quantity, Routine};
 use motor_control::commissioning_mode::FREQUENCY_RESPONSE_SETTLE_PERIODS;
 
 use super::candump;
@@ -48,7 +48,7 @@ use super::identify::Input;
 use super::writeback;
 use codegen::design::current_loop::analysis::{self, AxisGains};
 use codegen::design::current_loop::discrete;
-use motor_control::commissioning::{Axis, Lines, multisine_lines};
+use motor_control::commissioning::{Axis, multisine_lines};
 use motor_control::commissioning_mode::frequency_response_period;
 
 /// One measured (or modelled) point of L(jω).
@@ -216,30 +216,9 @@ pub fn period(capacity: usize) -> u32 {
     frequency_response_period(capacity)
 }
 
-/// The default line set for `axis` of design `d` with period `n`: the first line two
-/// octaves below the designed crossover (at least harmonic 1), as many lines per octave
-/// (1–8) as `motor_control::commissioning::MAX_LINES` allows up to the Nyquist harmonic N/2.
-pub fn default_lines(d: &Design, axis: Axis, n: u32) -> Option<(u16, u8)> {
-    let ts = d.drive.sample_period_s;
-    let w0 = 2.0 * PI / (f64::from(n) * ts);
-    let wc = designed_margins(d, axis)
-        .crossover_rad_s
-        .unwrap_or(d.current_loop.bandwidth_rad_s);
-    let first = ((wc / 4.0 / w0).floor() as u32).clamp(1, 255);
-    lines_spanning(first, n)
-}
-
-/// `first` with the most lines per octave whose set still reaches the highest octave
-/// below N/2 within `motor_control::commissioning::MAX_LINES` lines.
-pub fn lines_spanning(first: u32, n: u32) -> Option<(u16, u8)> {
-    let first = u16::try_from(first).ok()?;
-    // The last line within an octave of N/2 (a set cut at MAX_LINES ends lower).
-    let reach = |l: &Lines| l.used().last().is_some_and(|&k| u32::from(k) * 2 >= n / 2);
-    (1..=8u8)
-        .rev()
-        .find(|&r| multisine_lines(first, r, n).is_some_and(|l| reach(&l)))
-        .map(|r| (first, r))
-}
+/// The default line set for `axis` of design `d` with period `n` (the design core's,
+/// which [`codegen::constants::can::injection_limit`] bounds).
+pub use codegen::constants::can::{default_lines, lines_spanning};
 
 // ---------------------------------------------------------------------------------
 // The session
@@ -255,7 +234,9 @@ pub struct Options {
     pub timeout: String,
     /// The injected axis.
     pub axis: Axis,
-    /// Peak of the injection, e.g. `5 V` (`None`: [`default_amplitude`]).
+    /// Peak of the injection, e.g. `5 V` (`None`: the drive's injection limit, the
+    /// generated `INJECTION_LIMIT` (`codegen::constants::can::injection_limit`): the
+    /// most signal the drive allows, so the 12-bit current sensing's steps matter least).
     pub amplitude: Option<String>,
     /// The lines: `FIRST_HARMONIC/PER_OCTAVE`, e.g. `4/3` (`None`: [`default_lines`]).
     pub frequencies: Option<String>,
@@ -316,15 +297,8 @@ fn bad_option(option: &str, problem: String, accepted: &str) -> Error {
     Error::Option(Problem::new(option, problem, accepted))
 }
 
-/// The default injection peak of `axis` \[V\]: 5 % of the voltage limit U_dc/√3. The
-/// lines' weights (`FrequencyResponse::line_weight`) put most of it at high frequencies,
-/// where the axis's impedance |R + jωL| is large; the current stays small (the
-/// measured figures in README.md).
-pub fn default_amplitude(d: &Design, _axis: Axis) -> f64 {
-    0.05 * d.current_loop.voltage_limit_v
-}
-
-/// The trip level \[A\]: half the motor's peak current.
+/// The trip level \[A\]: half the motor's peak current (the I_trip the generated
+/// `INJECTION_LIMIT` keeps the injected current within half of).
 pub fn trip_level(d: &Design) -> f64 {
     0.5 * d.motor.peak_current_a
 }
@@ -355,17 +329,33 @@ pub fn plan_design(o: &Options, d: Design, spec_name: &str) -> Result<Plan, Erro
             )
         })?;
     let n = period(capacity);
-    let limit = d.current_loop.voltage_limit_v;
+    // One figure for the default, this refusal and the drive's own (it refuses a larger
+    // amplitude with `Reason::AmplitudeAboveLimit`): the f32 the image holds, compared
+    // with the amplitude as the drive decodes it from the command's voltage LSBs.
+    let limit = cfg.injection_limit;
+    let layout = cfg.layout;
+    let on_bus = |v: f32| layout.from_lsb(Quantity::Voltage, layout.to_lsb(Quantity::Voltage, v));
     let amplitude = match &o.amplitude {
-        None => default_amplitude(&d, o.axis),
+        // The largest whole number of LSBs within the limit.
+        None => {
+            let per = layout.per_lsb(Quantity::Voltage);
+            let mut k = (limit / per).floor().min(f32::from(i16::MAX));
+            while k > 0.0 && k * per > limit {
+                k -= 1.0;
+            }
+            on_bus(k * per)
+        }
         Some(t) => units::parse(Kind::Voltage, t)
             .ok()
-            .filter(|v| v.is_finite() && *v > 0.0 && *v <= 0.2 * limit)
+            .map(|v| on_bus(v as f32))
+            .filter(|v| v.is_finite() && *v > 0.0 && *v <= limit)
             .ok_or_else(|| {
                 bad_option(
                     "--amplitude",
-                    format!("`{t}` is not a voltage above 0 and up to 20 % of the voltage limit U_dc/√3"),
-                    &format!("a voltage up to {:.3} V, e.g. \"5 V\"", 0.2 * limit),
+                    format!(
+                        "`{t}` is not a voltage above 0 and up to the drive's injection limit INJECTION_LIMIT = {limit} V (the injected current within half the routine's trip, the voltage within U_dc/√3)"
+                    ),
+                    &format!("a voltage up to {limit} V, e.g. \"{:.2} V\"", 0.5 * limit),
                 )
             })?,
     };
@@ -406,7 +396,7 @@ pub fn plan_design(o: &Options, d: Design, spec_name: &str) -> Result<Plan, Erro
     let command = Command {
         routine: Some(Routine::FrequencyResponse),
         axis_q: o.axis == Axis::Q,
-        voltage: amplitude as f32,
+        voltage: amplitude,
         current_trip: trip.min(current_full_scale) as f32,
         decimation: u16::from_le_bytes([first as u8, per_octave]),
     };

@@ -14,6 +14,7 @@
 //! GPL-2.0 `libunicorn`. It is never a dependency of `codegen`/`motorgen` or of the image.
 
 pub mod bridge;
+pub mod can_bus;
 pub mod drive;
 pub mod hardware;
 pub mod image;

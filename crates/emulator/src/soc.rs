@@ -7,7 +7,7 @@
 
 use crate::bridge::{self, LegSwitches, PinWave, Wave};
 use crate::hardware::{Analog as Signal, Hardware, port_pin};
-use crate::periph::adc::{Adc, JEXTSEL_TIM1_TRGO2};
+use crate::periph::adc::{Adc, JEXTSEL_TIM1_TRGO2, SAR_CYCLES};
 use crate::periph::clock::{self, AHB1ENR, AHB2ENR, APB1ENR1, APB2ENR, Clocks};
 use crate::periph::fdcan::{self, Fdcan};
 use crate::periph::gpio::{Mode, Port};
@@ -1026,8 +1026,11 @@ impl Soc {
     }
 
     /// Completes the conversions due at `t` units: each rank reads the board's signal on
-    /// the pin its channel is (the chip's table), after checking that its sampling time
-    /// settles the input's source (DS12288 Table 67).
+    /// the pin its channel is (the chip's table) at the end of its sampling phase — the
+    /// sample-and-hold opens then and the 12.5 SAR cycles convert the held voltage
+    /// (RM0440 §21.4.12: t_CONV = t_SMPL + t_SAR, the input is sampled during t_SMPL) —
+    /// after checking that its sampling time settles the input's source (DS12288
+    /// Table 67).
     fn convert(&mut self, t: u64) {
         // Half a unit later: the rank's end time was rounded up to `t` units.
         let ts = (t as f64 + 0.5) / UNITS_PER_S;
@@ -1074,7 +1077,9 @@ impl Soc {
                         ),
                     ));
                 }
-                let v = analog.volts(input.signal, at, tim3.output((at * UNITS_PER_S) as u64));
+                // The rank ends at `at`; its input was held SAR_CYCLES earlier.
+                let held = at - SAR_CYCLES * clk;
+                let v = analog.volts(input.signal, held, tim3.output((held * UNITS_PER_S) as u64));
                 // Ideal 12-bit conversion: code = V/V_REF·4096, clamped (RM0440 §21.4.1).
                 (v / vref * 4096.0).floor().clamp(0.0, 4095.0) as u16
             });

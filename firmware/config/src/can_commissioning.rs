@@ -46,6 +46,7 @@ pub const MODE: ModeConfig = ModeConfig {
         average_samples: commissioning::FLUX_AVERAGE_SAMPLES,
         min_speed: commissioning::FLUX_MIN_SPEED,
     },
+    injection_limit: commissioning::INJECTION_LIMIT,
 };
 
 /// Captured samples the image holds.

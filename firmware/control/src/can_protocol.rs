@@ -227,6 +227,10 @@ pub enum Reason {
     Aborted = 6,
     /// The routine's current trip fired (capture still sent, with its trip data).
     Tripped = 7,
+    /// A frequency response's amplitude is above the drive's generated injection limit
+    /// (`INJECTION_LIMIT`): refused, nothing runs. (Code 8 is the pre-flight check's,
+    /// issue 26.)
+    AmplitudeAboveLimit = 9,
 }
 
 impl State {
@@ -256,6 +260,7 @@ impl Reason {
             Reason::Busy,
             Reason::Aborted,
             Reason::Tripped,
+            Reason::AmplitudeAboveLimit,
         ]
         .into_iter()
         .find(|r| *r as u8 == code)

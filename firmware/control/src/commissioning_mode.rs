@@ -50,6 +50,11 @@ pub struct ModeConfig {
     pub rotation: (i32, u32, u32),
     /// ψ_M run (§6.5).
     pub flux: FluxLinkage,
+    /// Largest injection peak of the frequency response \[V\] (the generated
+    /// `INJECTION_LIMIT`: the injected current within half the routine's trip and the
+    /// applied voltage within the linear modulation range); a command above it is
+    /// refused with [`Reason::AmplitudeAboveLimit`].
+    pub injection_limit: f32,
 }
 
 /// Safety inputs, every period.
@@ -103,6 +108,65 @@ pub fn frequency_response_period(capacity: usize) -> u32 {
     } else {
         1u32.checked_shl(31u32.saturating_sub(c.leading_zeros())).unwrap_or(0)
     }
+}
+
+/// What a command needs computed before the supervisor takes it: a frequency
+/// response's oscillators ([`FrequencyResponse::start`]: libm's sine and cosine of every
+/// line's rotation and phase, and the lines' weights). The board runs the supervisor's
+/// [`CommissioningMode::command_prepared`] inside a critical section that masks the
+/// control interrupt; computed there, the oscillators held the interrupt off for longer
+/// than a carrier period at 40 kHz (the emulated G474 names it: 25.1 µs masked, one
+/// instruction per cycle, a lower bound). [`prepare`] runs before, interrupts enabled.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Prepared {
+    command: Command,
+    /// The routine and its oscillators, or the reason the command is refused.
+    run: Result<(FrequencyResponse, FrequencyResponseState), Reason>,
+}
+
+/// Prepares `c` for [`CommissioningMode::command_prepared`]: for a valid frequency
+/// response (lines valid for the period a buffer of `capacity` holds, amplitude and trip
+/// positive and finite) the routine and its oscillators' initial state; nothing for
+/// any other command.
+pub fn prepare(cfg: &ModeConfig, c: &Command, capacity: usize) -> Prepared {
+    Prepared {
+        command: *c,
+        run: prepare_frequency_response(cfg, c, capacity),
+    }
+}
+
+/// The frequency response of `c`: its line set valid for the period a buffer of
+/// `capacity` holds, amplitude and trip positive and finite ([`Reason::BadCommand`]
+/// otherwise), the amplitude at most the configuration's `injection_limit` (refused, not
+/// clamped: [`Reason::AmplitudeAboveLimit`], so a capture never carries another
+/// amplitude than the host asked for).
+fn prepare_frequency_response(
+    cfg: &ModeConfig,
+    c: &Command,
+    capacity: usize,
+) -> Result<(FrequencyResponse, FrequencyResponseState), Reason> {
+    if c.routine != Some(Routine::FrequencyResponse) {
+        return Err(Reason::BadCommand);
+    }
+    let [first, per_octave] = c.decimation.to_le_bytes();
+    let period = frequency_response_period(capacity);
+    let lines = multisine_lines(u16::from(first), per_octave, period).ok_or(Reason::BadCommand)?;
+    if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
+        return Err(Reason::BadCommand);
+    }
+    // The voltage is finite here; a NaN limit (never generated) refuses every amplitude.
+    if c.voltage > cfg.injection_limit || cfg.injection_limit.is_nan() {
+        return Err(Reason::AmplitudeAboveLimit);
+    }
+    let r = FrequencyResponse {
+        axis: if c.axis_q { Axis::Q } else { Axis::D },
+        amplitude: c.voltage,
+        current_trip: c.current_trip,
+        period,
+        settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
+        lines,
+    };
+    Ok((r, r.start()))
 }
 
 /// What the current-control step gets this period.
@@ -220,14 +284,39 @@ impl CommissioningMode {
     }
 
     /// A received command; returns the reason it was refused ([`Reason::None`]:
-    /// accepted). `capacity` is the capture buffer's length.
+    /// accepted). `capacity` is the capture buffer's length. [`prepare`] and
+    /// [`CommissioningMode::command_prepared`] in one call.
     pub fn command(&mut self, cfg: &ModeConfig, c: &Command, guards: &Guards, omega_e: f32, capacity: usize) -> Reason {
-        let reason = self.accept(cfg, c, guards, omega_e, capacity);
+        let prepared = prepare(cfg, c, capacity);
+        self.command_prepared(cfg, c, &prepared, guards, omega_e, capacity)
+    }
+
+    /// [`CommissioningMode::command`] with what [`prepare`] computed for `c` beforehand
+    /// (outside the board's critical section: see [`prepare`]); a `prepared` made from
+    /// another command refuses a frequency response ([`Reason::BadCommand`]).
+    pub fn command_prepared(
+        &mut self,
+        cfg: &ModeConfig,
+        c: &Command,
+        prepared: &Prepared,
+        guards: &Guards,
+        omega_e: f32,
+        capacity: usize,
+    ) -> Reason {
+        let reason = self.accept(cfg, c, prepared, guards, omega_e, capacity);
         self.reason = reason;
         reason
     }
 
-    fn accept(&mut self, cfg: &ModeConfig, c: &Command, guards: &Guards, omega_e: f32, capacity: usize) -> Reason {
+    fn accept(
+        &mut self,
+        cfg: &ModeConfig,
+        c: &Command,
+        prepared: &Prepared,
+        guards: &Guards,
+        omega_e: f32,
+        capacity: usize,
+    ) -> Reason {
         let Some(routine) = c.routine else {
             // Abort: outputs off, capture dropped; clears a latched abort once safe.
             return match self.mode {
@@ -261,7 +350,7 @@ impl CommissioningMode {
             return Reason::NotAtStandstill;
         }
         if routine == Routine::FrequencyResponse {
-            return self.accept_frequency_response(cfg, c, capacity);
+            return self.accept_frequency_response(cfg, c, prepared);
         }
         let decimation = match u8::try_from(c.decimation) {
             Ok(d) if d >= 1 => d,
@@ -328,27 +417,24 @@ impl CommissioningMode {
         Reason::None
     }
 
-    /// The frequency response: amplitude and trip positive, the line set valid for the
-    /// period the buffer holds.
-    fn accept_frequency_response(&mut self, cfg: &ModeConfig, c: &Command, capacity: usize) -> Reason {
-        let [first, per_octave] = c.decimation.to_le_bytes();
-        let period = frequency_response_period(capacity);
-        let Some(lines) = multisine_lines(u16::from(first), per_octave, period) else {
-            return Reason::BadCommand;
-        };
-        if !(c.voltage > 0.0 && c.voltage.is_finite() && c.current_trip > 0.0 && c.current_trip.is_finite()) {
+    /// The frequency response [`prepare`]d from `c` (amplitude and trip positive, the
+    /// line set valid for the period the buffer holds).
+    fn accept_frequency_response(&mut self, cfg: &ModeConfig, c: &Command, prepared: &Prepared) -> Reason {
+        if prepared.command != *c {
             return Reason::BadCommand;
         }
-        let r = FrequencyResponse {
-            axis: if c.axis_q { Axis::Q } else { Axis::D },
-            amplitude: c.voltage,
-            current_trip: c.current_trip,
-            period,
-            settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
-            lines,
+        let (r, st) = match prepared.run {
+            Ok(run) => run,
+            Err(reason) => return reason,
         };
-        let run = Running::Frequency(r, r.start());
-        self.start(cfg, Routine::FrequencyResponse, run, c.axis_q, 1, c.current_trip);
+        self.start(
+            cfg,
+            Routine::FrequencyResponse,
+            Running::Frequency(r, st),
+            c.axis_q,
+            1,
+            c.current_trip,
+        );
         Reason::None
     }
 
@@ -590,7 +676,42 @@ mod tests {
                 average_samples: 2,
                 min_speed: 10.0,
             },
+            injection_limit: 3.0,
         }
+    }
+
+    /// A frequency response on the d axis with `voltage` as its amplitude: lines from
+    /// harmonic 4, 3 per octave of the period an 8192-sample buffer holds.
+    fn frequency_cmd(voltage: f32) -> Command {
+        Command {
+            routine: Some(Routine::FrequencyResponse),
+            axis_q: false,
+            voltage,
+            current_trip: 10.0,
+            decimation: u16::from_le_bytes([4, 3]),
+        }
+    }
+
+    /// The injection limit (3 V in `cfg`): an amplitude at it runs, one above it is
+    /// refused with its own reason and nothing starts; a command taken with what was
+    /// prepared for another is refused.
+    #[test]
+    fn frequency_response_amplitude_is_bounded_by_the_injection_limit() {
+        let c = cfg();
+        let g = Guards::default();
+        let mut m = CommissioningMode::new();
+        assert_eq!(
+            m.command(&c, &frequency_cmd(3.01), &g, 0.0, 8192),
+            Reason::AmplitudeAboveLimit
+        );
+        assert_eq!(m.state(), (State::Idle, Reason::AmplitudeAboveLimit));
+        let prepared = prepare(&c, &frequency_cmd(2.0), 8192);
+        assert_eq!(
+            m.command_prepared(&c, &frequency_cmd(2.5), &prepared, &g, 0.0, 8192),
+            Reason::BadCommand
+        );
+        assert_eq!(m.command(&c, &frequency_cmd(3.0), &g, 0.0, 8192), Reason::None);
+        assert_eq!(m.state().0, State::Commissioning);
     }
 
     fn step_cmd() -> Command {

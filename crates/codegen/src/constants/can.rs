@@ -396,6 +396,27 @@ impl<'a> Commissioning<'a> {
             json: Json::None,
         },
         Decl {
+            name: "INJECTION_LIMIT",
+            value: F32(|c| c.injection_limit().map_or(0.0, |l| l.volts), "V"),
+            formula: Lit(
+                "min over d, q of min(½·I_trip/G_i, U_max/G_v): the frequency response's injection peak A keeps the injected current within half the routine's trip I_trip = ½·I_peak and the applied voltage within the linear modulation range U_max = U_dc/√3 at standstill (operating point v = 0); G_i = Σ (a_j/A)·|P/(1+L)|, G_v = 1 + Σ (a_j/A)·|L/(1+L)| over the default multisine lines on the design's sampled loop (each line's steady-state peak added); a larger commanded amplitude is refused",
+            ),
+            equation: Lit("triangle inequality over the lines on the sampled loop of thesis A (5.8)–(5.16)"),
+            inputs: Of(|c| {
+                c.injection_limit().map_or("—".into(), |l| {
+                    format!(
+                        "I_peak = {}, U_max = {}, G_i = {:.4} A/V, G_v = {:.4} (axis {})",
+                        phys(c.d.motor.peak_current_a, "A"),
+                        phys(c.d.current_loop.voltage_limit_v, "V"),
+                        l.current_gain,
+                        l.voltage_gain,
+                        l.axis
+                    )
+                })
+            }),
+            json: Json::None,
+        },
+        Decl {
             name: "STANDSTILL_SPEED",
             value: F32(|c| 0.01 * c.d.motor.max_electrical_speed_rad_s, "rad/s"),
             formula: Lit("1 % of the maximum electrical speed: a command is accepted below it"),
@@ -404,6 +425,11 @@ impl<'a> Commissioning<'a> {
             json: Json::None,
         },
     ];
+
+    /// The frequency response's injection limit ([`injection_limit`]).
+    fn injection_limit(&self) -> Option<InjectionLimit> {
+        injection_limit(self.d)
+    }
 
     /// Whole control periods lasting at least `t` seconds (at least one).
     fn periods(&self, t: f64) -> f64 {
@@ -422,6 +448,126 @@ impl<'a> Commissioning<'a> {
     fn max_speed(&self) -> String {
         format!("ω_e,max = {}", phys(self.d.motor.max_electrical_speed_rad_s, "rad/s"))
     }
+}
+
+/// The frequency response's injection limit and what set it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct InjectionLimit {
+    /// The limit A_max \[V\], rounded to the `f32` the firmware holds.
+    pub volts: f64,
+    /// G_i: peak injected current per volt of A \[A/V\] on the limiting axis.
+    pub current_gain: f64,
+    /// G_v: peak applied voltage per volt of A on the limiting axis.
+    pub voltage_gain: f64,
+    /// The limiting axis, "d" or "q".
+    pub axis: &'static str,
+}
+
+/// The default line set of the frequency response of `axis` (`(first harmonic, lines
+/// per octave)`) for a multisine period of `n` samples: the first line two octaves
+/// below the designed crossover (at least harmonic 1), as many lines per octave (1–8)
+/// as `motor_control::commissioning::MAX_LINES` allows up to the Nyquist harmonic N/2.
+/// The host's default (`motorgen commission … frequency-response` without
+/// `--frequencies`) and [`injection_limit`]'s.
+pub fn default_lines(d: &Design, axis: motor_control::commissioning::Axis, n: u32) -> Option<(u16, u8)> {
+    use motor_control::commissioning::Axis;
+    let ts = d.drive.sample_period_s;
+    let w0 = 2.0 * std::f64::consts::PI / (f64::from(n) * ts);
+    let gains = match axis {
+        Axis::D => &d.current_loop.d,
+        Axis::Q => &d.current_loop.q,
+    };
+    let wc = gains
+        .sampled
+        .gain_crossover_rad_s
+        .unwrap_or(d.current_loop.bandwidth_rad_s);
+    let first = ((wc / 4.0 / w0).floor() as u32).clamp(1, 255);
+    lines_spanning(first, n)
+}
+
+/// `first` with the most lines per octave whose set still reaches the highest octave
+/// below N/2 within `motor_control::commissioning::MAX_LINES` lines.
+pub fn lines_spanning(first: u32, n: u32) -> Option<(u16, u8)> {
+    use motor_control::commissioning::{Lines, multisine_lines};
+    let first = u16::try_from(first).ok()?;
+    // The last line within an octave of N/2 (a set cut at MAX_LINES ends lower).
+    let reach = |l: &Lines| l.used().last().is_some_and(|&k| u32::from(k) * 2 >= n / 2);
+    (1..=8u8)
+        .rev()
+        .find(|&r| multisine_lines(first, r, n).is_some_and(|l| reach(&l)))
+        .map(|r| (first, r))
+}
+
+/// The largest injection peak A \[V\] of the frequency response (`INJECTION_LIMIT`).
+///
+/// The routine injects d = Σ a_j·sin(ω_j·t + φ_j) (clamped to ±A) at the controller's
+/// output, a_j = A·w_j/√(2·Σw²) (`motor_control::commissioning::FrequencyResponse::
+/// line_amplitude`), on the design's default lines ([`default_lines`], the capture
+/// buffer's period). On the design's sampled loop (gains, plant R, L, the 1.5·T_s delay:
+/// L(z) of `design::current_loop::analysis::open_loop`, plant P(z) = b/(z·(z − a))) the
+/// injection reaches the current through P/(1 + L) and the controller's output through
+/// −L/(1 + L); in periodic steady state each line's peak adds at most:
+///
+/// ```text
+/// |i| ≤ A·G_i,  G_i = Σ_j (a_j/A)·|P/(1 + L)|(ω_j)
+/// |v| ≤ |d| + |u_PI| ≤ A·G_v,  G_v = 1 + Σ_j (a_j/A)·|L/(1 + L)|(ω_j)
+/// ```
+///
+/// A_max = min over d, q of min(½·I_trip/G_i, U_max/G_v): the injected current within
+/// half the routine's trip I_trip = ½·I_peak (the host's trip level), the applied
+/// voltage within the linear modulation range U_max = U_dc/√3 (at standstill the
+/// operating point is v = 0). The clamp only lowers |d|; the settling transient is not
+/// bounded (the trip still guards it). `None` without a board or default lines.
+pub fn injection_limit(d: &Design) -> Option<InjectionLimit> {
+    use crate::design::current_loop::{analysis, discrete};
+    use motor_control::commissioning::{Axis, FrequencyResponse, multisine_lines};
+    use motor_control::commissioning_mode::{FREQUENCY_RESPONSE_SETTLE_PERIODS, frequency_response_period};
+    d.board.as_ref()?;
+    let n = frequency_response_period(CAPTURE_CAPACITY as usize);
+    let trip = 0.5 * d.motor.peak_current_a;
+    let u_max = d.current_loop.voltage_limit_v;
+    let ts = d.drive.sample_period_s;
+    let mut best: Option<InjectionLimit> = None;
+    for (name, axis) in [("d", Axis::D), ("q", Axis::Q)] {
+        let (first, per_octave) = default_lines(d, axis, n)?;
+        let lines = multisine_lines(first, per_octave, n)?;
+        let r = FrequencyResponse {
+            axis,
+            amplitude: 1.0,
+            current_trip: 1.0,
+            period: n,
+            settle_periods: FREQUENCY_RESPONSE_SETTLE_PERIODS,
+            lines,
+        };
+        let req = d.current_loop_request(axis);
+        let plant = discrete::SampledPlant::new(req.resistance_ohm, req.inductance_h, ts);
+        let gains = match axis {
+            Axis::D => &d.current_loop.d,
+            Axis::Q => &d.current_loop.q,
+        }
+        .loop_gains();
+        let (mut gi, mut gv) = (0.0, 1.0);
+        for (j, &k) in lines.used().iter().enumerate() {
+            let omega = 2.0 * std::f64::consts::PI * f64::from(k) / (f64::from(n) * ts);
+            let l = analysis::open_loop(&gains, &plant, omega);
+            let z = nalgebra::Complex::from_polar(1.0, omega * ts);
+            let p = plant.b / (z * (z - plant.a));
+            let one = nalgebra::Complex::new(1.0, 0.0);
+            let a = f64::from(r.line_amplitude(j));
+            gi += a * (p / (one + l)).norm();
+            gv += a * (l / (one + l)).norm();
+        }
+        let volts = f64::from(((0.5 * trip / gi).min(u_max / gv)) as f32);
+        if best.is_none_or(|b| volts < b.volts) {
+            best = Some(InjectionLimit {
+                volts,
+                current_gain: gi,
+                voltage_gain: gv,
+                axis: name,
+            });
+        }
+    }
+    best
 }
 
 /// The `commissioning` group: the fixed parameters of the chapter-6 routines the CAN

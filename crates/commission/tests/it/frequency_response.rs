@@ -205,3 +205,82 @@ fn retune_follows_the_measured_plant() {
     assert!(a_own >= alpha, "{a_own} < {alpha}");
     assert!(a_late < a_own, "{a_late} ≥ {a_own}");
 }
+
+/// The injection limit (the generated `INJECTION_LIMIT`) acting, every motor on its
+/// board: the host's default amplitude is the limit in whole voltage LSBs; an
+/// `--amplitude` above it is refused before the bus is touched, naming the limit; the
+/// simulated drive (the firmware's supervisor) refuses a command two LSBs above it with
+/// `Reason::AmplitudeAboveLimit`; and at the default amplitude on the q axis the
+/// routine runs with its trip lowered to half the host's trip level (the current the
+/// limit promises) and every captured applied voltage v stays within U_dc/√3.
+#[test]
+fn injection_limit_bounds_the_amplitude_on_host_and_drive() {
+    use motor_commission::Error;
+    use motor_commission::commission::{SessionError, run_session};
+    use motor_control::can_protocol::{Quantity, Reason};
+    let mut failures = vec![];
+    for (stem, _, _) in motor_test_support::motors() {
+        let (rel, d, spec) = motor(&stem);
+        let (cfg, _) = motor_commission::candump::mode_config(&d).unwrap();
+        let limit = cfg.injection_limit;
+        let per = cfg.layout.per_lsb(Quantity::Voltage);
+        let options = |amplitude: Option<String>| Options {
+            iface: "sim0".into(),
+            timeout: "60 s".into(),
+            axis: Axis::Q,
+            amplitude,
+            frequencies: None,
+        };
+        let mut plan = fr::plan_design(&options(None), d.clone(), &rel).unwrap();
+        let a = plan.command.voltage;
+        if !(a <= limit && a > limit - per) {
+            failures.push(format!(
+                "{stem}: default {a} V is not the limit {limit} V in whole LSBs of {per} V"
+            ));
+        }
+        match fr::plan_design(&options(Some(format!("{} V", 1.01 * limit))), d.clone(), &rel) {
+            Err(Error::Option(p)) if p.to_string().contains("INJECTION_LIMIT") => {}
+            other => failures.push(format!(
+                "{stem}: 1.01 × the limit not refused: {:?}",
+                other.map(|p| p.command)
+            )),
+        }
+        let bench = || motor_verify::Setup::new(&spec, &d).bench(0.0);
+        let mut above = plan.command;
+        above.voltage = a + 2.0 * per;
+        let mut drive = SimulatedDrive::new(&d, bench(), 0.0).unwrap();
+        match run_session(
+            &mut drive,
+            "sim0",
+            &cfg.layout,
+            &above,
+            std::time::Duration::from_secs(1),
+        ) {
+            Err(SessionError::Refused(Reason::AmplitudeAboveLimit)) => {}
+            other => failures.push(format!(
+                "{stem}: {} V not refused by the drive: {other:?}",
+                above.voltage
+            )),
+        }
+        plan.command.current_trip *= 0.5;
+        let mut drive = SimulatedDrive::new(&d, bench(), 0.0).unwrap();
+        match plan.run(&mut drive) {
+            Ok(m) => {
+                let u_max = d.current_loop.voltage_limit_v;
+                let peak = m
+                    .csv
+                    .1
+                    .lines()
+                    .skip_while(|l| !l.starts_with(|c: char| c.is_ascii_digit() || c == '-'))
+                    .filter_map(|l| l.split(',').nth(2)?.trim().parse::<f64>().ok())
+                    .fold(0.0f64, |p, v| p.max(v.abs()));
+                println!("{stem}: A = {a} V (limit {limit} V), peak |v| {peak:.3} V of U_max {u_max:.3} V");
+                if peak > u_max || peak < 0.5 * f64::from(a) {
+                    failures.push(format!("{stem}: peak |v| {peak} V outside [A/2, U_max = {u_max}]"));
+                }
+            }
+            Err(e) => failures.push(format!("{stem}: at the limit with half the trip: {e:?}")),
+        }
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}

@@ -1,7 +1,10 @@
-//! FDCAN1 (RM0440 §44) as a receiver of classic frames: configuration protection
-//! (INIT/CCE), the global filter (RXGFC) and standard filter elements in the message RAM,
-//! RX FIFO 0 with its fill level, get/put indices and acknowledge. Frames come from the
-//! test ([`crate::Frame`]). The bit timing the controller joins the bus with (NBTP and
+//! FDCAN1 (RM0440 §44) as a receiver and transmitter of classic frames: configuration
+//! protection (INIT/CCE), the global filter (RXGFC) and standard filter elements in the
+//! message RAM, RX FIFO 0 with its fill level, get/put indices and acknowledge; the Tx
+//! FIFO (TXBC.TFQM = 0, the reset value: three Tx buffers used in request order,
+//! RM0440 §44.3.3 "Tx FIFO") with TXFQS/TXBRP/TXBTO, each requested frame put on the bus
+//! one after the other at the joined bit rate ([`frame_bits`]) and handed to the test
+//! ([`Fdcan::take_sent`]). Frames to receive come from the test ([`crate::Frame`]). The bit timing the controller joins the bus with (NBTP and
 //! the kernel clock RCC_CCIPR.FDCANSEL selects) is recorded; a bus-off can be injected
 //! ([`Fdcan::bus_off`]): PSR.BO and CCCR.INIT set (RM0440 §44.3.2: INIT is set "by going
 //! Bus_Off"), no frame received until software clears INIT and 128 occurrences of 11
@@ -19,6 +22,11 @@ pub const RAM_BYTES: u32 = 212 * 4;
 const RXF0: u32 = 0xB0;
 const RX_ELEMENTS: u32 = 3;
 const RX_ELEMENT_BYTES: u32 = 72;
+/// Tx buffers offset and elements (RM0440 §44.3.3, fixed layout: 3 elements of 18 words
+/// after the Tx event FIFO at 0x260).
+const TXBUF: u32 = 0x278;
+const TX_ELEMENTS: u32 = 3;
+const TX_ELEMENT_BYTES: u32 = 72;
 
 /// CCCR bits (RM0440 §44.4.7).
 const INIT: u32 = 1;
@@ -38,6 +46,17 @@ pub struct Joined {
     pub bit_rate: f64,
     /// Sample point: (1 + NTSEG1 + 1)/quanta.
     pub sample_point: f64,
+}
+
+/// Bits a classic data frame occupies on the bus with `bytes` data bytes, stuff bits not
+/// counted (ISO 11898-1 frame format): standard — SOF 1, identifier 11, RTR 1, IDE 1,
+/// r0 1, DLC 4, data 8·n, CRC 15, CRC delimiter 1, ACK slot and delimiter 2, EOF 7,
+/// intermission 3 = 47 + 8·n; extended — SRR, IDE, 18 more identifier bits and r1 make
+/// 67 + 8·n. Stuff bits add at most (34 + 8·n − 1)/4 (standard), so the time a frame
+/// takes here is a lower bound.
+pub fn frame_bits(bytes: usize, extended: bool) -> f64 {
+    let base = if extended { 67.0 } else { 47.0 };
+    base + 8.0 * bytes.min(8) as f64
 }
 
 /// Known registers (RM0440 §44.4 register map).
@@ -86,6 +105,16 @@ pub struct Fdcan {
     pub missed_while_bus_off: u32,
     /// End of the running bus-off recovery \[s\].
     recovery_until: Option<f64>,
+    /// Requested Tx buffers in request order: (buffer index, frame, request time \[s\]).
+    tx_pending: std::collections::VecDeque<(u32, Frame, f64)>,
+    /// The Tx FIFO put index (TXFQS.TFQPI).
+    tx_put: u32,
+    /// The bus is free from this time on \[s\] (the last transmission's end).
+    bus_free_s: f64,
+    /// Transmitted frames not yet taken by the test, with the time each ended \[s\].
+    sent: std::collections::VecDeque<(f64, Frame)>,
+    /// Frames transmitted since reset.
+    pub transmitted: u32,
 }
 
 impl Default for Fdcan {
@@ -117,6 +146,11 @@ impl Fdcan {
             recoveries: 0,
             missed_while_bus_off: 0,
             recovery_until: None,
+            tx_pending: std::collections::VecDeque::new(),
+            tx_put: 0,
+            bus_free_s: 0.0,
+            sent: std::collections::VecDeque::new(),
+            transmitted: 0,
         }
     }
 
@@ -143,6 +177,69 @@ impl Fdcan {
             self.recovery_until = None;
             self.regs[0x44 / 4] &= !BO;
         }
+        while let Some(end) = self.next_tx_end() {
+            if end > now {
+                break;
+            }
+            let Some((index, frame, _)) = self.tx_pending.pop_front() else {
+                break;
+            };
+            self.bus_free_s = end;
+            // TXBTO: the buffer's transmission occurred (RM0440 §44.4.31), set when it
+            // ends, cleared by a new request of the buffer.
+            self.regs[0xD4 / 4] |= 1 << index;
+            self.transmitted += 1;
+            self.sent.push_back((end, frame));
+        }
+    }
+
+    /// When the oldest pending frame ends on the bus \[s\], if the controller is on the
+    /// bus (INIT = 0, not bus-off) and one is pending: it starts when requested or when
+    /// the previous one ended, whichever is later.
+    fn next_tx_end(&self) -> Option<f64> {
+        if self.cccr() & INIT != 0 || self.is_bus_off() {
+            return None;
+        }
+        let (_, frame, at) = self.tx_pending.front()?;
+        let rate = self.joined?.bit_rate;
+        Some(at.max(self.bus_free_s) + frame_bits(frame.data.len(), frame.extended) / rate)
+    }
+
+    /// Whether a transmitted frame is waiting for [`Fdcan::take_sent`] at `now` \[s\].
+    pub fn has_sent_by(&self, now: f64) -> bool {
+        !self.sent.is_empty() || self.next_tx_end().is_some_and(|end| end <= now)
+    }
+
+    /// The oldest frame transmitted by `now` \[s\] and the time its transmission ended.
+    pub fn take_sent(&mut self, now: f64) -> Option<(f64, Frame)> {
+        self.advance(now);
+        self.sent.pop_front()
+    }
+
+    /// The frame in Tx buffer `index` (RM0440 §44.3.3, "Tx buffer element": T0 =
+    /// ESI/XTD/RTR/ID (a standard identifier in bits 28:18), T1 = MM/EFC/FDF/BRS/DLC,
+    /// then the data bytes little-endian).
+    fn tx_element(&self, index: u32) -> Result<Frame, Broken> {
+        let base = ((TXBUF + index * TX_ELEMENT_BYTES) / 4) as usize;
+        let (t0, t1) = (self.ram[base], self.ram[base + 1]);
+        if t1 & (1 << 21) != 0 {
+            return Err(Broken::new(
+                "FDCAN1 Tx buffer",
+                "FDF set: an FD frame requested, only classic CAN is modelled (and CCCR.FDOE is not set)",
+            ));
+        }
+        let extended = t0 & (1 << 30) != 0;
+        let id = if extended { t0 & 0x1FFF_FFFF } else { (t0 >> 18) & 0x7FF };
+        let dlc = ((t1 >> 16) & 0xF).min(8) as usize;
+        let mut bytes = [0u8; 8];
+        bytes[..4].copy_from_slice(&self.ram[base + 2].to_le_bytes());
+        bytes[4..].copy_from_slice(&self.ram[base + 3].to_le_bytes());
+        Ok(Frame {
+            id,
+            extended,
+            remote: t0 & (1 << 29) != 0,
+            data: bytes[..dlc].to_vec(),
+        })
     }
 
     /// Register read at `now` \[s\].
@@ -157,6 +254,15 @@ impl Fdcan {
                 let put = (self.get + self.fill) % RX_ELEMENTS;
                 self.fill | (self.get << 8) | (put << 16) | (u32::from(self.fill == RX_ELEMENTS) << 24)
             }
+            // TXFQS: TFFL free level, TFGI get index, TFQPI put index, TFQF full
+            // (RM0440 §44.4.29).
+            0xC4 => {
+                let pending = self.tx_pending.len() as u32;
+                let get = self.tx_pending.front().map_or(self.tx_put, |p| p.0);
+                (TX_ELEMENTS - pending) | (get << 8) | (self.tx_put << 16) | (u32::from(pending == TX_ELEMENTS) << 21)
+            }
+            // TXBRP: the pending requests (RM0440 §44.4.30).
+            0xC8 => self.tx_pending.iter().fold(0, |m, p| m | 1 << p.0),
             _ => self.regs[(off / 4) as usize],
         })
     }
@@ -227,7 +333,29 @@ impl Fdcan {
                 self.get = (ai + 1) % RX_ELEMENTS;
                 self.regs[0x94 / 4] = ai;
             }
-            0x90 | 0x98 | 0x00 | 0x04 | 0x44 => {
+            // TXBAR: add requests (RM0440 §44.4.31); in FIFO mode the buffer is the put
+            // index TXFQS.TFQPI, free (ST's HAL_FDCAN_AddMessageToTxFifoQ writes the
+            // element at the put index and requests that buffer).
+            0xCC => {
+                for index in (0..TX_ELEMENTS).filter(|k| value & (1 << k) != 0) {
+                    if self.tx_pending.len() as u32 == TX_ELEMENTS || index != self.tx_put {
+                        return Err(Broken::new(
+                            "FDCAN1_TXBAR",
+                            format!(
+                                "transmission requested in Tx buffer {index}, not the free put index TXFQS.TFQPI = {} of a Tx FIFO with {} of 3 pending (RM0440 §44.3.3, Tx FIFO)",
+                                self.tx_put,
+                                self.tx_pending.len()
+                            ),
+                        ));
+                    }
+                    let frame = self.tx_element(index)?;
+                    self.regs[0xD4 / 4] &= !(1 << index);
+                    self.tx_pending.push_back((index, frame, now));
+                    self.tx_put = (index + 1) % TX_ELEMENTS;
+                }
+                self.regs[0xCC / 4] = value;
+            }
+            0x90 | 0x98 | 0x00 | 0x04 | 0x44 | 0xC4 | 0xC8 | 0xD4 | 0xD8 => {
                 return Err(Broken::new(
                     format!("FDCAN1+{off:#04x}"),
                     "read-only register (RM0440 §44.4)",
@@ -318,5 +446,61 @@ impl Fdcan {
         self.ram[base + 3] = u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]);
         self.fill += 1;
         self.accepted += 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Joins at 500 kbit/s from a 170 MHz kernel clock: NBRP = 19 (÷20), 17 quanta
+    /// (NTSEG1 = 13 → 14 + 1 sync, NTSEG2 = 1 → 2): 170 MHz/(20·17) = 500 kbit/s.
+    fn joined() -> Fdcan {
+        let mut f = Fdcan::new();
+        f.write(0x18, INIT | CCE, 0.0, 170e6).unwrap();
+        f.write(0x1C, (19 << 16) | (13 << 8) | 1, 0.0, 170e6).unwrap();
+        f.write(0x18, 0, 0.0, 170e6).unwrap();
+        f
+    }
+
+    /// Writes a standard frame (id, 8 bytes) into Tx buffer `k` as the image's
+    /// `tx_element` does (RM0440 §44.3.3: T0 = ID << 18, T1 = DLC << 16).
+    fn element(f: &mut Fdcan, k: u32, id: u32) {
+        let base = ((TXBUF + k * TX_ELEMENT_BYTES) / 4) as usize;
+        f.ram[base] = id << 18;
+        f.ram[base + 1] = 8 << 16;
+        f.ram[base + 2] = 0x0403_0201;
+        f.ram[base + 3] = 0x0807_0605;
+    }
+
+    /// Two requests in FIFO order: TXFQS counts them, the bus carries them one after the
+    /// other, 111 bits (47 + 64) each at 500 kbit/s = 222 µs; a request of a buffer other
+    /// than the put index is a violation.
+    #[test]
+    fn tx_fifo_sends_in_order_at_the_bit_rate() {
+        let mut f = joined();
+        assert_eq!(f.read(0xC4, 0.0).unwrap(), 3, "reset: 3 free, put 0");
+        element(&mut f, 0, 0x123);
+        f.write(0xCC, 1, 1e-3, 170e6).unwrap();
+        element(&mut f, 1, 0x124);
+        f.write(0xCC, 2, 1e-3, 170e6).unwrap();
+        let s = f.read(0xC4, 1e-3).unwrap();
+        assert_eq!((s & 7, (s >> 8) & 3, (s >> 16) & 3, (s >> 21) & 1), (1, 0, 2, 0));
+        assert_eq!(f.read(0xC8, 1e-3).unwrap(), 0b11);
+        assert!(
+            f.write(0xCC, 1, 1e-3, 170e6).is_err(),
+            "buffer 0 is not the put index 2"
+        );
+        let first_end = 1e-3 + 111.0 / 500e3;
+        assert!(!f.has_sent_by(first_end - 1e-9));
+        let (t, frame) = f.take_sent(first_end + 1e-9).unwrap();
+        assert!((t - first_end).abs() < 1e-12);
+        assert_eq!((frame.id, frame.data.len(), frame.data[7]), (0x123, 8, 8));
+        assert!(f.take_sent(first_end + 1e-9).is_none());
+        let (t, frame) = f.take_sent(1.0).unwrap();
+        assert!((t - (first_end + 222e-6)).abs() < 1e-12);
+        assert_eq!(frame.id, 0x124);
+        assert_eq!(f.read(0xC4, 1.0).unwrap() & 7, 3);
+        assert_eq!(f.read(0xD4, 1.0).unwrap(), 0b11, "TXBTO: both transmitted");
     }
 }

@@ -11,7 +11,7 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::interrupt::{self, Mutex};
 use motor_control::can_protocol::decode_command;
-use motor_control::commissioning_mode::{Control, Guards, Measured, Sample};
+use motor_control::commissioning_mode::{Control, Guards, Measured, Sample, prepare};
 use motor_control::{Demand, Trig};
 
 use super::can::Can;
@@ -50,9 +50,12 @@ pub fn frame_received(id: Option<u16>, data: &[u8]) {
         setpoint_timeout: TIMED_OUT.load(Ordering::Relaxed),
     };
     let omega_e = f32::from_bits(OMEGA_E.load(Ordering::Relaxed));
+    // The frequency response's oscillators are computed here, with the control
+    // interrupt enabled (`motor_control::commissioning_mode::Prepared`).
+    let prepared = prepare(&MODE, &command, CAPACITY);
     interrupt::free(|cs| {
         if let Ok(mut m) = SUPERVISOR.borrow(cs).try_borrow_mut() {
-            m.command(&MODE, &command, &guards, omega_e, CAPACITY);
+            m.command_prepared(&MODE, &command, &prepared, &guards, omega_e, CAPACITY);
         }
     });
 }
