@@ -27,8 +27,9 @@ use crate::commissioning::{
     Axis, CommissioningError, FluxLinkage, FluxLinkageState, FrequencyResponse, FrequencyResponseState, PolePairRatio,
     PolePairRatioState, Progress, ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState, multisine_lines,
 };
+use crate::preflight::{Preflight, PreflightFault, PreflightInput, PreflightState};
 use crate::step::Demand;
-use crate::transforms::Dq;
+use crate::transforms::{Dq, Uvw};
 use crate::trig::Trig;
 
 /// Fixed parameters of the routines (the command gives voltage, trip and decimation).
@@ -50,6 +51,8 @@ pub struct ModeConfig {
     pub rotation: (i32, u32, u32),
     /// ψ_M run (§6.5).
     pub flux: FluxLinkage,
+    /// The pre-flight check ([`crate::preflight`]).
+    pub preflight: Preflight,
 }
 
 /// Safety inputs, every period.
@@ -85,6 +88,10 @@ pub struct Measured {
     pub u_q: f32,
     /// Applied d voltage \[V\] (the same).
     pub u_d: f32,
+    /// The resolver's electrical angle θ_e (π-scaled Q1.31).
+    pub theta_e: i32,
+    /// Measured phase currents \[A\].
+    pub i_uvw: Uvw,
 }
 
 /// Multisine periods the frequency response runs before the captured one: the loop's
@@ -126,6 +133,7 @@ enum Running {
     Rotate(PolePairRatio, PolePairRatioState),
     Flux(FluxLinkageState),
     Frequency(FrequencyResponse, FrequencyResponseState),
+    Preflight(PreflightState),
 }
 
 // As `Running`: the running routine's state is the largest variant, by design.
@@ -156,6 +164,8 @@ pub struct CommissioningMode {
     end: End,
     crc: p::Crc32,
     len: usize,
+    /// Why the last pre-flight check refused the drive, until taken.
+    refused: Option<PreflightFault>,
 }
 
 impl Default for CommissioningMode {
@@ -189,7 +199,14 @@ impl CommissioningMode {
             },
             crc: p::Crc32::new(),
             len: 0,
+            refused: None,
         }
+    }
+
+    /// The pre-flight check's refusal, once (the board trips with its cause: outputs
+    /// off until reset, the fault record).
+    pub fn take_refusal(&mut self) -> Option<PreflightFault> {
+        self.refused.take()
     }
 
     /// The state and reason for the status frame.
@@ -263,6 +280,11 @@ impl CommissioningMode {
         if routine == Routine::FrequencyResponse {
             return self.accept_frequency_response(cfg, c, capacity);
         }
+        if routine == Routine::Preflight {
+            // Generated parameters only; nothing is captured.
+            self.start(cfg, routine, Running::Preflight(PreflightState::default()), false, 1, 0.0);
+            return Reason::None;
+        }
         let decimation = match u8::try_from(c.decimation) {
             Ok(d) if d >= 1 => d,
             _ => return Reason::BadCommand,
@@ -314,7 +336,7 @@ impl CommissioningMode {
             ),
             Routine::Flux => Running::Flux(FluxLinkageState::default()),
             // Accepted above, never here.
-            Routine::FrequencyResponse => return Reason::BadCommand,
+            Routine::FrequencyResponse | Routine::Preflight => return Reason::BadCommand,
         };
         let trip = if routine == Routine::Step { c.current_trip } else { 0.0 };
         self.start(
@@ -392,6 +414,36 @@ impl CommissioningMode {
             self.reason = Reason::Aborted;
             return Control::Off;
         }
+        // The pre-flight check: no capture; its verdict is the status (and, failed, the
+        // refusal the board turns into a fault record).
+        if let Running::Preflight(st) = &mut run {
+            let input = PreflightInput {
+                i_uvw: m.i_uvw,
+                theta_e: m.theta_e,
+                theta_r: m.theta_r,
+            };
+            return match cfg.preflight.process(st, trig, &input) {
+                Progress::Running(demand) => {
+                    self.mode = Mode::Running {
+                        routine,
+                        run,
+                        n: n.saturating_add(1),
+                    };
+                    Control::Demand(demand)
+                }
+                Progress::Finished(Ok(_)) => {
+                    self.mode = Mode::Idle;
+                    self.reason = Reason::None;
+                    Control::Off
+                }
+                Progress::Finished(Err(f)) => {
+                    self.mode = Mode::Fault;
+                    self.reason = Reason::PreflightFailed;
+                    self.refused = Some(f);
+                    Control::Off
+                }
+            };
+        }
         // The frequency response captures its own window (the previous period's u_PI
         // and v), never decimated.
         if let Running::Frequency(r, st) = &mut run {
@@ -465,7 +517,7 @@ impl CommissioningMode {
                 };
                 (outcome, (m.omega_e, m.u_q))
             }
-            Running::Frequency(..) => (Progress::Finished(None), (0.0, 0.0)),
+            Running::Frequency(..) | Running::Preflight(..) => (Progress::Finished(None), (0.0, 0.0)),
         };
         match progress {
             Progress::Running(demand) => {
@@ -561,6 +613,8 @@ pub fn capture_periods(cfg: &ModeConfig, routine: Routine) -> u64 {
         // One multisine period of the buffer ([`frequency_response_period`]), checked
         // when the command is accepted.
         Routine::FrequencyResponse => 0,
+        // Captures nothing.
+        Routine::Preflight => 0,
     }
 }
 
@@ -590,6 +644,7 @@ mod tests {
                 average_samples: 2,
                 min_speed: 10.0,
             },
+            preflight: crate::preflight::tests::EXAMPLE,
         }
     }
 
