@@ -150,5 +150,8 @@ pub fn reason_text(r: Reason) -> &'static str {
         Reason::Busy => "a routine or capture is already in progress",
         Reason::Aborted => "aborted: a fault, the break or a setpoint timeout switched the outputs off",
         Reason::Tripped => "the routine's current trip fired",
+        Reason::PreflightFailed => {
+            "the pre-flight check refused the drive (outputs off until reset; the fault record's cause 11–18 says which check)"
+        }
     }
 }

@@ -383,13 +383,14 @@ pub fn encode_header(layout: &Layout, h: &Header) -> Frame {
     }
 }
 
-/// The header in a header frame's bytes; `None` if the length or routine is wrong.
+/// The header in a header frame's bytes; `None` if the length or routine is wrong (the
+/// pre-flight check captures nothing, so a header of it is wrong too).
 pub fn decode_header(layout: &Layout, data: &[u8]) -> Option<Header> {
     let [flags, decimation, p0, p1, c0, c1, t0, t1] = *data else {
         return None;
     };
     Some(Header {
-        routine: Routine::from_code(flags & 0x0F)?,
+        routine: Routine::from_code(flags & 0x0F).filter(|r| *r != Routine::Preflight)?,
         axis_q: flags & 0x10 != 0,
         tripped: flags & 0x20 != 0,
         decimation,

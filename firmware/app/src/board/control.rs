@@ -122,6 +122,8 @@ impl Control {
                 omega_e: 0.0,
                 u_q: 0.0,
                 u_d: 0.0,
+                theta_e: 0,
+                i_uvw: motor_control::transforms::Uvw { u: 0.0, v: 0.0, w: 0.0 },
             },
             calibration: OffsetCalibration::new(),
             zero: None,
@@ -189,8 +191,13 @@ impl Control {
             break_active: pwm::Break(&self.tim1).break_flag(),
             setpoint_timeout: self.setpoint.timed_out(&SETPOINT),
         };
-        let (demand, run) =
+        let (demand, run, refused) =
             commissioning::control_step(&mut self.cordic, &self.measured, &guards, self.omega_e, normal, run);
+        // The pre-flight check refused the drive: outputs off until reset, its cause
+        // (11–18) in the fault record.
+        if let Some(f) = refused {
+            self.trip(FaultCause::from(f));
+        }
         let (demand, run) = if calibrating {
             (Demand::Off, false)
         } else {
@@ -203,6 +210,8 @@ impl Control {
             omega_e: out.omega_e,
             u_q: out.u_dq.q,
             u_d: out.u_dq.d,
+            theta_e: out.theta_e,
+            i_uvw: out.i_uvw,
         };
         self.omega_e = out.omega_e;
         pwm::set_compare(&self.tim1, out.compare);
