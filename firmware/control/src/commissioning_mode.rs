@@ -854,4 +854,46 @@ mod tests {
         assert_eq!(e.trip_sample, 2);
         assert!((e.trip_current - 12.0).abs() < 0.01);
     }
+
+    /// Routine 6, the pre-flight check: accepted with the generated parameters (the
+    /// command's voltage and trip unused), runs with no capture; with no current flowing
+    /// at all (every phase open) the turn refuses it as an open phase: outputs off, state
+    /// fault with reason 8, the refusal taken once, nothing to stream; an abort clears it.
+    #[test]
+    fn preflight_refusal_is_reported_once() {
+        let c = cfg();
+        let mut m = CommissioningMode::new();
+        let mut buf = [(0.0f32, 0.0f32); 8];
+        let g = Guards::default();
+        let pre = Command {
+            routine: Some(Routine::Preflight),
+            voltage: 0.0,
+            current_trip: 0.0,
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &pre, &g, 0.0, 8), Reason::None);
+        assert_eq!(m.status(&c, 0).bytes(), &[2, 0, 6, 0]);
+        let mut periods = 0u64;
+        while let Control::Demand(d) = m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf) {
+            assert!(matches!(d, Demand::VoltageAlphaBeta(_)), "{d:?}");
+            periods += 1;
+            assert!(periods <= c.preflight.periods());
+        }
+        // Hold 100 + turn 256 + hold 100 periods (EXAMPLE): the verdict at the end.
+        assert!(periods > 400, "{periods}");
+        assert_eq!(m.state(), (State::Fault, Reason::PreflightFailed));
+        assert_eq!(m.take_refusal(), Some(PreflightFault::OpenPhase));
+        assert_eq!(m.take_refusal(), None);
+        assert_eq!(m.next_frame(&c, &buf), None);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Off
+        );
+        let abort = Command {
+            routine: None,
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &abort, &g, 0.0, 8), Reason::None);
+        assert_eq!(m.state(), (State::Idle, Reason::None));
+    }
 }
