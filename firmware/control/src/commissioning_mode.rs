@@ -282,7 +282,14 @@ impl CommissioningMode {
         }
         if routine == Routine::Preflight {
             // Generated parameters only; nothing is captured.
-            self.start(cfg, routine, Running::Preflight(PreflightState::default()), false, 1, 0.0);
+            self.start(
+                cfg,
+                routine,
+                Running::Preflight(PreflightState::default()),
+                false,
+                1,
+                0.0,
+            );
             return Reason::None;
         }
         let decimation = match u8::try_from(c.decimation) {

@@ -234,6 +234,16 @@ impl PreflightState {
     }
 }
 
+/// `x ≥ min`, false for NaN.
+fn at_least(x: f32, min: f32) -> bool {
+    x >= min
+}
+
+/// `x ≤ max`, false for NaN.
+fn at_most(x: f32, max: f32) -> bool {
+    x <= max
+}
+
 /// `x` with the pulse's sign (pulse 0 positive, 1 negative).
 fn signed(pulse: u8, x: f32) -> f32 {
     if pulse == 0 { x } else { -x }
@@ -275,7 +285,7 @@ impl Preflight {
         m: &PreflightInput,
     ) -> Progress<Result<PulseFigures, PreflightFault>> {
         // Beyond what the lowest accepted R would draw (NaN trips too).
-        let trip = |i: f32| !(libm::fabsf(i) <= self.current_trip);
+        let trip = |i: f32| !at_most(libm::fabsf(i), self.current_trip);
         if trip(m.i_uvw.u) || trip(m.i_uvw.v) || trip(m.i_uvw.w) {
             return Progress::Finished(Err(PreflightFault::Resistance));
         }
@@ -353,20 +363,20 @@ impl Preflight {
     fn rotation_verdict(&self, st: &PreflightState, average: u32) -> Result<(), PreflightFault> {
         // The least current the rotation draws: V_rot at the highest accepted R.
         let least = self.rotation_voltage / (self.resistance * self.resistance_ratio);
-        if st.peak.iter().any(|&p| !(p >= self.open_fraction * least)) {
+        if st.peak.iter().any(|&p| !at_least(p, self.open_fraction * least)) {
             return Err(PreflightFault::OpenPhase);
         }
         // Expected resolver travel: one electrical turn · n_r/n_p.
         let expected_travel = TURN as f32 / self.ratio;
         let travelled = st.travelled as f32;
-        if !(libm::fabsf(travelled) >= 0.25 * expected_travel) {
+        if !at_least(libm::fabsf(travelled), 0.25 * expected_travel) {
             return Err(PreflightFault::PolePairRatio);
         }
         if travelled < 0.0 {
             return Err(PreflightFault::Direction);
         }
         let ratio = st.generated as f32 / travelled;
-        if !(libm::fabsf(ratio - self.ratio) <= self.ratio_bound) {
+        if !at_most(libm::fabsf(ratio - self.ratio), self.ratio_bound) {
             return Err(PreflightFault::PolePairRatio);
         }
         let error = st.angle_error.checked_div(i64::from(average.max(1))).unwrap_or(0);
@@ -445,7 +455,7 @@ impl Preflight {
         uvw: [f32; 3],
     ) -> Result<(), PreflightFault> {
         let i = signed(st.pulse, mean);
-        if !(i > 0.0) {
+        if !at_least(i, f32::MIN_POSITIVE) {
             return Err(PreflightFault::InvertedSensing);
         }
         if st.level == 0 {
@@ -454,7 +464,7 @@ impl Preflight {
         }
         let sum = libm::fabsf(uvw.iter().sum::<f32>());
         st.figures.sum = st.figures.sum.max(sum);
-        if self.sum_bound > 0.0 && !(sum <= self.sum_bound) {
+        if self.sum_bound > 0.0 && !at_most(sum, self.sum_bound) {
             return Err(PreflightFault::CurrentSum);
         }
         // Open phase: the phases within 60° of the pulse carry their share.
@@ -463,7 +473,7 @@ impl Preflight {
             let c = trig.sin_cos(axis).to_f32().cos;
             axis = axis.wrapping_sub(THIRD);
             let expected = mean * c;
-            if libm::fabsf(c) >= 0.5 && !(libm::fabsf(measured) >= self.open_fraction * libm::fabsf(expected)) {
+            if libm::fabsf(c) >= 0.5 && !at_least(libm::fabsf(measured), self.open_fraction * libm::fabsf(expected)) {
                 return Err(PreflightFault::OpenPhase);
             }
         }
@@ -494,7 +504,6 @@ impl Preflight {
 #[cfg(test)]
 pub(crate) mod tests {
     use super::*;
-    use crate::trig::SoftTrig;
 
     /// A motor of R = 0.1 Ω, L = 1 mH at T_s = 50 µs; 1 V pulses (10 A), 4 ms levels.
     pub(crate) const EXAMPLE: Preflight = Preflight {

@@ -18,8 +18,8 @@ use super::Source::{Custom, F32};
 use super::Text::{Lit, Of};
 use super::{Decl, Group, Json, Value, declare, intv, phys};
 use crate::board::Board;
-use crate::design::Design;
 use crate::design::BoardOut;
+use crate::design::Design;
 
 /// Standard identifier of the fault report, a choice of the firmware: low (high
 /// priority on the bus), below the drive's other frames on the seed boards; a board's
@@ -444,7 +444,9 @@ impl<'a> Commissioning<'a> {
         Decl {
             name: "PREFLIGHT_CURRENT_TRIP",
             value: F32(|c| 1.2 * PREFLIGHT_RESISTANCE_RATIO * c.preflight_current(), "A"),
-            formula: Lit("1.2·ρ_R·I_p: 20 % above what the lowest accepted R draws at V; ends the check (R out of bound)"),
+            formula: Lit(
+                "1.2·ρ_R·I_p: 20 % above what the lowest accepted R draws at V; ends the check (R out of bound)",
+            ),
             equation: Lit("—"),
             inputs: Of(|c| c.rating_in()),
             json: Json::None,

@@ -168,7 +168,12 @@ fn one_pair_per_board() -> Vec<(String, String)> {
             continue;
         }
         let spec = motor_emulator::wiring::spec(&motor).unwrap();
-        let d = motor_emulator::wiring::design(&motor, &format!("boards/{board}.toml"), &std::fs::read_to_string(motor_test_support::repo().join(format!("boards/{board}.toml"))).unwrap()).unwrap();
+        let d = motor_emulator::wiring::design(
+            &motor,
+            &format!("boards/{board}.toml"),
+            &std::fs::read_to_string(motor_test_support::repo().join(format!("boards/{board}.toml"))).unwrap(),
+        )
+        .unwrap();
         if Setup::new(&spec, &d).motor.psi > 0.0 {
             out.push((motor, board));
         }
@@ -195,7 +200,11 @@ fn correct_wiring_passes() {
         );
         assert_eq!(o.cause, None, "{name}: a fault was recorded");
         assert!(o.on_at_end, "{name}: the drive is off after the check");
-        assert!(o.peak_a >= 0.5 * ip && o.peak_a <= trip, "{name}: peak {:.2} A, I_p {ip:.2} A", o.peak_a);
+        assert!(
+            o.peak_a >= 0.5 * ip && o.peak_a <= trip,
+            "{name}: peak {:.2} A, I_p {ip:.2} A",
+            o.peak_a
+        );
     }
 }
 
@@ -222,9 +231,16 @@ fn refused(defect: Defect, cause: &str) {
         o.peak_a
     );
     assert_eq!(o.cause.as_deref(), Some(cause), "{name}: {defect:?}");
-    assert!(!o.switched_after_verdict, "{name}: {defect:?}: a gate could switch after the verdict");
+    assert!(
+        !o.switched_after_verdict,
+        "{name}: {defect:?}: a gate could switch after the verdict"
+    );
     assert!(!o.on_at_end, "{name}: {defect:?}: enabled at the end");
-    assert!(o.peak_a <= trip, "{name}: {defect:?}: {:.2} A beyond the check's trip {trip:.2} A", o.peak_a);
+    assert!(
+        o.peak_a <= trip,
+        "{name}: {defect:?}: {:.2} A beyond the check's trip {trip:.2} A",
+        o.peak_a
+    );
 }
 
 /// The sensing inverted on every phase: refused at the first pulse level, cause 11.
