@@ -16,6 +16,11 @@
 //!   capture is sent raw (unfiltered): header, one data frame per sample, end frame
 //!   with the CRC-32 ([`CommissioningMode::next_frame`], one frame per call).
 //!
+//! * The pre-flight check (routine 6, [`crate::preflight`]) runs the same way but captures
+//!   nothing: it ends idle (passed) or in the fault state with reason
+//!   [`Reason::PreflightFailed`], its refusal handed once to the board
+//!   ([`CommissioningMode::take_refusal`]), which trips with the refusal's fault cause.
+//!
 //! Raw capture instead of the FMAC: the host filters with the bit-exact FMAC model
 //! (`motor_control::fir::FmacFir`, the same taps), so the result is the same number
 //! for number, and the log keeps the unfiltered current for inspection; the FMAC stays

@@ -10,6 +10,10 @@
 //! Meanwhile the step runs with [`Demand::Off`] (the angle observer locks on) and a
 //! commissioning routine sees a fault.
 //!
+//! The pre-flight check (CAN routine 6) runs through the commissioning mode like the
+//! chapter-6 routines; a refusal trips the drive here with its own cause (11–18,
+//! `FaultCause::from(PreflightFault)`): outputs off until reset, the record sealed.
+//!
 //! Order: read and acknowledge the conversions; trip on the board's levels
 //! ([`crate::config::TRIPS`]: a phase current beyond the over-current level or at the
 //! converter's rail, the DC link beyond the over-voltage level, the last period's
