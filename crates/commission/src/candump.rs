@@ -16,6 +16,7 @@ use std::fmt::Write as _;
 use motor_control::can_protocol::{self as p, Crc32, End, Header, Layout, Quantity, Routine};
 use motor_control::commissioning::{Axis, Capture as StepCapture, CommissioningError, FluxLinkage};
 use motor_control::commissioning_mode::ModeConfig;
+use motor_control::preflight::Preflight;
 
 use super::recording::{RecordingKind, StepRun, write_step_csv};
 use codegen::constants::{Group, constants};
@@ -56,6 +57,7 @@ pub fn mode_config(d: &Design) -> Option<(ModeConfig, usize)> {
     let can = groups.iter().find(|g| g.name == "can")?;
     let num = |g: &Group, name: &str| g.constants.iter().find(|k| k.name == name)?.value.number.as_f64();
     let u = |name: &str| num(g, name).map(|x| x as u32);
+    let f = |name: &str| num(g, name).map(|x| x as f32);
     Some((
         ModeConfig {
             layout,
@@ -79,6 +81,27 @@ pub fn mode_config(d: &Design) -> Option<(ModeConfig, usize)> {
                 min_speed: num(g, "FLUX_MIN_SPEED")? as f32,
             },
             injection_limit: num(g, "INJECTION_LIMIT")? as f32,
+            preflight: Preflight {
+                voltage: f("PREFLIGHT_VOLTAGE")?,
+                level_samples: u("PREFLIGHT_LEVEL_SAMPLES")?,
+                rest_samples: u("PREFLIGHT_REST_SAMPLES")?,
+                average_samples: u("PREFLIGHT_AVERAGE_SAMPLES")?,
+                resistance: f("PREFLIGHT_RESISTANCE")?,
+                inductance: f("PREFLIGHT_INDUCTANCE")?,
+                resistance_ratio: f("PREFLIGHT_RESISTANCE_RATIO")?,
+                inductance_ratio: f("PREFLIGHT_INDUCTANCE_RATIO")?,
+                current_trip: f("PREFLIGHT_CURRENT_TRIP")?,
+                sum_bound: f("PREFLIGHT_SUM_BOUND")?,
+                open_fraction: f("PREFLIGHT_OPEN_FRACTION")?,
+                sample_period: d.drive.sample_period_s as f32,
+                tau_offset: f("PREFLIGHT_TAU_OFFSET")?,
+                rotation_voltage: f("PREFLIGHT_VOLTAGE")?,
+                rotation_step: num(g, "ROTATION_STEP")? as i32,
+                settle_samples: u("ROTATION_SETTLE_SAMPLES")?,
+                ratio: f("PREFLIGHT_RATIO")?,
+                ratio_bound: f("PREFLIGHT_RATIO_BOUND")?,
+                angle_bound: num(g, "PREFLIGHT_ANGLE_BOUND")? as i32,
+            },
         },
         u("CAPTURE_CAPACITY")? as usize,
     ))
@@ -92,6 +115,9 @@ pub fn kind_of(r: Routine) -> RecordingKind {
         Routine::PolePairRatio => RecordingKind::PolePairRatio,
         Routine::Flux => RecordingKind::Flux,
         Routine::FrequencyResponse => RecordingKind::FrequencyResponse,
+        // Captures nothing: `decode_header` refuses a header of it, so no capture of
+        // this routine reaches here; the arm only completes the match.
+        Routine::Preflight => RecordingKind::Step,
     }
 }
 

@@ -151,5 +151,8 @@ pub fn reason_text(r: Reason) -> &'static str {
         Reason::Aborted => "aborted: a fault, the break or a setpoint timeout switched the outputs off",
         Reason::Tripped => "the routine's current trip fired",
         Reason::AmplitudeAboveLimit => "the injection amplitude is above the drive's INJECTION_LIMIT",
+        Reason::PreflightFailed => {
+            "the pre-flight check refused the drive (outputs off until reset; the fault record's cause 11–18 says which check)"
+        }
     }
 }

@@ -99,6 +99,8 @@ impl SimulatedDrive {
                 omega_e: o.omega_e,
                 u_q: o.u_dq.q,
                 u_d: o.u_dq.d,
+                theta_e: o.theta_e,
+                i_uvw: o.i_uvw,
             };
         }
         // The status frame has the slot at its period, as on the board.

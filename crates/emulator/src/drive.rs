@@ -37,7 +37,13 @@ pub struct Drive {
     /// Longest integration step \[s\]: the design's sample period, for which the plant's
     /// RK4 sub-steps are sized ([`motor_sim::plant::SUBSTEPS`]).
     max_step_s: f64,
-    sensing: Sensing,
+    /// The board's sensing (with any defect a test injects).
+    pub sensing: Sensing,
+    /// Which motor winding each of the bridge's legs u, v, w is connected to (a defect
+    /// a test injects: `[0, 2, 1]` is leads v and w swapped at the motor; `[0, 1, 2]` as
+    /// wired). The winding gets its leg's voltage; the leg's current sensor measures
+    /// that winding's current.
+    pub leads: [usize; 3],
     /// Every bridge change, in time order.
     pub samples: Vec<Sample>,
 }
@@ -53,6 +59,7 @@ impl Drive {
             plant: setup.plant(speed),
             max_step_s: d.drive.sample_period_s,
             sensing: Sensing::new(hw),
+            leads: [0, 1, 2],
             samples: Vec::new(),
         }
     }
@@ -82,13 +89,20 @@ impl Analog for Drive {
     /// resolver angle θ_r.
     fn volts(&mut self, signal: Signal, t: f64, excitation_high: bool) -> f64 {
         let m = self.measure_at(t);
+        let by_leg = self.leads.map(|w| m.phase_currents[w]);
         self.sensing
-            .volts(signal, m.phase_currents, m.dc_link, m.theta_r, excitation_high)
+            .volts(signal, by_leg, m.dc_link, m.theta_r, excitation_high)
     }
 
     fn bridge(&mut self, t: f64, duties: Option<[f64; 3]>) {
         Self::integrate(&mut self.plant, t, self.max_step_s);
-        self.plant.pending = duties.map(|d| d.map(|x| x as f32));
+        self.plant.pending = duties.map(|d| {
+            let mut winding = [0.0f32; 3];
+            for (leg, &w) in self.leads.iter().enumerate() {
+                winding[w] = d[leg] as f32;
+            }
+            winding
+        });
         self.samples.push(Sample {
             t,
             i: self.plant.i,

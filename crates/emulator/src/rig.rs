@@ -183,6 +183,14 @@ impl Rig {
             8 => "panic",
             9 => "watchdog",
             10 => "current offset",
+            11 => "inverted current sensing",
+            12 => "resistance out of bound",
+            13 => "inductance out of bound",
+            14 => "phase currents do not sum to zero",
+            15 => "open phase",
+            16 => "wrong direction",
+            17 => "pole-pair ratio",
+            18 => "resolver offset",
             _ => "unknown",
         };
         Some(format!("{cause} ({name})"))

@@ -51,6 +51,10 @@ pub struct Sensing {
     /// \[V\] (a defect a test injects: an offset resistor off its value, an amplifier's
     /// input offset; zero for the board as described).
     pub zero_error_v: [f64; 3],
+    /// Each phase's gain against the hardware description's (a defect a test injects:
+    /// −1 for a sensor mounted or wired the other way round; 1 for the board as
+    /// described).
+    pub gain_error: [f64; 3],
 }
 
 impl Sensing {
@@ -59,6 +63,7 @@ impl Sensing {
         Self {
             hw: hw.clone(),
             zero_error_v: [0.0; 3],
+            gain_error: [1.0; 3],
         }
     }
 
@@ -75,7 +80,7 @@ impl Sensing {
         let half = self.hw.vref / 2.0;
         let sign = if excitation_high { 1.0 } else { -1.0 };
         match signal {
-            Signal::Current(k) => self.hw.current_volts(currents[k]) + self.zero_error_v[k],
+            Signal::Current(k) => self.hw.current_volts(self.gain_error[k] * currents[k]) + self.zero_error_v[k],
             Signal::DcLink => dc_link_v * self.hw.dc_link_ratio,
             Signal::Sin => half + RESOLVER_AMPLITUDE * half * sign * theta_r.sin(),
             Signal::Cos => half + RESOLVER_AMPLITUDE * half * sign * theta_r.cos(),

@@ -31,6 +31,10 @@ pub struct Bench {
     /// Q1.31 full scale (1 here; a board's front end may give less — the trig-identity
     /// observer's gain scales with it, thesis A (4.10)).
     pub resolver_amplitude: f64,
+    /// Each phase sensor's true gain relative to the configuration's (1: as configured;
+    /// −1: the sensing inverted; 1.2: 20 % high) — a board whose sensing is not what its
+    /// file says.
+    pub current_gain: [f64; 3],
 }
 
 /// One recorded period.
@@ -66,6 +70,7 @@ impl Bench {
             plant,
             frozen_dc_link: None,
             resolver_amplitude: 1.0,
+            current_gain: [1.0; 3],
         }
     }
 
@@ -81,9 +86,9 @@ impl Bench {
         let ds = &self.cfg.dc_link_sense;
         AdcSample {
             phase_currents: [
-                code(m.phase_currents[0], 0),
-                code(m.phase_currents[1], 1),
-                code(m.phase_currents[2], 2),
+                code(self.current_gain[0] * m.phase_currents[0], 0),
+                code(self.current_gain[1] * m.phase_currents[1], 1),
+                code(self.current_gain[2] * m.phase_currents[2], 2),
             ],
             resolver: ResolverSample {
                 sin: q(self.resolver_amplitude * m.theta_r.sin()),

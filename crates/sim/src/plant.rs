@@ -198,6 +198,12 @@ pub struct Plant {
     pub extra_delay: f64,
     /// The duties of the previous period (for [`Plant::extra_delay`]).
     pub previous: Option<[f32; 3]>,
+    /// A winding open (0 = u, 1 = v, 2 = w; a broken lead or connector): its current is
+    /// zero and the star point floats, so the αβ current stays on the line
+    /// perpendicular to that phase's axis (2π·k/3). Modelled by projecting the current
+    /// onto that line after every integration sub-step: exact for a non-salient machine
+    /// (L_d = L_q), an approximation of the cross-coupling for a salient one.
+    pub open_phase: Option<usize>,
 }
 
 impl Plant {
@@ -218,6 +224,7 @@ impl Plant {
             pending: None,
             extra_delay: 0.0,
             previous: None,
+            open_phase: None,
         }
     }
 
@@ -329,6 +336,9 @@ impl Plant {
                 for j in 0..4 {
                     s[j] += h / 6.0 * (k1[j] + 2.0 * k2[j] + 2.0 * k3[j] + k4[j]);
                 }
+                if let Some(k) = self.open_phase {
+                    s = open_phase_projection(s, np, k);
+                }
                 t += h;
             }
             s
@@ -347,6 +357,21 @@ impl Plant {
         }
         self.t += self.ts;
     }
+}
+
+/// The state `s` = [i_d, i_q, θ_m, ω_m] with the αβ current projected onto the line
+/// perpendicular to phase `k`'s axis (phase `k` open, [`Plant::open_phase`]).
+fn open_phase_projection(mut s: [f64; 4], np: f64, k: usize) -> [f64; 4] {
+    let (sn, cs) = (np * s[2]).sin_cos();
+    let (alpha, beta) = (cs * s[0] - sn * s[1], sn * s[0] + cs * s[1]);
+    // e ⟂ the phase axis at 2πk/3.
+    let (ps, pc) = (2.0 * std::f64::consts::PI * k as f64 / 3.0).sin_cos();
+    let (ex, ey) = (-ps, pc);
+    let along = alpha * ex + beta * ey;
+    let (alpha, beta) = (along * ex, along * ey);
+    s[0] = cs * alpha + sn * beta;
+    s[1] = -sn * alpha + cs * beta;
+    s
 }
 
 /// Wraps an angle into [−π, π).

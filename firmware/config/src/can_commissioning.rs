@@ -8,6 +8,7 @@
 use motor_control::can_protocol::Layout;
 use motor_control::commissioning::FluxLinkage;
 use motor_control::commissioning_mode::{CommissioningMode, ModeConfig};
+use motor_control::preflight::Preflight;
 
 use crate::motor::{board, can, commissioning};
 
@@ -47,6 +48,31 @@ pub const MODE: ModeConfig = ModeConfig {
         min_speed: commissioning::FLUX_MIN_SPEED,
     },
     injection_limit: commissioning::INJECTION_LIMIT,
+    preflight: PREFLIGHT,
+};
+
+/// The pre-flight check (issue 26 item 2): the generated `PREFLIGHT_*` figures; the
+/// rotation turns at the §6.4 rotation's rate and holds as long.
+pub const PREFLIGHT: Preflight = Preflight {
+    voltage: commissioning::PREFLIGHT_VOLTAGE,
+    level_samples: commissioning::PREFLIGHT_LEVEL_SAMPLES,
+    rest_samples: commissioning::PREFLIGHT_REST_SAMPLES,
+    average_samples: commissioning::PREFLIGHT_AVERAGE_SAMPLES,
+    resistance: commissioning::PREFLIGHT_RESISTANCE,
+    inductance: commissioning::PREFLIGHT_INDUCTANCE,
+    resistance_ratio: commissioning::PREFLIGHT_RESISTANCE_RATIO,
+    inductance_ratio: commissioning::PREFLIGHT_INDUCTANCE_RATIO,
+    current_trip: commissioning::PREFLIGHT_CURRENT_TRIP,
+    sum_bound: commissioning::PREFLIGHT_SUM_BOUND,
+    open_fraction: commissioning::PREFLIGHT_OPEN_FRACTION,
+    sample_period: crate::config::CONTROLLER.sample_period,
+    tau_offset: commissioning::PREFLIGHT_TAU_OFFSET,
+    rotation_voltage: commissioning::PREFLIGHT_VOLTAGE,
+    rotation_step: commissioning::ROTATION_STEP,
+    settle_samples: commissioning::ROTATION_SETTLE_SAMPLES,
+    ratio: commissioning::PREFLIGHT_RATIO,
+    ratio_bound: commissioning::PREFLIGHT_RATIO_BOUND,
+    angle_bound: commissioning::PREFLIGHT_ANGLE_BOUND,
 };
 
 /// Captured samples the image holds.

@@ -20,6 +20,7 @@
 #![forbid(unsafe_code)]
 
 use motor_control::can_protocol::Crc32;
+use motor_control::preflight::PreflightFault;
 
 /// Words of the sealed record: magic, cause, flags, PC, CFSR, HFSR, the control state
 /// ([`STATE_WORDS`]), CRC.
@@ -68,6 +69,43 @@ pub enum FaultCause {
     /// the board file, a sensor or amplifier without supply, a broken channel. The
     /// outputs were never switched on. (Numbers 10–19 are issue 26's start-up checks.)
     CurrentOffset = 10,
+    /// Pre-flight check (`motor_control::preflight`, CAN routine 6): the pulse's current
+    /// had the wrong sign — the current sensing is inverted.
+    PreflightInvertedSensing = 11,
+    /// Pre-flight: R from the pulses (or a current above what the lowest accepted R
+    /// draws) outside the bound of the spec's R.
+    PreflightResistance = 12,
+    /// Pre-flight: L from the pulse's rise outside the bound of the spec's L_d.
+    PreflightInductance = 13,
+    /// Pre-flight: the three measured phase currents do not sum to zero.
+    PreflightCurrentSum = 14,
+    /// Pre-flight: a phase carried less than half its expected current (open lead,
+    /// connector or winding; dead sensor).
+    PreflightOpenPhase = 15,
+    /// Pre-flight: the resolver turned against the rotating field (two motor leads
+    /// swapped, or the resolver's SIN/COS).
+    PreflightDirection = 16,
+    /// Pre-flight: the rotor did not follow, or the resolver turned by another ratio than
+    /// n_r/n_p (a wrong pole-pair count).
+    PreflightPolePairRatio = 17,
+    /// Pre-flight: the rotor came to rest away from the commanded electrical angle (a
+    /// wrong resolver offset).
+    PreflightResolverOffset = 18,
+}
+
+impl From<PreflightFault> for FaultCause {
+    fn from(f: PreflightFault) -> Self {
+        match f {
+            PreflightFault::InvertedSensing => Self::PreflightInvertedSensing,
+            PreflightFault::Resistance => Self::PreflightResistance,
+            PreflightFault::Inductance => Self::PreflightInductance,
+            PreflightFault::CurrentSum => Self::PreflightCurrentSum,
+            PreflightFault::OpenPhase => Self::PreflightOpenPhase,
+            PreflightFault::Direction => Self::PreflightDirection,
+            PreflightFault::PolePairRatio => Self::PreflightPolePairRatio,
+            PreflightFault::ResolverOffset => Self::PreflightResolverOffset,
+        }
+    }
 }
 
 impl FaultCause {
@@ -85,6 +123,14 @@ impl FaultCause {
             Panic,
             Watchdog,
             CurrentOffset,
+            PreflightInvertedSensing,
+            PreflightResistance,
+            PreflightInductance,
+            PreflightCurrentSum,
+            PreflightOpenPhase,
+            PreflightDirection,
+            PreflightPolePairRatio,
+            PreflightResolverOffset,
         ]
         .into_iter()
         .find(|c| *c as u32 == code)
@@ -342,12 +388,25 @@ mod tests {
             reported: true,
         };
         assert_eq!(FaultRecord::from_words(&bare.to_words()), Some(bare));
-        for code in 1..=10 {
-            let c = FaultCause::from_code(code).expect("codes 1–10 are causes");
+        for code in 1..=18 {
+            let c = FaultCause::from_code(code).expect("codes 1–18 are causes");
             assert_eq!(c as u32, code);
         }
         assert_eq!(FaultCause::from_code(0), None);
-        assert_eq!(FaultCause::from_code(11), None);
+        assert_eq!(FaultCause::from_code(19), None);
+        // The pre-flight check's refusals keep their numbers in the record.
+        for f in [
+            PreflightFault::InvertedSensing,
+            PreflightFault::Resistance,
+            PreflightFault::Inductance,
+            PreflightFault::CurrentSum,
+            PreflightFault::OpenPhase,
+            PreflightFault::Direction,
+            PreflightFault::PolePairRatio,
+            PreflightFault::ResolverOffset,
+        ] {
+            assert_eq!(FaultCause::from(f) as u8, f.code());
+        }
     }
 
     /// Layout: word 0 is the magic, word 1 the cause code, the last word the CRC of the

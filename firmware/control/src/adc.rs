@@ -63,7 +63,11 @@ impl CurrentSense {
 
     /// αβ current \[A\] (2.7), from three phases or from two with (2.1).
     pub fn alpha_beta(&self, codes: [u16; 3]) -> AlphaBeta {
-        let i = self.currents(codes);
+        self.alpha_beta_of(self.currents(codes))
+    }
+
+    /// αβ current \[A\] (2.7) of phase currents from [`CurrentSense::currents`].
+    pub fn alpha_beta_of(&self, i: Uvw) -> AlphaBeta {
         match self.phases {
             MeasuredPhases::Three => clarke(i),
             MeasuredPhases::UV => clarke_uv(i.u, i.v),

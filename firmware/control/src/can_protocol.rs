@@ -110,16 +110,23 @@ pub enum Routine {
     /// of the injected axis. The command's decimation bytes carry the line set: byte 6 the
     /// first harmonic, byte 7 the lines per octave (the capture is never decimated).
     FrequencyResponse = 5,
+    /// The pre-flight check before the loop closes ([`crate::preflight`]): d pulses and one
+    /// electrical turn with generated parameters (the command's voltage, trip and
+    /// decimation are not used); nothing is captured — the verdict is the status frame
+    /// (idle, reason none: passed; fault, reason `PreflightFailed`: the fault record's
+    /// cause says which check).
+    Preflight = 6,
 }
 
 impl Routine {
     /// All routines, in code order.
-    pub const ALL: [Routine; 5] = [
+    pub const ALL: [Routine; 6] = [
         Routine::Step,
         Routine::ResolverOffset,
         Routine::PolePairRatio,
         Routine::Flux,
         Routine::FrequencyResponse,
+        Routine::Preflight,
     ];
 
     /// The routine with bus code `code`.
@@ -130,6 +137,7 @@ impl Routine {
             3 => Some(Routine::PolePairRatio),
             4 => Some(Routine::Flux),
             5 => Some(Routine::FrequencyResponse),
+            6 => Some(Routine::Preflight),
             _ => None,
         }
     }
@@ -147,6 +155,8 @@ impl Routine {
             Routine::PolePairRatio => [Quantity::Angle, Quantity::Angle],
             Routine::Flux => [Quantity::Speed, Quantity::Voltage],
             Routine::FrequencyResponse => [Quantity::Voltage, Quantity::Voltage],
+            // Nothing is captured; the d pulses' voltage and current if it ever were.
+            Routine::Preflight => [Quantity::Voltage, Quantity::Current],
         }
     }
 }
@@ -227,9 +237,11 @@ pub enum Reason {
     Aborted = 6,
     /// The routine's current trip fired (capture still sent, with its trip data).
     Tripped = 7,
+    /// The pre-flight check refused the drive: outputs off until reset, the fault
+    /// record's cause (11–18) says which check.
+    PreflightFailed = 8,
     /// A frequency response's amplitude is above the drive's generated injection limit
-    /// (`INJECTION_LIMIT`): refused, nothing runs. (Code 8 is the pre-flight check's,
-    /// issue 26.)
+    /// (`INJECTION_LIMIT`): refused, nothing runs.
     AmplitudeAboveLimit = 9,
 }
 
@@ -260,6 +272,7 @@ impl Reason {
             Reason::Busy,
             Reason::Aborted,
             Reason::Tripped,
+            Reason::PreflightFailed,
             Reason::AmplitudeAboveLimit,
         ]
         .into_iter()
@@ -374,13 +387,14 @@ pub fn encode_header(layout: &Layout, h: &Header) -> Frame {
     }
 }
 
-/// The header in a header frame's bytes; `None` if the length or routine is wrong.
+/// The header in a header frame's bytes; `None` if the length or routine is wrong (the
+/// pre-flight check captures nothing, so a header of it is wrong too).
 pub fn decode_header(layout: &Layout, data: &[u8]) -> Option<Header> {
     let [flags, decimation, p0, p1, c0, c1, t0, t1] = *data else {
         return None;
     };
     Some(Header {
-        routine: Routine::from_code(flags & 0x0F)?,
+        routine: Routine::from_code(flags & 0x0F).filter(|r| *r != Routine::Preflight)?,
         axis_q: flags & 0x10 != 0,
         tripped: flags & 0x20 != 0,
         decimation,
@@ -602,16 +616,16 @@ mod tests {
             decode_status(&l, 0x101, f.bytes()),
             Some((State::Idle, Reason::TorqueNotZero, 1, 0))
         );
-        assert_eq!(decode_status(&l, 0x101, &[4, 8, 0, 0]), None);
+        assert_eq!(decode_status(&l, 0x101, &[4, 9, 0, 0]), None);
         assert_eq!(decode_status(&l, 0x102, f.bytes()), None);
         // Every state and reason survives the trip through its code.
-        for code in 0..=7u8 {
+        for code in 0..=8u8 {
             assert_eq!(Reason::from_code(code).map(|r| r as u8), Some(code));
         }
         for code in 0..=4u8 {
             assert_eq!(State::from_code(code).map(|s| s as u8), Some(code));
         }
-        assert_eq!((State::from_code(5), Reason::from_code(8)), (None, None));
+        assert_eq!((State::from_code(5), Reason::from_code(9)), (None, None));
     }
 
     /// Saturation and wrap: currents beyond ±327.67 A saturate, NaN is 0; an angle of

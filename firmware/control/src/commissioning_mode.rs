@@ -16,6 +16,11 @@
 //!   capture is sent raw (unfiltered): header, one data frame per sample, end frame
 //!   with the CRC-32 ([`CommissioningMode::next_frame`], one frame per call).
 //!
+//! * The pre-flight check (routine 6, [`crate::preflight`]) runs the same way but captures
+//!   nothing: it ends idle (passed) or in the fault state with reason
+//!   [`Reason::PreflightFailed`], its refusal handed once to the board
+//!   ([`CommissioningMode::take_refusal`]), which trips with the refusal's fault cause.
+//!
 //! Raw capture instead of the FMAC: the host filters with the bit-exact FMAC model
 //! (`motor_control::fir::FmacFir`, the same taps), so the result is the same number
 //! for number, and the log keeps the unfiltered current for inspection; the FMAC stays
@@ -27,8 +32,9 @@ use crate::commissioning::{
     Axis, CommissioningError, FluxLinkage, FluxLinkageState, FrequencyResponse, FrequencyResponseState, PolePairRatio,
     PolePairRatioState, Progress, ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState, multisine_lines,
 };
+use crate::preflight::{Preflight, PreflightFault, PreflightInput, PreflightState};
 use crate::step::Demand;
-use crate::transforms::Dq;
+use crate::transforms::{Dq, Uvw};
 use crate::trig::Trig;
 
 /// Fixed parameters of the routines (the command gives voltage, trip and decimation).
@@ -55,6 +61,8 @@ pub struct ModeConfig {
     /// applied voltage within the linear modulation range); a command above it is
     /// refused with [`Reason::AmplitudeAboveLimit`].
     pub injection_limit: f32,
+    /// The pre-flight check ([`crate::preflight`]).
+    pub preflight: Preflight,
 }
 
 /// Safety inputs, every period.
@@ -90,6 +98,10 @@ pub struct Measured {
     pub u_q: f32,
     /// Applied d voltage \[V\] (the same).
     pub u_d: f32,
+    /// The resolver's electrical angle θ_e (π-scaled Q1.31).
+    pub theta_e: i32,
+    /// Measured phase currents \[A\].
+    pub i_uvw: Uvw,
 }
 
 /// Multisine periods the frequency response runs before the captured one: the loop's
@@ -190,6 +202,7 @@ enum Running {
     Rotate(PolePairRatio, PolePairRatioState),
     Flux(FluxLinkageState),
     Frequency(FrequencyResponse, FrequencyResponseState),
+    Preflight(PreflightState),
 }
 
 // As `Running`: the running routine's state is the largest variant, by design.
@@ -220,6 +233,8 @@ pub struct CommissioningMode {
     end: End,
     crc: p::Crc32,
     len: usize,
+    /// Why the last pre-flight check refused the drive, until taken.
+    refused: Option<PreflightFault>,
 }
 
 impl Default for CommissioningMode {
@@ -253,7 +268,14 @@ impl CommissioningMode {
             },
             crc: p::Crc32::new(),
             len: 0,
+            refused: None,
         }
+    }
+
+    /// The pre-flight check's refusal, once (the board trips with its cause: outputs
+    /// off until reset, the fault record).
+    pub fn take_refusal(&mut self) -> Option<PreflightFault> {
+        self.refused.take()
     }
 
     /// The state and reason for the status frame.
@@ -352,6 +374,18 @@ impl CommissioningMode {
         if routine == Routine::FrequencyResponse {
             return self.accept_frequency_response(cfg, c, prepared);
         }
+        if routine == Routine::Preflight {
+            // Generated parameters only; nothing is captured.
+            self.start(
+                cfg,
+                routine,
+                Running::Preflight(PreflightState::default()),
+                false,
+                1,
+                0.0,
+            );
+            return Reason::None;
+        }
         let decimation = match u8::try_from(c.decimation) {
             Ok(d) if d >= 1 => d,
             _ => return Reason::BadCommand,
@@ -403,7 +437,7 @@ impl CommissioningMode {
             ),
             Routine::Flux => Running::Flux(FluxLinkageState::default()),
             // Accepted above, never here.
-            Routine::FrequencyResponse => return Reason::BadCommand,
+            Routine::FrequencyResponse | Routine::Preflight => return Reason::BadCommand,
         };
         let trip = if routine == Routine::Step { c.current_trip } else { 0.0 };
         self.start(
@@ -478,6 +512,36 @@ impl CommissioningMode {
             self.reason = Reason::Aborted;
             return Control::Off;
         }
+        // The pre-flight check: no capture; its verdict is the status (and, failed, the
+        // refusal the board turns into a fault record).
+        if let Running::Preflight(st) = &mut run {
+            let input = PreflightInput {
+                i_uvw: m.i_uvw,
+                theta_e: m.theta_e,
+                theta_r: m.theta_r,
+            };
+            return match cfg.preflight.process(st, trig, &input) {
+                Progress::Running(demand) => {
+                    self.mode = Mode::Running {
+                        routine,
+                        run,
+                        n: n.saturating_add(1),
+                    };
+                    Control::Demand(demand)
+                }
+                Progress::Finished(Ok(_)) => {
+                    self.mode = Mode::Idle;
+                    self.reason = Reason::None;
+                    Control::Off
+                }
+                Progress::Finished(Err(f)) => {
+                    self.mode = Mode::Fault;
+                    self.reason = Reason::PreflightFailed;
+                    self.refused = Some(f);
+                    Control::Off
+                }
+            };
+        }
         // The frequency response captures its own window (the previous period's u_PI
         // and v), never decimated.
         if let Running::Frequency(r, st) = &mut run {
@@ -551,7 +615,7 @@ impl CommissioningMode {
                 };
                 (outcome, (m.omega_e, m.u_q))
             }
-            Running::Frequency(..) => (Progress::Finished(None), (0.0, 0.0)),
+            Running::Frequency(..) | Running::Preflight(..) => (Progress::Finished(None), (0.0, 0.0)),
         };
         match progress {
             Progress::Running(demand) => {
@@ -647,6 +711,8 @@ pub fn capture_periods(cfg: &ModeConfig, routine: Routine) -> u64 {
         // One multisine period of the buffer ([`frequency_response_period`]), checked
         // when the command is accepted.
         Routine::FrequencyResponse => 0,
+        // Captures nothing.
+        Routine::Preflight => 0,
     }
 }
 
@@ -677,6 +743,7 @@ mod tests {
                 min_speed: 10.0,
             },
             injection_limit: 3.0,
+            preflight: crate::preflight::tests::EXAMPLE,
         }
     }
 
@@ -919,5 +986,47 @@ mod tests {
         let e = p::decode_end(&c.layout, last.bytes()).unwrap();
         assert_eq!(e.trip_sample, 2);
         assert!((e.trip_current - 12.0).abs() < 0.01);
+    }
+
+    /// Routine 6, the pre-flight check: accepted with the generated parameters (the
+    /// command's voltage and trip unused), runs with no capture; with no current flowing
+    /// at all (every phase open) the turn refuses it as an open phase: outputs off, state
+    /// fault with reason 8, the refusal taken once, nothing to stream; an abort clears it.
+    #[test]
+    fn preflight_refusal_is_reported_once() {
+        let c = cfg();
+        let mut m = CommissioningMode::new();
+        let mut buf = [(0.0f32, 0.0f32); 8];
+        let g = Guards::default();
+        let pre = Command {
+            routine: Some(Routine::Preflight),
+            voltage: 0.0,
+            current_trip: 0.0,
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &pre, &g, 0.0, 8), Reason::None);
+        assert_eq!(m.status(&c, 0).bytes(), &[2, 0, 6, 0]);
+        let mut periods = 0u64;
+        while let Control::Demand(d) = m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf) {
+            assert!(matches!(d, Demand::VoltageAlphaBeta(_)), "{d:?}");
+            periods += 1;
+            assert!(periods <= c.preflight.periods());
+        }
+        // Hold 100 + turn 256 + hold 100 periods (EXAMPLE): the verdict at the end.
+        assert!(periods > 400, "{periods}");
+        assert_eq!(m.state(), (State::Fault, Reason::PreflightFailed));
+        assert_eq!(m.take_refusal(), Some(PreflightFault::OpenPhase));
+        assert_eq!(m.take_refusal(), None);
+        assert_eq!(m.next_frame(&c, &buf), None);
+        assert_eq!(
+            m.step(&c, &g, &Measured::default(), &mut SoftTrig, &mut buf),
+            Control::Off
+        );
+        let abort = Command {
+            routine: None,
+            ..step_cmd()
+        };
+        assert_eq!(m.command(&c, &abort, &g, 0.0, 8), Reason::None);
+        assert_eq!(m.state(), (State::Idle, Reason::None));
     }
 }

@@ -24,6 +24,7 @@
 //! | [`modulation`] | THPWM (3.7), (3.8), duties and compare values |
 //! | [`fir`] | FMAC-bit-exact FIR for the identification filter (§6.2) |
 //! | [`commissioning`] | chapter-6 routines as state machines |
+//! | [`preflight`] | the pre-flight check before the loop closes: d pulses, one electrical turn |
 //! | [`commissioning_mode`] | CAN-commanded commissioning: guards, capture, streaming |
 //! | [`can_protocol`] | status, command and capture frames as bytes, CRC-32 |
 //! | [`setpoint`] | received setpoint with timeout and ramp to zero |
@@ -65,6 +66,7 @@ pub mod feedforward;
 pub mod fir;
 pub mod modulation;
 pub mod pi;
+pub mod preflight;
 pub mod q31;
 pub mod setpoint;
 pub mod step;

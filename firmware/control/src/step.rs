@@ -26,7 +26,7 @@ use crate::feedforward::{FeedForwardConfig, dc_link_gain, effective_dc_link};
 use crate::modulation::{compare_values, thpwm};
 use crate::pi::{CurrentPiConfig, CurrentPiState, VoltageLimit, limit_voltage};
 use crate::torque::{TorqueConfig, TorqueState};
-use crate::transforms::{AlphaBeta, Dq, INV_SQRT_3, inverse_park, park};
+use crate::transforms::{AlphaBeta, Dq, INV_SQRT_3, Uvw, inverse_park, park};
 use crate::trig::Trig;
 
 /// Everything the current-control step needs; plain data so a code generator can
@@ -163,6 +163,8 @@ pub struct StepOutput {
     pub omega_e: f32,
     /// Measured currents in dq at θ_e \[A\].
     pub i_dq: Dq,
+    /// Measured phase currents \[A\] (w from (2.1) with two measured phases).
+    pub i_uvw: Uvw,
     /// Applied (limited) voltage in dq \[V\], in the frame of the lead angle.
     pub u_dq: Dq,
     /// Applied voltage in αβ \[V\].
@@ -219,7 +221,8 @@ impl ControllerConfig {
         let u_dc_eff = effective_dc_link(u_dc, self.dc_link_min);
         let inv_u_dc = dc_link_gain(u_dc, self.dc_link_min);
         let v_max = self.voltage_margin * u_dc_eff * INV_SQRT_3;
-        let i_ab = self.current_sense.alpha_beta(sample.phase_currents);
+        let i_uvw = self.current_sense.currents(sample.phase_currents);
+        let i_ab = self.current_sense.alpha_beta_of(i_uvw);
 
         let omega_e = speed_to_rad_per_s(omega_e_i, self.speed_per_lsb);
 
@@ -309,6 +312,7 @@ impl ControllerConfig {
             theta_e,
             omega_e,
             i_dq,
+            i_uvw,
             u_dq,
             u_alpha_beta: u_ab,
             u_dc,

@@ -18,6 +18,7 @@ use super::Source::{Custom, F32};
 use super::Text::{Lit, Of};
 use super::{Decl, Group, Json, Value, declare, intv, phys};
 use crate::board::Board;
+use crate::design::BoardOut;
 use crate::design::Design;
 
 /// Standard identifier of the fault report, a choice of the firmware: low (high
@@ -261,9 +262,16 @@ pub fn group(d: &Design) -> Option<Group> {
 /// 32 KiB of the STM32G474's 128 KiB SRAM (DS12288 §3.5).
 pub const CAPTURE_CAPACITY: u32 = 4096;
 
+/// R accepted by the pre-flight check in [R/ρ, R·ρ].
+pub const PREFLIGHT_RESISTANCE_RATIO: f64 = 2.0;
+/// L accepted by the pre-flight check in [L_d/ρ, L_d·ρ].
+pub const PREFLIGHT_INDUCTANCE_RATIO: f64 = 2.0;
+
 /// What the commissioning entries read.
 struct Commissioning<'a> {
     d: &'a Design,
+    /// The board's values with this motor.
+    b: &'a BoardOut,
     /// T_s \[s\].
     ts: f64,
     /// τ = max(L_d, L_q)/R \[s\].
@@ -372,6 +380,169 @@ impl<'a> Commissioning<'a> {
             json: Json::None,
         },
         Decl {
+            name: "PREFLIGHT_CURRENT",
+            value: F32(|c| c.preflight_current(), "A"),
+            formula: Lit(
+                "I_p = ¼·min(rated amplitude, over-current trip): the pre-flight pulses' and rotation's current — well inside the rating and the board's trip, large against the sensing's quantisation",
+            ),
+            equation: Lit("issue 26 item 2"),
+            inputs: Of(|c| c.rating_in()),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_VOLTAGE",
+            value: F32(|c| c.d.motor.phase_resistance_ohm * c.preflight_current(), "V"),
+            formula: Lit("V = R·I_p: the pulses' second level (the first is V/2) and the rotation's αβ voltage"),
+            equation: Lit("thesis A (6.3)"),
+            inputs: Of(|c| format!("R = {}, {}", phys(c.d.motor.phase_resistance_ohm, "Ω"), c.rating_in())),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_LEVEL_SAMPLES",
+            value: Custom(|c| c.samples(c.level_periods())),
+            formula: Lit("⌈max(8·τ, 2 ms)/T_s⌉, τ = max(L_d, L_q)/R: each pulse level settles to e⁻⁸"),
+            equation: Lit("thesis A (6.4)"),
+            inputs: Of(|c| c.tau_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_REST_SAMPLES",
+            value: Custom(|c| c.samples(c.level_periods())),
+            formula: Lit("as a level: the current decays to e⁻⁸ at 0 V before the next pulse"),
+            equation: Lit("thesis A (6.4)"),
+            inputs: Of(|c| c.tau_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_AVERAGE_SAMPLES",
+            value: Custom(|c| c.samples((c.level_periods() / 10.0).ceil().max(1.0))),
+            formula: Lit("⌈levels/10⌉: the last tenth of a level (and of the rotation's end hold) averaged"),
+            equation: Lit("—"),
+            inputs: Of(|c| c.tau_in.clone()),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_RESISTANCE_RATIO",
+            value: F32(|_| PREFLIGHT_RESISTANCE_RATIO, ""),
+            formula: Lit(
+                "R accepted in [R/2, 2·R]: copper from −40 to +180 °C is 0.76…1.63 of R at 20 °C (thesis B (2.24)), plus leads and switches; a wrong motor, a wrong sensing gain or a bad connection is outside",
+            ),
+            equation: Lit("thesis B (2.24)"),
+            inputs: Lit("—"),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_INDUCTANCE_RATIO",
+            value: F32(|_| PREFLIGHT_INDUCTANCE_RATIO, ""),
+            formula: Lit(
+                "L accepted in [L_d/2, 2·L_d]: saturation and the d/q difference stay inside; a wrong motor or a sensing whose bandwidth or gain is wrong does not",
+            ),
+            equation: Lit("thesis A (6.8)"),
+            inputs: Lit("—"),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_CURRENT_TRIP",
+            value: F32(|c| 1.2 * PREFLIGHT_RESISTANCE_RATIO * c.preflight_current(), "A"),
+            formula: Lit(
+                "1.2·ρ_R·I_p: 20 % above what the lowest accepted R draws at V; ends the check (R out of bound)",
+            ),
+            equation: Lit("—"),
+            inputs: Of(|c| c.rating_in()),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_SUM_BOUND",
+            value: F32(|c| c.sum_bound(), "A"),
+            formula: Lit(
+                "0.1·I_p + 3 codes of a 12-bit conversion (0 with two measured phases: the third is computed from them): one phase's gain 10 % off, or an offset of that size, is refused",
+            ),
+            equation: Lit("thesis A (2.1)"),
+            inputs: Of(|c| {
+                format!(
+                    "{} phases measured, {} per 12-bit code",
+                    c.b.current_phases,
+                    phys(16.0 * c.b.amps_per_lsb.abs(), "A")
+                )
+            }),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_OPEN_FRACTION",
+            value: F32(|_| 0.5, ""),
+            formula: Lit(
+                "a phase must carry ½ of its expected current (of the least the rotation draws; of its share cos(θ − 2πk/3) of a pulse within 60° of its axis)",
+            ),
+            equation: Lit("thesis A (2.7)"),
+            inputs: Lit("—"),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_TAU_OFFSET",
+            value: F32(|c| c.b.loop_delay_s + 0.5 * c.ts, "s"),
+            formula: Lit(
+                "loop delay + T_s/2: the rise's area from the sample of the period that computed the step (a left-rectangle sum) is (delay + τ + T_s/2)·ΔI",
+            ),
+            equation: Lit("thesis A §4.6"),
+            inputs: Of(|c| format!("loop delay {}, {}", phys(c.b.loop_delay_s, "s"), c.ts_in)),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_RESISTANCE",
+            value: F32(|c| c.d.motor.phase_resistance_ohm, "Ω"),
+            formula: Lit("the spec's phase resistance R, the pre-flight check's reference"),
+            equation: Lit("thesis A (6.3)"),
+            inputs: Lit("motor.phase_resistance"),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_INDUCTANCE",
+            value: F32(|c| c.d.motor.d_inductance_h, "H"),
+            formula: Lit("the spec's L_d: the pulses are on the d axis"),
+            equation: Lit("thesis A (6.8)"),
+            inputs: Lit("motor.d_inductance"),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_RATIO",
+            value: F32(
+                |c| {
+                    let o = &c.d.angle_observer;
+                    f64::from(o.motor_pole_pairs) / f64::from(o.resolver_pole_pairs.max(1))
+                },
+                "",
+            ),
+            formula: Lit("n_p/n_r: electrical turns per resolver turn the rotation must show"),
+            equation: Lit("thesis A (4.5), (6.2)"),
+            inputs: Of(|c| {
+                let o = &c.d.angle_observer;
+                format!("n_p = {}, n_r = {}", o.motor_pole_pairs, o.resolver_pole_pairs)
+            }),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_RATIO_BOUND",
+            value: F32(|c| 0.5 / f64::from(c.d.angle_observer.resolver_pole_pairs.max(1)), ""),
+            formula: Lit("0.5/n_r: half-way to the neighbouring pole-pair counts (n_p ± 1)/n_r"),
+            equation: Lit("thesis A (4.5), (6.2)"),
+            inputs: Of(|c| format!("n_r = {}", c.d.angle_observer.resolver_pole_pairs)),
+            json: Json::None,
+        },
+        Decl {
+            name: "PREFLIGHT_ANGLE_BOUND",
+            value: Custom(|_| {
+                // 30° electrical = π/6 in π-scaled Q1.31: 2^31/6.
+                let bound = (2_147_483_648.0f64 / 6.0).round() as i64;
+                (intv(bound, "i32", "int32_t"), format!("{bound} LSB (30° electrical)"))
+            }),
+            formula: Lit(
+                "30° electrical: a resolver offset off by more costs over 13 % of the torque per ampere (1 − cos 30°) and sets a field-weakening current on q",
+            ),
+            equation: Lit("thesis A (4.5)"),
+            inputs: Lit("—"),
+            json: Json::None,
+        },
+        Decl {
             name: "FLUX_SETTLE_SAMPLES",
             value: Custom(|c| c.samples(c.periods(0.2))),
             formula: Lit("⌈200 ms/T_s⌉: the current loop settles at i = 0"),
@@ -442,6 +613,45 @@ impl<'a> Commissioning<'a> {
             intv(periods as i64, "u32", "uint32_t"),
             format!("{periods} periods ({})", phys(periods * self.ts, "s")),
         )
+    }
+
+    /// The pre-flight current I_p = ¼·min(rated amplitude, over-current trip) \[A\].
+    fn preflight_current(&self) -> f64 {
+        0.25 * self.rated_amplitude().min(self.b.trips.over_current_a.value)
+    }
+
+    /// The rating's amplitude: √2·I_n, else √2·I_peak \[A\].
+    fn rated_amplitude(&self) -> f64 {
+        let m = &self.d.motor;
+        std::f64::consts::SQRT_2 * m.nominal_current_a_rms.unwrap_or(m.peak_current_a_rms)
+    }
+
+    /// The rating and the trip as inputs.
+    fn rating_in(&self) -> String {
+        format!(
+            "rated amplitude {} ({}), over-current trip {}",
+            phys(self.rated_amplitude(), "A"),
+            if self.d.motor.nominal_current_a_rms.is_some() {
+                "√2·nominal_current"
+            } else {
+                "√2·peak_current"
+            },
+            phys(self.b.trips.over_current_a.value, "A")
+        )
+    }
+
+    /// Periods of a pulse level: ⌈max(8·τ, 2 ms)/T_s⌉.
+    fn level_periods(&self) -> f64 {
+        self.periods((8.0 * self.tau).max(2e-3))
+    }
+
+    /// |i_u + i_v + i_w| accepted \[A\] (0: two measured phases).
+    fn sum_bound(&self) -> f64 {
+        if self.b.current_phases < 3 {
+            0.0
+        } else {
+            0.1 * self.preflight_current() + 3.0 * 16.0 * self.b.amps_per_lsb.abs()
+        }
     }
 
     /// ω_e,max as an input.
@@ -574,13 +784,14 @@ pub fn injection_limit(d: &Design) -> Option<InjectionLimit> {
 /// command starts (the command gives voltage, trip and decimation), emitted with the
 /// CAN interface (only for a design on a board).
 pub fn commissioning_group(d: &Design) -> Option<Group> {
-    d.board.as_ref()?;
+    let b = d.board.as_ref()?;
     let m = &d.motor;
     let ts = d.drive.sample_period_s;
     let tau = m.d_inductance_h.max(m.q_inductance_h) / m.phase_resistance_ohm;
     let ts_in = format!("T_s = {} (drive.switching_frequency)", phys(ts, "s"));
     let commissioning = Commissioning {
         d,
+        b,
         ts,
         tau,
         tau_in: format!("τ = {}, {ts_in}", phys(tau, "s")),

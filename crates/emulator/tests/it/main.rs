@@ -9,6 +9,7 @@ mod closed_loop;
 mod defects;
 mod first_power_up;
 mod frequency_response;
+mod preflight;
 mod protection;
 
 /// Upper bound for the bring-up \[s\]: the ADC regulator's 2 × 20 µs, a calibration each,

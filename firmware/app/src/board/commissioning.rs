@@ -12,6 +12,7 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use cortex_m::interrupt::{self, Mutex};
 use motor_control::can_protocol::decode_command;
 use motor_control::commissioning_mode::{Control, Guards, Measured, Sample, prepare};
+use motor_control::preflight::PreflightFault;
 use motor_control::{Demand, Trig};
 
 use super::can::Can;
@@ -84,7 +85,8 @@ pub fn transmit(tx: &mut Can, ticks: u32, last_status: &mut u32) {
 }
 
 /// Control interrupt: one period of the supervisor. `normal` is the torque demand;
-/// returns the demand to run and whether the outputs may be on.
+/// returns the demand to run, whether the outputs may be on, and the pre-flight check's
+/// refusal when it refused the drive this period (the caller trips with its cause).
 pub fn control_step<T: Trig>(
     trig: &mut T,
     measured: &Measured,
@@ -92,24 +94,27 @@ pub fn control_step<T: Trig>(
     omega_e: f32,
     normal: Demand,
     run: bool,
-) -> (Demand, bool) {
+) -> (Demand, bool, Option<PreflightFault>) {
     OMEGA_E.store(omega_e.to_bits(), Ordering::Relaxed);
     FAULT.store(guards.fault, Ordering::Relaxed);
     TIMED_OUT.store(guards.setpoint_timeout, Ordering::Relaxed);
     BREAK.store(guards.break_active, Ordering::Relaxed);
-    let control = interrupt::free(|cs| {
+    let (control, refused) = interrupt::free(|cs| {
         match (
             SUPERVISOR.borrow(cs).try_borrow_mut(),
             BUFFER.borrow(cs).try_borrow_mut(),
         ) {
-            (Ok(mut m), Ok(mut buffer)) => m.step(&MODE, guards, measured, trig, &mut buffer[..]),
+            (Ok(mut m), Ok(mut buffer)) => {
+                let c = m.step(&MODE, guards, measured, trig, &mut buffer[..]);
+                (c, m.take_refusal())
+            }
             // Never happens (every borrow is inside a critical section); outputs off.
-            _ => Control::Off,
+            _ => (Control::Off, None),
         }
     });
     match control {
-        Control::Normal => (normal, run),
-        Control::Demand(d) => (d, !guards.fault),
-        Control::Off => (Demand::Off, false),
+        Control::Normal => (normal, run, refused),
+        Control::Demand(d) => (d, !guards.fault, refused),
+        Control::Off => (Demand::Off, false, refused),
     }
 }

@@ -10,6 +10,10 @@
 //! Meanwhile the step runs with [`Demand::Off`] (the angle observer locks on) and a
 //! commissioning routine sees a fault.
 //!
+//! The pre-flight check (CAN routine 6) runs through the commissioning mode like the
+//! chapter-6 routines; a refusal trips the drive here with its own cause (11–18,
+//! `FaultCause::from(PreflightFault)`): outputs off until reset, the record sealed.
+//!
 //! Order: read and acknowledge the conversions; trip on the board's levels
 //! ([`crate::config::TRIPS`]: a phase current beyond the over-current level or at the
 //! converter's rail, the DC link beyond the over-voltage level, the last period's
@@ -122,6 +126,8 @@ impl Control {
                 omega_e: 0.0,
                 u_q: 0.0,
                 u_d: 0.0,
+                theta_e: 0,
+                i_uvw: motor_control::transforms::Uvw { u: 0.0, v: 0.0, w: 0.0 },
             },
             calibration: OffsetCalibration::new(),
             zero: None,
@@ -189,8 +195,13 @@ impl Control {
             break_active: pwm::Break(&self.tim1).break_flag(),
             setpoint_timeout: self.setpoint.timed_out(&SETPOINT),
         };
-        let (demand, run) =
+        let (demand, run, refused) =
             commissioning::control_step(&mut self.cordic, &self.measured, &guards, self.omega_e, normal, run);
+        // The pre-flight check refused the drive: outputs off until reset, its cause
+        // (11–18) in the fault record.
+        if let Some(f) = refused {
+            self.trip(FaultCause::from(f));
+        }
         let (demand, run) = if calibrating {
             (Demand::Off, false)
         } else {
@@ -203,6 +214,8 @@ impl Control {
             omega_e: out.omega_e,
             u_q: out.u_dq.q,
             u_d: out.u_dq.d,
+            theta_e: out.theta_e,
+            i_uvw: out.i_uvw,
         };
         self.omega_e = out.omega_e;
         pwm::set_compare(&self.tim1, out.compare);

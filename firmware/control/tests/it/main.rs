@@ -4,3 +4,4 @@
 mod closed_loop;
 mod commissioning;
 mod common;
+mod preflight;
