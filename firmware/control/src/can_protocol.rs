@@ -616,16 +616,16 @@ mod tests {
             decode_status(&l, 0x101, f.bytes()),
             Some((State::Idle, Reason::TorqueNotZero, 1, 0))
         );
-        assert_eq!(decode_status(&l, 0x101, &[4, 9, 0, 0]), None);
+        assert_eq!(decode_status(&l, 0x101, &[4, 10, 0, 0]), None);
         assert_eq!(decode_status(&l, 0x102, f.bytes()), None);
         // Every state and reason survives the trip through its code.
-        for code in 0..=8u8 {
+        for code in 0..=9u8 {
             assert_eq!(Reason::from_code(code).map(|r| r as u8), Some(code));
         }
         for code in 0..=4u8 {
             assert_eq!(State::from_code(code).map(|s| s as u8), Some(code));
         }
-        assert_eq!((State::from_code(5), Reason::from_code(9)), (None, None));
+        assert_eq!((State::from_code(5), Reason::from_code(10)), (None, None));
     }
 
     /// Saturation and wrap: currents beyond ±327.67 A saturate, NaN is 0; an angle of
