@@ -40,7 +40,40 @@ pub fn board_source(file: &str, text: &str) -> Result<board::Board, Diagnostics>
 /// [`design::on_board`]).
 pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &str) -> Result<Design, Diagnostics> {
     let board = board_source(board_file, board_text);
-    let design = design_source(file, text);
+    // The motor is designed for the voltage the board's duty limit leaves it
+    // (`design::duty_limit`): its switching frequency and dead time with the board's
+    // sampling window.
+    let source = Source { file, text };
+    let design = spec::parse(source).and_then(|spec| {
+        let max_duty = board
+            .as_ref()
+            .ok()
+            .and_then(|b| {
+                let dead = spec
+                    .drive
+                    .dead_time
+                    .as_ref()
+                    .map_or(b.dead_time_s, |p| p.value.max(b.dead_time_s));
+                let l = design::duty_limit::for_board(b, spec.drive.switching_frequency.value, dead)?;
+                Some((l, spec.drive.switching_frequency.value))
+            });
+        // A window that leaves too little voltage is the board's error, before the
+        // motor's design fails for lack of voltage at a spec key.
+        if let (Some((l, fs)), Ok(b)) = (&max_duty, &board)
+            && let Some(e) = design::refuse_duty_limit(
+                b,
+                Source {
+                    file: board_file,
+                    text: board_text,
+                },
+                l,
+                *fs,
+            )
+        {
+            return Err(Diagnostics(vec![e]));
+        }
+        design::design_with_duty_limit(&spec, source, max_duty.map_or(1.0, |(l, _)| l.max_duty))
+    });
     let (board, design) = match (board, design) {
         (Ok(b), Ok(d)) => (b, d),
         (Err(mut a), Err(b)) => {
