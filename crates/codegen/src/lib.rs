@@ -45,18 +45,15 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
     // sampling window.
     let source = Source { file, text };
     let design = spec::parse(source).and_then(|spec| {
-        let max_duty = board
-            .as_ref()
-            .ok()
-            .and_then(|b| {
-                let dead = spec
-                    .drive
-                    .dead_time
-                    .as_ref()
-                    .map_or(b.dead_time_s, |p| p.value.max(b.dead_time_s));
-                let l = design::duty_limit::for_board(b, spec.drive.switching_frequency.value, dead)?;
-                Some((l, spec.drive.switching_frequency.value))
-            });
+        let max_duty = board.as_ref().ok().and_then(|b| {
+            let dead = spec
+                .drive
+                .dead_time
+                .as_ref()
+                .map_or(b.dead_time_s, |p| p.value.max(b.dead_time_s));
+            let l = design::duty_limit::for_board(b, spec.drive.switching_frequency.value, dead)?;
+            Some((l, spec.drive.switching_frequency.value))
+        });
         // A window that leaves too little voltage is the board's error, before the
         // motor's design fails for lack of voltage at a spec key.
         if let (Some((l, fs)), Ok(b)) = (&max_duty, &board)

@@ -200,6 +200,12 @@ pub struct Soc {
     bridge_armed: bool,
     /// The switches as last analysed.
     pub switches: Option<[LegSwitches; 3]>,
+    /// The analysis before that: the carrier period before the last update event, whose
+    /// tail holds the low-side turn-on a sampling at the update's carrier extreme
+    /// follows ([`Soc::sampling_window`]).
+    pub previous_switches: Option<[LegSwitches; 3]>,
+    /// Whether `switches` was analysed with MOE = 1.
+    switches_enabled: bool,
     /// The core executed WFI and sleeps until an enabled interrupt is pending (ARMv7-M
     /// B1.5.18: WFI suspends execution until a wake-up event; an interrupt wakes it even
     /// while PRIMASK masks it). The harness skips the time in between.
@@ -322,6 +328,8 @@ impl Soc {
             sr_in_irq: None,
             bridge_armed: false,
             switches: None,
+            previous_switches: None,
+            switches_enabled: false,
             sleeping: false,
             wfi_at: None,
         };
@@ -562,7 +570,12 @@ impl Soc {
         } else {
             None
         };
-        self.switches = Some(legs);
+        // The previous period counts only when the bridge switched in it too (MOE = 1 in
+        // both analyses): the first period after enabling has no low-side history.
+        let moe = self.tim1.moe();
+        let previous = self.switches.replace(legs);
+        self.previous_switches = previous.filter(|_| moe && self.switches_enabled);
+        self.switches_enabled = moe;
         duties
     }
 
@@ -1116,38 +1129,60 @@ impl Soc {
         if !self.tim1.moe() {
             return None;
         }
-        let legs = self.switches.as_ref()?;
-        let low = &legs[phase].low;
-        let (a, b) = (self.tim1.window_phase_s(sampling.0)?, self.tim1.window_phase_s(sampling.1)?);
+        // Not checked in the first period after the outputs were enabled (no previous
+        // switching period to hold the low side's turn-on).
+        let previous = self.previous_switches.as_ref()?;
+        let now = &self.switches.as_ref()?[phase].low;
+        let len = now.len;
+        let (a, b) = (
+            self.tim1.window_phase_s(sampling.0)?,
+            self.tim1.window_phase_s(sampling.1)?,
+        );
+        // The low side over the period before the last update (shifted to [−len, 0))
+        // and this one, intervals meeting at the update joined: a sampling that starts
+        // before the update (b < a) starts in the previous period.
+        let mut iv: Vec<(f64, f64)> = previous[phase]
+            .low
+            .high
+            .iter()
+            .map(|&(x, y)| (x - len, y - len))
+            .collect();
+        let eps = 1e-12;
+        for &(x, y) in &now.high {
+            match iv.last_mut() {
+                Some(last) if (last.1 - x).abs() <= eps => last.1 = y,
+                _ => iv.push((x, y)),
+            }
+        }
+        let a = if b < a { a - len } else { a };
         let leg = ["u", "v", "w"][phase];
         let cut = |what: String| {
             Some(Broken::new(
                 format!("{adc} channel {ch}"),
                 format!(
-                    "ADC sampling inside a switching edge: the phase {leg} current (low-side shunt) sampled from {:.1} to {:.1} ns into the carrier period, but {what} — the duty must leave the low side on around the sampling for the settling time and the sampling (the design's board::MAX_DUTY, codegen::design::duty_limit)",
+                    "ADC sampling inside a switching edge: the phase {leg} current (low-side shunt) sampled from {:.1} to {:.1} ns from the last update event, but {what} — the duty must leave the low side on around the sampling for the settling time and the sampling (the design's board::MAX_DUTY, codegen::design::duty_limit)",
                     a * 1e9,
                     b * 1e9
                 ),
             ))
         };
-        // The sampling wraps past the window's end: the window cannot hold it.
-        if b < a {
-            return cut("the sampling spans the update event".into());
-        }
-        let eps = 1e-12;
-        let Some(&(on, _)) = low.high.iter().find(|&&(on, off)| on <= a + eps && b <= off + eps) else {
-            let near = low
-                .high
+        let Some(&(on, _)) = iv.iter().find(|&&(on, off)| on <= a + eps && b <= off + eps) else {
+            let near = iv
                 .iter()
-                .map(|&(on, off)| format!("{:.1}–{:.1} ns", on * 1e9, off * 1e9))
+                .map(|&(on, off)| format!("{:.1}…{:.1} ns", on * 1e9, off * 1e9))
                 .collect::<Vec<_>>();
             return cut(format!(
                 "the {leg} low side is not on throughout (on {})",
-                if near.is_empty() { "never".to_string() } else { near.join(", ") }
+                if near.is_empty() {
+                    "never".to_string()
+                } else {
+                    near.join(", ")
+                }
             ));
         };
-        // An interval from the window's start continues from before it: no edge here.
-        if on > eps && a - on < settle - eps {
+        // An interval from the start of the analysed span continues from before it: no
+        // edge seen.
+        if on > -len + eps && a - on < settle - eps {
             return cut(format!(
                 "the {leg} low side switched on at {:.1} ns, only {:.1} ns before (settling {:.0} ns)",
                 on * 1e9,

@@ -84,7 +84,11 @@ pub fn limit_phase_peak(phase: Uvw, u_dc: f32, max_duty: f32) -> Uvw {
     if peak <= room {
         return phase;
     }
-    let k = if peak.is_finite() && room > 0.0 { room / peak } else { 0.0 };
+    let k = if peak.is_finite() && room > 0.0 {
+        room / peak
+    } else {
+        0.0
+    };
     let s = |x: f32| {
         let y = x * k;
         if y.is_finite() { y } else { 0.0 }
@@ -106,7 +110,13 @@ pub fn thpwm<T: Trig + ?Sized>(u: AlphaBeta, u_dc: f32, inv_u_dc: f32, trig: &mu
 /// [`thpwm`] with the duties limited to `max_duty` (and `1 − max_duty`) by scaling the
 /// phase voltages together ([`limit_phase_peak`]), then each duty saturated to
 /// \[0, `max_duty`\] against rounding.
-pub fn thpwm_limited<T: Trig + ?Sized>(u: AlphaBeta, u_dc: f32, inv_u_dc: f32, max_duty: f32, trig: &mut T) -> [f32; 3] {
+pub fn thpwm_limited<T: Trig + ?Sized>(
+    u: AlphaBeta,
+    u_dc: f32,
+    inv_u_dc: f32,
+    max_duty: f32,
+    trig: &mut T,
+) -> [f32; 3] {
     let phase = limit_phase_peak(phase_voltages(u, u_dc, trig), u_dc, max_duty);
     duties(phase, inv_u_dc).map(|d| if d > max_duty { max_duty } else { d })
 }
@@ -283,12 +293,27 @@ mod tests {
     /// 0.5 + 19.2/48 = 0.9 and 0.5 − 9.6/48 = 0.3.
     #[test]
     fn duty_limit_by_hand() {
-        let p = limit_phase_peak(Uvw { u: 24.0, v: -12.0, w: -12.0 }, 48.0, 0.9);
-        assert!((p.u - 19.2).abs() < 1e-5 && (p.v + 9.6).abs() < 1e-5 && (p.w + 9.6).abs() < 1e-5, "{p:?}");
+        let p = limit_phase_peak(
+            Uvw {
+                u: 24.0,
+                v: -12.0,
+                w: -12.0,
+            },
+            48.0,
+            0.9,
+        );
+        assert!(
+            (p.u - 19.2).abs() < 1e-5 && (p.v + 9.6).abs() < 1e-5 && (p.w + 9.6).abs() < 1e-5,
+            "{p:?}"
+        );
         let d = duties(p, 1.0 / 48.0);
         assert!((d[0] - 0.9).abs() < 1e-6 && (d[1] - 0.3).abs() < 1e-6, "{d:?}");
         // Within the room: unchanged.
-        let q = Uvw { u: 10.0, v: -5.0, w: -5.0 };
+        let q = Uvw {
+            u: 10.0,
+            v: -5.0,
+            w: -5.0,
+        };
         assert_eq!(limit_phase_peak(q, 48.0, 0.9), q);
     }
 

@@ -131,7 +131,10 @@ pub(super) fn resolve(
         cx.err(
             t.span.clone(),
             "current_sensing.settling_time",
-            format!("a settling time of {} s is not one a current-sensing stage has", t.value),
+            format!(
+                "a settling time of {} s is not one a current-sensing stage has",
+                t.value
+            ),
             "a time from 0 up to below 100 µs, e.g. settling_time = \"1 µs\"",
         );
     }

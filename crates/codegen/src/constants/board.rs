@@ -482,7 +482,10 @@ impl<'a> OnBoard<'a> {
             name: "MAX_COMPARE",
             value: Custom(|c| {
                 let l = &c.o.duty_limit;
-                (intv(l.max_compare.into(), "u16", "uint16_t"), format!("ticks of ARR {}", c.d.drive.pwm_period))
+                (
+                    intv(l.max_compare.into(), "u16", "uint16_t"),
+                    format!("ticks of ARR {}", c.d.drive.pwm_period),
+                )
             }),
             formula: Lit("ARR − ⌈h·f_TIM⌉: the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h"),
             equation: Lit("RM0440 §29.3.10 (centre-aligned PWM); design::duty_limit"),

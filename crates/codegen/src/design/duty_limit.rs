@@ -276,8 +276,20 @@ mod tests {
         let c = 1.0 / 42.5e6;
         let tick = 1.0 / 170e6;
         let ranks = [
-            CurrentRank { adc: 1, rank: 1, phase: 0, start_s: 0.0, end_s: 27.625 * c },
-            CurrentRank { adc: 1, rank: 2, phase: 1, start_s: 37.0 * c, end_s: 64.625 * c },
+            CurrentRank {
+                adc: 1,
+                rank: 1,
+                phase: 0,
+                start_s: 0.0,
+                end_s: 27.625 * c,
+            },
+            CurrentRank {
+                adc: 1,
+                rank: 2,
+                phase: 1,
+                start_s: 37.0 * c,
+                end_s: 64.625 * c,
+            },
         ];
         let (h, bound) = half_window(&ranks, 500e-9, 1e-6, tick);
         assert!((h - 1514.71e-9).abs() < 0.01e-9, "{h}");

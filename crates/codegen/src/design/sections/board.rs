@@ -405,7 +405,10 @@ pub(in crate::design) fn board(
             );
         }
     }
-    let dead_s = d.drive.dead_time_s.map_or(board.dead_time_s, |spec| spec.max(board.dead_time_s));
+    let dead_s = d
+        .drive
+        .dead_time_s
+        .map_or(board.dead_time_s, |spec| spec.max(board.dead_time_s));
     let limit = duty_limit::for_board(board, d.drive.switching_frequency_hz, dead_s);
     if let Some(l) = &limit
         && let Some(e) = refuse_duty_limit(board, board_src, l, d.drive.switching_frequency_hz)
@@ -438,7 +441,8 @@ pub(in crate::design) fn board(
         Signal::CanRx,
         Signal::CanTx,
     ];
-    let (Some(can_timing), Some(timing), Some(duty_limit), true) = (can_timing, timing, limit, errors.is_empty()) else {
+    let (Some(can_timing), Some(timing), Some(duty_limit), true) = (can_timing, timing, limit, errors.is_empty())
+    else {
         return Err(errors);
     };
     let trips = trips(board, d);
@@ -505,12 +509,7 @@ pub const MIN_USABLE_VOLTAGE_FRACTION: f64 = 0.5;
 /// U_dc/√3, at the board key of the condition that set it (the settling time, or the
 /// dead time where it is the larger part, or the current inputs' sampling time), with
 /// the switching frequency that would leave enough.
-pub fn refuse_duty_limit(
-    board: &Board,
-    board_src: Source<'_>,
-    l: &DutyLimit,
-    fs_hz: f64,
-) -> Option<Diagnostic> {
+pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs_hz: f64) -> Option<Diagnostic> {
     if l.usable_voltage_fraction >= MIN_USABLE_VOLTAGE_FRACTION {
         return None;
     }
