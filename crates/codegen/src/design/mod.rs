@@ -36,7 +36,9 @@ use crate::spec::Spec;
 use sections::Context;
 pub use sections::adc::AdcOut;
 pub use sections::angle_observer::ObserverOut;
-pub use sections::board::{BoardOut, MIN_USABLE_VOLTAGE_FRACTION, Trip, TripSource, Trips, refuse_duty_limit};
+pub use sections::board::{
+    BoardOut, MIN_USABLE_VOLTAGE_FRACTION, Trip, TripSource, Trips, duty_limit_key, refuse_duty_limit,
+};
 pub use sections::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
 pub use sections::drive::DriveOut;
 pub use sections::motor::{MotorOut, Origin};

@@ -505,6 +505,17 @@ pub(in crate::design) fn board(
 /// it the field-weakening gain grows without bound, thesis B (2.60).)
 pub const MIN_USABLE_VOLTAGE_FRACTION: f64 = 0.5;
 
+/// The board key of the condition that set a duty limit: the settling time, or the
+/// dead time where it is the larger part of the settling condition, or the current
+/// inputs' sampling time.
+pub fn duty_limit_key(l: &DutyLimit) -> &'static str {
+    match l.bound {
+        DutyBound::Settling if l.dead_time_s > l.settling_time_s => "pwm.dead_time",
+        DutyBound::Settling => "current_sensing.settling_time",
+        DutyBound::SamplingEnd | DutyBound::None => "sensing.source_resistance.current",
+    }
+}
+
 /// The refusal of a duty limit that leaves less than [`MIN_USABLE_VOLTAGE_FRACTION`] of
 /// U_dc/√3, at the board key of the condition that set it (the settling time, or the
 /// dead time where it is the larger part, or the current inputs' sampling time), with
@@ -516,11 +527,7 @@ pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs
     // d_floor: the duty whose usable fraction is the floor; T_s ≥ 2h/(1 − d_floor).
     let d_floor = 0.5 + duty_limit::thpwm_phase_peak(MIN_USABLE_VOLTAGE_FRACTION);
     let fs_max = (1.0 - d_floor) / (2.0 * l.half_window_s);
-    let key = match l.bound {
-        DutyBound::Settling if l.dead_time_s > l.settling_time_s => "pwm.dead_time",
-        DutyBound::Settling => "current_sensing.settling_time",
-        DutyBound::SamplingEnd | DutyBound::None => "sensing.source_resistance.current",
-    };
+    let key = duty_limit_key(l);
     Some(board_src.error(
         board.span(key),
         key,
