@@ -1099,7 +1099,7 @@ impl Soc {
                 }
                 if let crate::hardware::Analog::Current(phase) = input.signal {
                     let sampling = (at - crate::periph::adc::SAR_CYCLES * clk - sampled, at - crate::periph::adc::SAR_CYCLES * clk);
-                    currents.push((ch, usize::from(phase), sampling));
+                    currents.push((ch, phase, sampling));
                 }
                 let v = analog.volts(input.signal, at, tim3.output((at * UNITS_PER_S) as u64));
                 // Ideal 12-bit conversion: code = V/V_REF·4096, clamped (RM0440 §21.4.1).
