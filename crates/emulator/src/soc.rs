@@ -202,7 +202,7 @@ pub struct Soc {
     pub switches: Option<[LegSwitches; 3]>,
     /// The analysis before that: the carrier period before the last update event, whose
     /// tail holds the low-side turn-on a sampling at the update's carrier extreme
-    /// follows ([`Soc::sampling_window`]).
+    /// follows (the rule "ADC sampling inside a switching edge").
     pub previous_switches: Option<[LegSwitches; 3]>,
     /// Whether `switches` was analysed with MOE = 1.
     switches_enabled: bool,
