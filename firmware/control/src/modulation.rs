@@ -79,7 +79,16 @@ pub fn duties(phase: Uvw, inv_u_dc: f32) -> [f32; 3] {
 /// `(max_duty − 1/2)·u_dc` (module documentation): unchanged within it; the vector's
 /// angle kept beyond it. A non-finite peak gives zeros (the duties then 1/2).
 pub fn limit_phase_peak(phase: Uvw, u_dc: f32, max_duty: f32) -> Uvw {
-    let peak = phase.u.abs().max(phase.v.abs()).max(phase.w.abs());
+    // Comparisons, not `f32::max` (a libm call on the Cortex-M4, whose FPU has no
+    // VMAXNM): a NaN phase leaves the peak finite here and its duty saturates to 0.
+    let (av, aw) = (phase.v.abs(), phase.w.abs());
+    let mut peak = phase.u.abs();
+    if av > peak {
+        peak = av;
+    }
+    if aw > peak {
+        peak = aw;
+    }
     let room = (max_duty - 0.5) * u_dc;
     if peak <= room {
         return phase;
