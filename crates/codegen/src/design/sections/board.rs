@@ -12,7 +12,10 @@
 //! image trips at the lower of the motor's limit and the board's ceiling ([`Trips`]), the
 //! motor's limits being the full scales of its design (the spec's `[scaling] margin` over
 //! its peak current, DC link and maximum speed, thesis A Table 4.1). Conversions that
-//! take more than a quarter of the control period are a warning.
+//! take more than a quarter of the control period are a warning. The duty limit of the
+//! current sensing's sampling window (`design::duty_limit`) is carried here; a window
+//! that leaves less than [`MIN_USABLE_VOLTAGE_FRACTION`] of U_dc/√3 is refused at the
+//! board key that set it.
 
 use serde::Serialize;
 
