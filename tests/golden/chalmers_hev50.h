@@ -192,8 +192,8 @@ static const float CHALMERS_HEV50_LIMITS_SWITCHING_FREQUENCY_HZ = 10000.0f;
  *  Inputs: f_s = 10000 Hz (spec). */
 static const float CHALMERS_HEV50_LIMITS_SAMPLE_PERIOD_S = 0.0001f;
 
-/** 184.752 V: U_dc/√3 (voltage circle), thesis B (2.50).
- *  Inputs: U_dc = 320 V (spec). */
+/** 184.752 V: k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board or with in-line sensing), thesis B (2.50); design::duty_limit.
+ *  Inputs: U_dc = 320 V (spec), k = 1. */
 static const float CHALMERS_HEV50_LIMITS_VOLTAGE_LIMIT_V = 184.75209f;
 
 /** 320 V: lowest U_dc for the 1/U_dc feed-forward (5.1), thesis A (5.1).
@@ -222,8 +222,8 @@ static const float CHALMERS_HEV50_LIMITS_MAX_ELECTRICAL_SPEED = 2513.2742f;
  *  Inputs: V'_max/V_max = 0.9. */
 static const float CHALMERS_HEV50_FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
 
-/** 166.277 V: V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
- *  Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 184.752 V (U_dc = 320 V, spec). */
+/** 166.277 V: V'_max = fraction·V_max, V_max = k·U_dc/√3 the usable voltage at the nominal U_dc (k from the board's duty limit, 1 without one; the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
+ *  Inputs: V'_max/V_max = 0.9, V_max = k·U_dc/√3 = 184.752 V (U_dc = 320 V, spec). */
 static const float CHALMERS_HEV50_FIELD_WEAKENING_VOLTAGE_LIMIT_V = 166.27687f;
 
 /** 147 rad/s: α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c, thesis B (2.60), §2.3.3.

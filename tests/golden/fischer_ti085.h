@@ -192,8 +192,8 @@ static const float FISCHER_TI085_LIMITS_SWITCHING_FREQUENCY_HZ = 20000.0f;
  *  Inputs: f_s = 20000 Hz (spec). */
 static const float FISCHER_TI085_LIMITS_SAMPLE_PERIOD_S = 5e-5f;
 
-/** 346.41 V: U_dc/√3 (voltage circle), thesis B (2.50).
- *  Inputs: U_dc = 600 V (spec). */
+/** 346.41 V: k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board or with in-line sensing), thesis B (2.50); design::duty_limit.
+ *  Inputs: U_dc = 600 V (spec), k = 1. */
 static const float FISCHER_TI085_LIMITS_VOLTAGE_LIMIT_V = 346.41016f;
 
 /** 432 V: lowest U_dc for the 1/U_dc feed-forward (5.1), thesis A (5.1).
@@ -222,8 +222,8 @@ static const float FISCHER_TI085_LIMITS_MAX_ELECTRICAL_SPEED = 8377.58f;
  *  Inputs: V'_max/V_max = 0.9. */
 static const float FISCHER_TI085_FIELD_WEAKENING_VOLTAGE_FRACTION = 0.9f;
 
-/** 311.769 V: V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
- *  Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 346.41 V (U_dc = 600 V, spec). */
+/** 311.769 V: V'_max = fraction·V_max, V_max = k·U_dc/√3 the usable voltage at the nominal U_dc (k from the board's duty limit, 1 without one; the firmware rescales with the measured U_dc), thesis B (2.51), (2.55).
+ *  Inputs: V'_max/V_max = 0.9, V_max = k·U_dc/√3 = 346.41 V (U_dc = 600 V, spec). */
 static const float FISCHER_TI085_FIELD_WEAKENING_VOLTAGE_LIMIT_V = 311.76913f;
 
 /** 10 rad/s: α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c, thesis B (2.60), §2.3.3.

@@ -195,9 +195,9 @@ pub mod limits {
     ///
     /// Inputs: f_s = 20000 Hz (spec).
     pub const SAMPLE_PERIOD_S: f32 = 5e-5;
-    /// 346.41 V: `U_dc/√3 (voltage circle)`, thesis B (2.50).
+    /// 346.41 V: `k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board or with in-line sensing)`, thesis B (2.50); design::duty_limit.
     ///
-    /// Inputs: U_dc = 600 V (spec).
+    /// Inputs: U_dc = 600 V (spec), k = 1.
     pub const VOLTAGE_LIMIT_V: f32 = 346.41016;
     /// 432 V: `lowest U_dc for the 1/U_dc feed-forward (5.1)`, thesis A (5.1).
     ///
@@ -227,9 +227,9 @@ pub mod field_weakening {
     ///
     /// Inputs: V'_max/V_max = 0.9.
     pub const VOLTAGE_FRACTION: f32 = 0.9;
-    /// 311.769 V: `V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc)`, thesis B (2.51), (2.55).
+    /// 311.769 V: `V'_max = fraction·V_max, V_max = k·U_dc/√3 the usable voltage at the nominal U_dc (k from the board's duty limit, 1 without one; the firmware rescales with the measured U_dc)`, thesis B (2.51), (2.55).
     ///
-    /// Inputs: V'_max/V_max = 0.9, V_max = U_dc/√3 = 346.41 V (U_dc = 600 V, spec).
+    /// Inputs: V'_max/V_max = 0.9, V_max = k·U_dc/√3 = 346.41 V (U_dc = 600 V, spec).
     pub const VOLTAGE_LIMIT_V: f32 = 311.76913;
     /// 10 rad/s: `α_fw: field-weakening pole at −α_fw (2.61), α_fw ≪ α_c`, thesis B (2.60), §2.3.3.
     ///

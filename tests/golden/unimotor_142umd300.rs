@@ -195,9 +195,9 @@ pub mod limits {
     ///
     /// Inputs: f_s = 20000 Hz (spec).
     pub const SAMPLE_PERIOD_S: f32 = 5e-5;
-    /// 346.41 V: `U_dc/√3 (voltage circle)`, thesis B (2.50).
+    /// 346.41 V: `k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board or with in-line sensing)`, thesis B (2.50); design::duty_limit.
     ///
-    /// Inputs: U_dc = 600 V (spec).
+    /// Inputs: U_dc = 600 V (spec), k = 1.
     pub const VOLTAGE_LIMIT_V: f32 = 346.41016;
     /// 600 V: `lowest U_dc for the 1/U_dc feed-forward (5.1)`, thesis A (5.1).
     ///

@@ -39,24 +39,69 @@ pub fn board_source(file: &str, text: &str) -> Result<board::Board, Diagnostics>
 /// constants and the checks that need both (warnings at the board key, see
 /// [`design::on_board`]).
 pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &str) -> Result<Design, Diagnostics> {
+    let board_src = Source {
+        file: board_file,
+        text: board_text,
+    };
     let board = board_source(board_file, board_text);
-    let design = design_source(file, text);
-    let (board, design) = match (board, design) {
-        (Ok(b), Ok(d)) => (b, d),
+    let source = Source { file, text };
+    let spec = spec::parse(source);
+    let (board, spec) = match (board, spec) {
+        (Ok(b), Ok(s)) => (b, s),
         (Err(mut a), Err(b)) => {
             a.0.extend(b.0);
             return Err(a);
         }
         (Err(e), _) | (_, Err(e)) => return Err(e),
     };
-    design::on_board(
-        design,
-        &board,
-        Source {
-            file: board_file,
-            text: board_text,
-        },
-    )
+    // The motor is designed for the voltage the board's duty limit leaves it
+    // (`design::duty_limit`): its switching frequency and dead time with the board's
+    // sampling window.
+    let fs = spec.drive.switching_frequency.value;
+    let dead = spec
+        .drive
+        .dead_time
+        .as_ref()
+        .map_or(board.dead_time_s, |p| p.value.max(board.dead_time_s));
+    let limit = design::duty_limit::for_board(&board, fs, dead);
+    // A window that leaves too little voltage is the board's error, before the motor's
+    // design fails for lack of voltage at a spec key.
+    if let Some(e) = limit
+        .as_ref()
+        .and_then(|l| design::refuse_duty_limit(&board, board_src, l, fs))
+    {
+        return Err(Diagnostics(vec![e]));
+    }
+    let max_duty = limit.as_ref().map_or(1.0, |l| l.max_duty);
+    match design::design_with_duty_limit(&spec, source, max_duty) {
+        Ok(d) => design::on_board(d, &board, board_src),
+        Err(e) if max_duty < 1.0 => {
+            // The motor fails with the voltage the board leaves it. Designed with the
+            // whole linear range: a motor that fails then too gets its own errors; one the
+            // board does not fit for other reasons (its sensing, ratings) gets those; one
+            // that only lacks the voltage gets the duty limit as the board's error, with
+            // the motor's rule as a note.
+            let alone = design::design(&spec, source)?;
+            design::on_board(alone, &board, board_src)?;
+            let l = limit.as_ref().expect("a duty limit below 1 comes from one");
+            let key = design::duty_limit_key(l);
+            let mut d = board_src.error(
+                board.span(key),
+                key,
+                format!(
+                    "the low-side shunts' sampling window limits the duty to {:.4} at f_s = {fs} Hz, which leaves {} ({file}) only {:.1} % of U_dc/√3 ({:.2} V): its design does not hold with that voltage (note)",
+                    l.max_duty,
+                    spec.name,
+                    l.usable_voltage_fraction * 100.0,
+                    l.usable_voltage_fraction * spec.drive.dc_link_voltage.value / 3f64.sqrt()
+                ),
+                "a shorter settling, dead or sampling time on the board, a lower switching frequency, or a motor that fits the usable voltage",
+            );
+            d.notes.extend(e.0.iter().map(|x| x.to_string()));
+            Err(Diagnostics(vec![d]))
+        }
+        Err(e) => Err(e),
+    }
 }
 
 /// Parses, resolves and designs one spec. `file` is only used in messages.

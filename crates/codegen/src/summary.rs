@@ -299,6 +299,30 @@ pub fn board(b: &crate::design::BoardOut, d: &Design) -> String {
             b.dead_time_ns,
             b.conversion_time_s * 1e6
         )?;
+        let l = &b.duty_limit;
+        let why = match l.bound {
+            crate::design::duty_limit::DutyBound::None => {
+                "in-line sensing reads the current whatever the switches do".to_string()
+            }
+            crate::design::duty_limit::DutyBound::Settling => format!(
+                "low-side shunts: ±{:.2} µs of low-side pulse about the carrier maximum, dead time {:.0} ns + settling {:.0} ns before the first current rank samples",
+                l.half_window_s * 1e6,
+                l.dead_time_s * 1e9,
+                l.settling_time_s * 1e9
+            ),
+            crate::design::duty_limit::DutyBound::SamplingEnd => format!(
+                "low-side shunts: ±{:.2} µs of low-side pulse about the carrier maximum, until the last current rank's sampling ends",
+                l.half_window_s * 1e6
+            ),
+        };
+        writeln!(
+            s,
+            "  maximum duty {:.4} (compare {}): {why}; usable voltage {:.2} V = {:.1} % of U_dc/√3",
+            l.max_duty,
+            l.max_compare,
+            d.modulation.usable_phase_voltage_v,
+            l.usable_voltage_fraction * 100.0
+        )?;
         Ok(())
     })();
     s

@@ -111,6 +111,10 @@ pub struct Patches {
     /// ADC_CR writes that start the injected conversions (JADSTART) carry ADEN = 1 as
     /// well, as the image's former read-modify-write did (issue 26 item 5).
     pub jadstart_rewrites_aden: bool,
+    /// TIM1_CCR1–3 writes of at least this compare value are written one tick above it:
+    /// a duty one timer tick beyond the sampling window's limit (`board::MAX_COMPARE`),
+    /// as a modulator without the duty limit would exceed it (issue 26 item 3).
+    pub compare_beyond: Option<u16>,
 }
 
 /// A break pulse the test schedules on the comparator.
@@ -196,6 +200,12 @@ pub struct Soc {
     bridge_armed: bool,
     /// The switches as last analysed.
     pub switches: Option<[LegSwitches; 3]>,
+    /// The analysis before that: the carrier period before the last update event, whose
+    /// tail holds the low-side turn-on a sampling at the update's carrier extreme
+    /// follows (the rule "ADC sampling inside a switching edge").
+    pub previous_switches: Option<[LegSwitches; 3]>,
+    /// Whether `switches` was analysed with MOE = 1.
+    switches_enabled: bool,
     /// The core executed WFI and sleeps until an enabled interrupt is pending (ARMv7-M
     /// B1.5.18: WFI suspends execution until a wake-up event; an interrupt wakes it even
     /// while PRIMASK masks it). The harness skips the time in between.
@@ -318,6 +328,8 @@ impl Soc {
             sr_in_irq: None,
             bridge_armed: false,
             switches: None,
+            previous_switches: None,
+            switches_enabled: false,
             sleeping: false,
             wfi_at: None,
         };
@@ -558,7 +570,12 @@ impl Soc {
         } else {
             None
         };
-        self.switches = Some(legs);
+        // The previous period counts only when the bridge switched in it too (MOE = 1 in
+        // both analyses): the first period after enabling has no low-side history.
+        let moe = self.tim1.moe();
+        let previous = self.switches.replace(legs);
+        self.previous_switches = previous.filter(|_| moe && self.switches_enabled);
+        self.switches_enabled = moe;
         duties
     }
 
@@ -810,6 +827,11 @@ impl Soc {
             self.tim1_cursor = [t; 2];
             self.bridge_armed = true;
         }
+        if let (0x34..=0x3C, Some(limit)) = (off, self.patches.compare_beyond)
+            && value >= u32::from(limit)
+        {
+            value = u32::from(limit) + 1;
+        }
         if off == 0x44 {
             if self.patches.dead_time_zero {
                 value &= !0xFF;
@@ -1043,6 +1065,7 @@ impl Soc {
             let mut problem = None;
             let smp: Vec<(u8, f64)> = (0..19).map(|ch| (ch, self.adc[k].smp_cycles(ch))).collect();
             let name = self.adc[k].name;
+            let mut currents = Vec::new();
             self.adc[k].complete(ts, |ch, at| {
                 let input = hw.adc_pin(k + 1, ch).and_then(|p| hw.analog_at(p));
                 let Some(input) = input else {
@@ -1077,8 +1100,12 @@ impl Soc {
                         ),
                     ));
                 }
-                // The rank ends at `at`; its input was held SAR_CYCLES earlier.
+                // The rank ends at `at`; its input was held SAR_CYCLES earlier, at the end
+                // of its sampling phase (§21.4.12).
                 let held = at - SAR_CYCLES * clk;
+                if let crate::hardware::Analog::Current(phase) = input.signal {
+                    currents.push((ch, phase, (held - sampled, held)));
+                }
                 let v = analog.volts(input.signal, held, tim3.output((held * UNITS_PER_S) as u64));
                 // Ideal 12-bit conversion: code = V/V_REF·4096, clamped (RM0440 §21.4.1).
                 (v / vref * 4096.0).floor().clamp(0.0, 4095.0) as u16
@@ -1086,7 +1113,89 @@ impl Soc {
             if let Some(b) = problem {
                 self.fail(b);
             }
+            for (ch, phase, sampling) in currents {
+                if let Some(b) = self.sampling_window(name, ch, phase, sampling) {
+                    self.fail(b);
+                }
+            }
         }
+    }
+
+    /// The strict rule "ADC sampling inside a switching edge" for a board with low-side
+    /// shunts ([`crate::hardware::Hardware::low_side_settling_s`]): while the bridge
+    /// switches (MOE = 1), a conversion of phase `phase`'s current must sample — over
+    /// `sampling` = (start, end) \[s\] — inside one low-side pulse of that leg, at least
+    /// the stage's settling time after the low side switched on and ending before it
+    /// switches off: a shunt whose low side is off carries no phase current, and one
+    /// that just switched on still rings. The leg's low side is the gate driver's
+    /// output ([`crate::bridge::leg`]: TIM1's complementary output with both dead times).
+    fn sampling_window(&self, adc: &str, ch: u8, phase: usize, sampling: (f64, f64)) -> Option<Broken> {
+        let settle = self.wiring.hw.low_side_settling_s?;
+        if !self.tim1.moe() {
+            return None;
+        }
+        // Not checked in the first period after the outputs were enabled (no previous
+        // switching period to hold the low side's turn-on).
+        let previous = self.previous_switches.as_ref()?;
+        let now = &self.switches.as_ref()?[phase].low;
+        let len = now.len;
+        let (a, b) = (
+            self.tim1.window_phase_s(sampling.0)?,
+            self.tim1.window_phase_s(sampling.1)?,
+        );
+        // The low side over the period before the last update (shifted to [−len, 0))
+        // and this one, intervals meeting at the update joined: a sampling that starts
+        // before the update (b < a) starts in the previous period.
+        let mut iv: Vec<(f64, f64)> = previous[phase]
+            .low
+            .high
+            .iter()
+            .map(|&(x, y)| (x - len, y - len))
+            .collect();
+        let eps = 1e-12;
+        for &(x, y) in &now.high {
+            match iv.last_mut() {
+                Some(last) if (last.1 - x).abs() <= eps => last.1 = y,
+                _ => iv.push((x, y)),
+            }
+        }
+        let a = if b < a { a - len } else { a };
+        let leg = ["u", "v", "w"][phase];
+        let cut = |what: String| {
+            Some(Broken::new(
+                format!("{adc} channel {ch}"),
+                format!(
+                    "ADC sampling inside a switching edge: the phase {leg} current (low-side shunt) sampled from {:.1} to {:.1} ns from the last update event, but {what} — the duty must leave the low side on around the sampling for the settling time and the sampling (the design's board::MAX_DUTY, codegen::design::duty_limit)",
+                    a * 1e9,
+                    b * 1e9
+                ),
+            ))
+        };
+        let Some(&(on, _)) = iv.iter().find(|&&(on, off)| on <= a + eps && b <= off + eps) else {
+            let near = iv
+                .iter()
+                .map(|&(on, off)| format!("{:.1}…{:.1} ns", on * 1e9, off * 1e9))
+                .collect::<Vec<_>>();
+            return cut(format!(
+                "the {leg} low side is not on throughout (on {})",
+                if near.is_empty() {
+                    "never".to_string()
+                } else {
+                    near.join(", ")
+                }
+            ));
+        };
+        // An interval from the start of the analysed span continues from before it: no
+        // edge seen.
+        if on > -len + eps && a - on < settle - eps {
+            return cut(format!(
+                "the {leg} low side switched on at {:.1} ns, only {:.1} ns before (settling {:.0} ns)",
+                on * 1e9,
+                (a - on) * 1e9,
+                settle * 1e9
+            ));
+        }
+        None
     }
 }
 

@@ -71,6 +71,10 @@ pub fn controller_parameters(d: &Design) -> ControllerParameters {
         dc_link_min: d.drive.dc_link_voltage_min_v as f32,
         pwm_period: d.drive.pwm_period,
         torque: torque_parameters(d),
+        // On a board its duty limit (the firmware's `board::MAX_DUTY`), else none; the
+        // usable fraction as the design has it (1 without a limit).
+        max_duty: d.board.as_ref().map_or(1.0, |b| b.duty_limit.max_duty) as f32,
+        usable_voltage_fraction: d.modulation.usable_voltage_fraction as f32,
     }
 }
 

@@ -92,6 +92,8 @@ pub const PARAMETERS: ControllerParameters = ControllerParameters {
     dc_link_min: limits::DC_LINK_MIN_V,
     pwm_period: PWM_PERIOD,
     torque: TORQUE,
+    max_duty: board::MAX_DUTY,
+    usable_voltage_fraction: board::USABLE_VOLTAGE_FRACTION,
 };
 
 /// The torque → current-reference stage of thesis B §2.3 and chapter 3 (MTPA (3.10) by

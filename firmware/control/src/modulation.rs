@@ -8,6 +8,17 @@
 //! 3. (3.8) `u_x = ũ_x + u_NM`;
 //! 4. duty (3.4)/(5.1): `DC_x = 1/2 + u_x/U_dc`, saturated to \[0, 1\].
 //!
+//! With a duty limit `d_max < 1` (low-side shunts need the low side on around the
+//! carrier maximum for the sampling; the generated `board::MAX_DUTY`,
+//! `codegen::design::duty_limit`) [`thpwm_limited`] scales the three phase voltages of
+//! step 3 together by `(d_max − 1/2)·U_dc / max_x |u_x|` when their peak exceeds it: the
+//! line-to-line voltages shrink by one factor, so the voltage vector keeps its angle and
+//! only its length is cut, and every duty stays in `[1 − d_max, d_max]`. The step's
+//! voltage limit is the usable fraction of U_dc/√3 that keeps the modulator inside this
+//! range (`USABLE_VOLTAGE_FRACTION`), so the scaling only acts on what the limit lets
+//! through by rounding or a DC link that moved within the period; clamping one duty
+//! alone would turn the vector instead.
+//!
 //! Linear range: |u_αβ| ≤ U_dc/√3 (modulation index M = 1.15, (3.6)). There the
 //! duties stay inside \[0, 1\] for every angle: the phase peak is
 //! `max_x(a·cos x − b·cos 3x)` with `b = U_dc/(6√3)` fixed; it is convex in the
@@ -64,11 +75,59 @@ pub fn duties(phase: Uvw, inv_u_dc: f32) -> [f32; 3] {
     ]
 }
 
+/// The phase voltages scaled together so that their peak is at most
+/// `(max_duty − 1/2)·u_dc` (module documentation): unchanged within it; the vector's
+/// angle kept beyond it. A non-finite peak gives zeros (the duties then 1/2).
+pub fn limit_phase_peak(phase: Uvw, u_dc: f32, max_duty: f32) -> Uvw {
+    // Comparisons, not `f32::max` (a libm call on the Cortex-M4, whose FPU has no
+    // VMAXNM): a NaN phase leaves the peak finite here and its duty saturates to 0.
+    let (av, aw) = (phase.v.abs(), phase.w.abs());
+    let mut peak = phase.u.abs();
+    if av > peak {
+        peak = av;
+    }
+    if aw > peak {
+        peak = aw;
+    }
+    let room = (max_duty - 0.5) * u_dc;
+    if peak <= room {
+        return phase;
+    }
+    let k = if peak.is_finite() && room > 0.0 {
+        room / peak
+    } else {
+        0.0
+    };
+    let s = |x: f32| {
+        let y = x * k;
+        if y.is_finite() { y } else { 0.0 }
+    };
+    Uvw {
+        u: s(phase.u),
+        v: s(phase.v),
+        w: s(phase.w),
+    }
+}
+
 /// THPWM duties for the αβ voltage `u` \[V\] at the DC-link voltage `u_dc` \[V\]
 /// (already guarded, see [`crate::feedforward::effective_dc_link`]) with
 /// `inv_u_dc = 1/u_dc`.
 pub fn thpwm<T: Trig + ?Sized>(u: AlphaBeta, u_dc: f32, inv_u_dc: f32, trig: &mut T) -> [f32; 3] {
     duties(phase_voltages(u, u_dc, trig), inv_u_dc)
+}
+
+/// [`thpwm`] with the duties limited to `max_duty` (and `1 − max_duty`) by scaling the
+/// phase voltages together ([`limit_phase_peak`]), then each duty saturated to
+/// \[0, `max_duty`\] against rounding.
+pub fn thpwm_limited<T: Trig + ?Sized>(
+    u: AlphaBeta,
+    u_dc: f32,
+    inv_u_dc: f32,
+    max_duty: f32,
+    trig: &mut T,
+) -> [f32; 3] {
+    let phase = limit_phase_peak(phase_voltages(u, u_dc, trig), u_dc, max_duty);
+    duties(phase, inv_u_dc).map(|d| if d > max_duty { max_duty } else { d })
 }
 
 /// Timer compare values `round(DC·period)` for centre-aligned PWM with auto-reload
@@ -198,6 +257,73 @@ mod tests {
             lo = lo.min(d[0].min(d[1]).min(d[2]));
         }
         assert!(hi > 0.9999 && lo < 1e-4, "{lo} {hi}");
+    }
+
+    proptest! {
+        /// With a duty limit every duty lies in [1 − d_max, d_max] (any input, also
+        /// non-finite) and inside it nothing changes; beyond it the line-to-line voltages
+        /// keep their ratios (the vector's angle): (d_u − d_v)/(d_v − d_w) equals the
+        /// unlimited phases' (u_u − u_v)/(u_v − u_w).
+        #[test]
+        fn duty_limit_keeps_the_angle(m in 0f64..=1.5, phi in -PI..PI, udc in 10f64..800.0, dmax in 0.6f64..=1.0) {
+            let (udc, dmax) = (udc as f32, dmax as f32);
+            let mag = m as f32 * udc * crate::transforms::INV_SQRT_3;
+            let ab = AlphaBeta { alpha: mag * (phi as f32).cos(), beta: mag * (phi as f32).sin() };
+            let d = thpwm_limited(ab, udc, 1.0 / udc, dmax, &mut SoftTrig);
+            let free = phase_voltages(ab, udc, &mut SoftTrig);
+            let peak = free.u.abs().max(free.v.abs()).max(free.w.abs());
+            for x in d {
+                prop_assert!(x <= dmax && x >= 1.0 - dmax - 1e-6, "{x} {dmax}");
+            }
+            if peak <= (dmax - 0.5) * udc {
+                let plain = thpwm(ab, udc, 1.0 / udc, &mut SoftTrig);
+                prop_assert_eq!(d, plain);
+            } else {
+                // Compare the line-to-line vector's direction: cross product ≈ 0.
+                let got = [d[0] - d[1], d[1] - d[2]];
+                let want = [free.u - free.v, free.v - free.w];
+                let cross = got[0] * want[1] - got[1] * want[0];
+                let scale = (got[0].hypot(got[1]) * want[0].hypot(want[1])).max(1e-6);
+                prop_assert!((cross / scale).abs() < 1e-4, "{cross} {scale}");
+            }
+        }
+
+        /// Non-finite inputs stay within [0, d_max].
+        #[test]
+        fn duty_limit_saturates(alpha in proptest::num::f32::ANY, beta in proptest::num::f32::ANY) {
+            for x in thpwm_limited(AlphaBeta { alpha, beta }, 48.0, 1.0 / 48.0, 0.9, &mut SoftTrig) {
+                prop_assert!((0.0..=0.9).contains(&x), "{x}");
+            }
+        }
+    }
+
+    /// Hand calculation: U_dc = 48 V, d_max = 0.9 leaves a phase peak of 0.4·48 = 19.2 V.
+    /// Phases (24, −12, −12) V scale by 19.2/24 = 0.8 to (19.2, −9.6, −9.6) V: duties
+    /// 0.5 + 19.2/48 = 0.9 and 0.5 − 9.6/48 = 0.3.
+    #[test]
+    fn duty_limit_by_hand() {
+        let p = limit_phase_peak(
+            Uvw {
+                u: 24.0,
+                v: -12.0,
+                w: -12.0,
+            },
+            48.0,
+            0.9,
+        );
+        assert!(
+            (p.u - 19.2).abs() < 1e-5 && (p.v + 9.6).abs() < 1e-5 && (p.w + 9.6).abs() < 1e-5,
+            "{p:?}"
+        );
+        let d = duties(p, 1.0 / 48.0);
+        assert!((d[0] - 0.9).abs() < 1e-6 && (d[1] - 0.3).abs() < 1e-6, "{d:?}");
+        // Within the room: unchanged.
+        let q = Uvw {
+            u: 10.0,
+            v: -5.0,
+            w: -5.0,
+        };
+        assert_eq!(limit_phase_peak(q, 48.0, 0.9), q);
     }
 
     #[test]

@@ -23,7 +23,7 @@ use crate::adc::{CurrentSense, DcLinkSense};
 use crate::angle::{ResolverToElectrical, ResolverTurns, lead, speed_to_rad_per_s};
 use crate::ato::{AtoConfig, AtoState, ResolverSample};
 use crate::feedforward::{FeedForwardConfig, dc_link_gain, effective_dc_link};
-use crate::modulation::{compare_values, thpwm};
+use crate::modulation::{compare_values, thpwm_limited};
 use crate::pi::{CurrentPiConfig, CurrentPiState, VoltageLimit, limit_voltage};
 use crate::torque::{TorqueConfig, TorqueState};
 use crate::transforms::{AlphaBeta, Dq, INV_SQRT_3, Uvw, inverse_park, park};
@@ -60,6 +60,10 @@ pub struct ControllerConfig {
     pub voltage_margin: f32,
     /// PWM timer auto-reload (centre-aligned period) for the compare values \[ticks\].
     pub pwm_period: u16,
+    /// Largest duty of a leg (the low-side shunts' sampling window; 1 without a limit):
+    /// the modulator scales the phase voltages to stay within it
+    /// ([`crate::modulation::thpwm_limited`]).
+    pub max_duty: f32,
     /// The torque → current-reference stage of [`Demand::Torque`] (MTPA, field
     /// weakening, MTPV; [`crate::torque`]).
     pub torque: TorqueConfig,
@@ -303,7 +307,7 @@ impl ControllerConfig {
         };
 
         // 7. Modulation.
-        let duties = thpwm(u_ab, u_dc_eff, inv_u_dc, trig);
+        let duties = thpwm_limited(u_ab, u_dc_eff, inv_u_dc, self.max_duty, trig);
         StepOutput {
             duties,
             compare: compare_values(duties, self.pwm_period),
@@ -368,6 +372,7 @@ mod tests {
         dc_link_min: 432.0,
         voltage_margin: 1.0,
         pwm_period: 4250,
+        max_duty: 1.0,
         torque: TorqueConfig::OFF,
     };
 

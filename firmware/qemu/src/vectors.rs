@@ -409,6 +409,7 @@ fn controller() -> ControllerConfig {
         dc_link_min: 432.0,
         voltage_margin: 0.95,
         pwm_period: 4250,
+        max_duty: 1.0,
         torque: torque_stage(),
     }
 }

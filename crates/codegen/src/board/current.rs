@@ -49,6 +49,11 @@ pub struct CurrentSensing {
     pub gain_v_per_a: f64,
     /// ADC-pin voltage at zero current \[V\].
     pub offset_v: f64,
+    /// Time the pin's signal needs after a switching edge of its leg before it reads the
+    /// phase current (`current_sensing.settling_time`) \[s\]: the amplifier's settling and
+    /// the edge's ringing. Required for low-side shunts, whose window it narrows
+    /// (`design::duty_limit`); `None` where the board file does not state it.
+    pub settling_time_s: Option<f64>,
 }
 
 /// What the sign of a low-side or in-line shunt's voltage is for a positive phase current.
@@ -110,6 +115,30 @@ pub(super) fn resolve(
     {
         cx.err(o.span.clone(), "current_sensing.offset", format!("the zero-current level {} V is not inside the ADC range 0 … {} V: one current direction could not be measured", o.value, v.value), "the sensor output at 0 A, between 0 V and the ADC reference (bipolar phase currents), e.g. half the reference");
     }
+    let settling = c.settling_time.as_ref().and_then(|v| {
+        spans.push(("current_sensing.settling_time".into(), v.span()));
+        cx.quantity(
+            "current_sensing.settling_time",
+            v,
+            Kind::Time,
+            Provenance::Datasheet,
+            false,
+        )
+    });
+    if let Some(t) = &settling
+        && !(t.value >= 0.0 && t.value < 100e-6)
+    {
+        cx.err(
+            t.span.clone(),
+            "current_sensing.settling_time",
+            format!(
+                "a settling time of {} s is not one a current-sensing stage has",
+                t.value
+            ),
+            "a time from 0 up to below 100 µs, e.g. settling_time = \"1 µs\"",
+        );
+    }
+    let settling_time_s = settling.map(|t| t.value);
     let out = match kind {
         SensorKind::Shunt => {
             foreign(
@@ -192,6 +221,16 @@ pub(super) fn resolve(
                     }
                 }
             });
+            if let Some((Placement::LowSide, _)) = &placement
+                && c.settling_time.is_none()
+            {
+                cx.err(
+                    section.clone(),
+                    "current_sensing.settling_time",
+                    "missing `current_sensing.settling_time`: a low-side shunt reads the phase current only once its stage has settled after the low-side switch turned on, and the maximum duty follows from that window",
+                    "settling_time = \"1 µs\": the amplifier's settling to 12 bits plus the switching edge's ringing, from the stage's datasheet or a measurement",
+                );
+            }
             let (Some((placement, _)), Some(shunt), Some(gain), Some(offset)) = (placement, shunt, gain, offset) else {
                 return None;
             };
@@ -204,6 +243,7 @@ pub(super) fn resolve(
                 direction: None,
                 gain_v_per_a: gain * shunt.value * shunt_sign(placement),
                 offset_v: offset.value,
+                settling_time_s,
             }
         }
         SensorKind::Hall => {
@@ -271,6 +311,7 @@ pub(super) fn resolve(
                 direction: Some(direction),
                 gain_v_per_a: sign * sens.value,
                 offset_v: offset.value,
+                settling_time_s,
             }
         }
     };

@@ -196,6 +196,10 @@ pub struct RawCurrentSensing {
     #[serde(default)]
     pub direction: Option<Spanned<Direction>>,
     pub offset: Val,
+    /// Time the sensed signal needs after a switching edge of its leg before it reads the
+    /// phase current (required for low-side shunts: the duty limit).
+    #[serde(default)]
+    pub settling_time: Option<Val>,
 }
 
 /// `[clock]`.

@@ -463,6 +463,53 @@ impl<'a> OnBoard<'a> {
             inputs: Of(|c| c.key("sensing")),
             json: Json::At("/board/conversion_time_s"),
         },
+        Decl {
+            name: "SAMPLING_HALF_WINDOW_S",
+            value: F32(|c| c.o.duty_limit.half_window_s, "s"),
+            formula: Lit(
+                "h = max over the current ranks of (t_d + t_set − (t_k − t_tick), t_k + t_s,k − t_tick): the low-side on-time each side of the carrier maximum the sampling needs (0: in-line sensing, no limit)",
+            ),
+            equation: Lit("RM0440 §29.3.15 (dead time), §21.4.12 (sampling); DS12288 Table 66; design::duty_limit"),
+            inputs: Of(|c| {
+                format!(
+                    "current_sensing.placement, current_sensing.settling_time, pwm.dead_time, sensing.source_resistance.current ({}), bound: {:?}",
+                    c.b.file, c.o.duty_limit.bound
+                )
+            }),
+            json: Json::At("/board/duty_limit/half_window_s"),
+        },
+        Decl {
+            name: "MAX_COMPARE",
+            value: Custom(|c| {
+                let l = &c.o.duty_limit;
+                (
+                    intv(l.max_compare.into(), "u16", "uint16_t"),
+                    format!("ticks of ARR {}", c.d.drive.pwm_period),
+                )
+            }),
+            formula: Lit("ARR − ⌈h·f_TIM⌉: the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h"),
+            equation: Lit("RM0440 §29.3.10 (centre-aligned PWM); design::duty_limit"),
+            inputs: Of(|c| format!("SAMPLING_HALF_WINDOW_S, drive.switching_frequency ({})", c.d.spec_file)),
+            json: Json::At("/board/duty_limit/max_compare"),
+        },
+        Decl {
+            name: "MAX_DUTY",
+            value: F32(|c| c.o.duty_limit.max_duty, ""),
+            formula: Lit("d_max = MAX_COMPARE/ARR = 1 − 2·h/T_s, rounded down to a whole compare value"),
+            equation: Lit("design::duty_limit"),
+            inputs: Of(|c| format!("SAMPLING_HALF_WINDOW_S ({})", c.b.file)),
+            json: Json::At("/board/duty_limit/max_duty"),
+        },
+        Decl {
+            name: "USABLE_VOLTAGE_FRACTION",
+            value: F32(|c| c.o.duty_limit.usable_voltage_fraction, ""),
+            formula: Lit(
+                "largest m with max_φ (m/√3·cos φ − cos 3φ/(6√3)) ≤ d_max − 1/2: the voltage amplitude, over U_dc/√3, whose THPWM duties stay within [1 − d_max, d_max]",
+            ),
+            equation: Lit("thesis A (3.7), (3.8); thesis B (2.50); design::duty_limit::usable_voltage_fraction"),
+            inputs: Lit("MAX_DUTY"),
+            json: Json::At("/board/duty_limit/usable_voltage_fraction"),
+        },
     ];
 
     /// A trip's inputs: which limit set it and the other one.

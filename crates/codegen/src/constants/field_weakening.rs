@@ -134,12 +134,12 @@ impl<'a> On<'a> {
             name: "VOLTAGE_LIMIT_V",
             value: F32(|c| c.fw.voltage_limit_v, "V"),
             formula: Lit(
-                "V'_max = fraction·U_dc/√3 at the nominal U_dc (the firmware rescales with the measured U_dc)",
+                "V'_max = fraction·V_max, V_max = k·U_dc/√3 the usable voltage at the nominal U_dc (k from the board's duty limit, 1 without one; the firmware rescales with the measured U_dc)",
             ),
             equation: Lit("thesis B (2.51), (2.55)"),
             inputs: Of(|c| {
                 format!(
-                    "{}, V_max = U_dc/√3 = {} (U_dc = {}, spec)",
+                    "{}, V_max = k·U_dc/√3 = {} (U_dc = {}, spec)",
                     c.fraction,
                     phys(c.d.current_loop.voltage_limit_v, "V"),
                     phys(c.d.drive.dc_link_voltage_v, "V")

@@ -40,9 +40,17 @@ impl<'a> Limits<'a> {
         Decl {
             name: "VOLTAGE_LIMIT_V",
             value: F32(|c| c.d.current_loop.voltage_limit_v, "V"),
-            formula: Lit("U_dc/√3 (voltage circle)"),
-            equation: Lit("thesis B (2.50)"),
-            inputs: Of(|c| format!("U_dc = {} (spec)", phys(c.d.drive.dc_link_voltage_v, "V"))),
+            formula: Lit(
+                "k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board or with in-line sensing)",
+            ),
+            equation: Lit("thesis B (2.50); design::duty_limit"),
+            inputs: Of(|c| {
+                format!(
+                    "U_dc = {} (spec), k = {}",
+                    phys(c.d.drive.dc_link_voltage_v, "V"),
+                    c.d.modulation.usable_voltage_fraction
+                )
+            }),
             json: Json::At("/current_loop/voltage_limit_v"),
         },
         Decl {

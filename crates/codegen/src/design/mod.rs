@@ -14,6 +14,7 @@ pub mod angle_observer;
 pub mod cross_check;
 pub mod current_loop;
 pub mod dead_time;
+pub mod duty_limit;
 
 pub mod field_weakening;
 pub mod finite;
@@ -35,7 +36,9 @@ use crate::spec::Spec;
 use sections::Context;
 pub use sections::adc::AdcOut;
 pub use sections::angle_observer::ObserverOut;
-pub use sections::board::{BoardOut, Trip, TripSource, Trips};
+pub use sections::board::{
+    BoardOut, MIN_USABLE_VOLTAGE_FRACTION, Trip, TripSource, Trips, duty_limit_key, refuse_duty_limit,
+};
 pub use sections::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
 pub use sections::drive::DriveOut;
 pub use sections::motor::{MotorOut, Origin};
@@ -88,11 +91,20 @@ pub struct Design {
 /// Computes the design, or every rule it breaks, each at its key; a design with a
 /// non-finite number is never returned ([`finite`]).
 pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
+    design_with_duty_limit(spec, src, 1.0)
+}
+
+/// [`design()`] for a drive whose duty cycles may reach `max_duty` only (a board's
+/// [`duty_limit`]): the current loop's voltage limit and the field weakening's V_max
+/// are the usable fraction of U_dc/√3 it leaves ([`duty_limit::usable_voltage_fraction`]).
+pub fn design_with_duty_limit(spec: &Spec, src: Source<'_>, max_duty: f64) -> Result<Design, Diagnostics> {
+    let usable = duty_limit::usable_voltage_fraction(max_duty);
     let mut cx = Context {
         spec,
         src,
         errors: Vec::new(),
         warnings: Vec::new(),
+        usable_voltage_fraction: usable,
     };
     // The motor values against each other and the drive first: a value off by a unit
     // prefix is refused at its key before it makes the sections below fail confusingly.
@@ -139,7 +151,12 @@ pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
         scaling: sections::scaling::scalings(spec),
         per_unit,
         fir,
-        modulation: modulation::modulation(spec.drive.dc_link_voltage.value, spec.drive.dc_link_voltage_min.value),
+        modulation: modulation::modulation(
+            spec.drive.dc_link_voltage.value,
+            spec.drive.dc_link_voltage_min.value,
+            max_duty,
+            usable,
+        ),
         adc,
         field_weakening,
         sensorless,

@@ -22,11 +22,22 @@ pub struct Modulation {
     pub max_modulation_index: f64,
     /// Same at the lowest DC-link voltage \[V\].
     pub max_phase_voltage_at_min_dc_v: f64,
+    /// Largest duty cycle of a leg (`design::duty_limit`; 1 without a board or with
+    /// in-line sensing).
+    pub max_duty: f64,
+    /// The fraction of U_dc/√3 the duty limit leaves (`duty_limit::usable_voltage_fraction`).
+    pub usable_voltage_fraction: f64,
+    /// The usable phase-voltage amplitude at nominal U_dc \[V\]: that fraction of U_dc/√3.
+    pub usable_phase_voltage_v: f64,
 }
 
-/// Constants for nominal `u_dc` \[V\] and minimum `u_dc_min` \[V\].
-pub fn modulation(u_dc: f64, u_dc_min: f64) -> Modulation {
+/// Constants for nominal `u_dc` \[V\] and minimum `u_dc_min` \[V\], duties up to
+/// `max_duty` leaving `usable` of U_dc/√3.
+pub fn modulation(u_dc: f64, u_dc_min: f64, max_duty: f64, usable: f64) -> Modulation {
     Modulation {
+        max_duty,
+        usable_voltage_fraction: usable,
+        usable_phase_voltage_v: usable * u_dc / 3f64.sqrt(),
         thpwm_common_mode_ratio: thpwm_common_mode_ratio(),
         thpwm_common_mode_amplitude_v: u_dc * thpwm_common_mode_ratio(),
         max_phase_voltage_v: u_dc / 3f64.sqrt(),
@@ -44,7 +55,7 @@ mod tests {
     /// u_NM of (3.7) lifts the phase amplitude to U_dc/√3, a 15.5 % gain (2/√3 = 1.1547).
     #[test]
     fn third_harmonic_extends_linear_range() {
-        let m = modulation(600.0, 432.0);
+        let m = modulation(600.0, 432.0, 1.0, 1.0);
         assert!((m.thpwm_common_mode_ratio - 0.096_225).abs() < 1e-6);
         assert!((m.max_phase_voltage_v / m.max_phase_voltage_spwm_v - 1.1547).abs() < 1e-4);
         // Check (3.7) numerically: at amplitude U_dc/√3, phase u plus u_NM never exceeds U_dc/2.

@@ -302,3 +302,84 @@ fn a_refused_current_loop_adds_no_field_weakening_error_of_its_numbers() {
     refused_at(&e, &text, "current_loop.bandwidth");
     assert_eq!(e.0.len(), 1, "{e}");
 }
+
+/// The maxon motor (24 V, 40 kHz: ARR = 170 MHz/(2·40 kHz) = 2125) on the NUCLEO's
+/// low-side shunts (issue 26 item 3), by hand: the current ranks are ADC1 rank 1 (w) and
+/// ADC2 ranks 1 (u) and 2 (v), each 24.5 cycles at 42.5 MHz; ADC2 rank 2 samples from
+/// 24.5 + 12.5 = 37 cycles to 3.125 + 37 + 24.5 = 64.625 cycles = 1520.59 ns after the
+/// trigger, which leads the carrier maximum by one tick (5.88 ns): 1514.71 ns; the
+/// settling condition, dead time 500 ns + settling 1000 ns + 5.88 ns = 1505.88 ns, is
+/// shorter. ⌈1514.71 ns·170 MHz⌉ = ⌈257.50⌉ = 258 ticks → compare 2125 − 258 = 1867,
+/// d_max = 1867/2125 = 0.878588. The usable fraction k solves
+/// max_φ (k/√3·cos φ − cos 3φ/(6√3)) = d_max − ½ = 0.378588: at the interior maximum
+/// sin²φ = (3/2 − k)/2 this is checked below as a property of k (not by the code's own
+/// bisection); the voltage the current loop and the field weakening then use is
+/// k·24/√3 and V'_max = 0.9 of it.
+#[test]
+fn the_nucleo_duty_limit_and_usable_voltage_by_hand() {
+    let d = on_board("maxon-ec45-flat-70w", &[], "nucleo-g474re-ihm08m1").unwrap_or_else(|e| panic!("{e}"));
+    let l = &d.board.as_ref().unwrap().duty_limit;
+    assert_eq!(l.max_compare, 1867);
+    assert!((l.max_duty - 1867.0 / 2125.0).abs() < 1e-12);
+    assert!(
+        (l.half_window_s - (64.625 / 42.5e6 - 1.0 / 170e6)).abs() < 1e-15,
+        "{}",
+        l.half_window_s
+    );
+    let k = l.usable_voltage_fraction;
+    // The property k must have: the phase peak of (3.8) at amplitude k·U_dc/√3, found by
+    // a dense scan of φ here, equals d_max − ½ (in units of U_dc).
+    let s3 = 3f64.sqrt();
+    let peak = (0..100_000)
+        .map(|i| {
+            let phi = f64::from(i) * std::f64::consts::PI / 100_000.0;
+            k / s3 * phi.cos() - (3.0 * phi).cos() / (6.0 * s3)
+        })
+        .fold(f64::MIN, f64::max);
+    assert!(
+        (peak - (l.max_duty - 0.5)).abs() < 1e-8,
+        "{peak} vs {}",
+        l.max_duty - 0.5
+    );
+    let v_use = k * 24.0 / s3;
+    assert!((d.current_loop.voltage_limit_v - v_use).abs() < 1e-9);
+    assert!((d.modulation.usable_phase_voltage_v - v_use).abs() < 1e-9);
+    let fw = d.field_weakening.as_ref().unwrap();
+    assert!(
+        (fw.voltage_limit_v - 0.9 * v_use).abs() < 1e-9,
+        "{}",
+        fw.voltage_limit_v
+    );
+    // The same motor on the reference board (Hall sensors): no limit, the whole range.
+    let r = on_board("maxon-ec45-flat-70w", &[], "motorgen-reference").unwrap();
+    let lr = &r.board.as_ref().unwrap().duty_limit;
+    assert_eq!(
+        (lr.max_duty, lr.max_compare, lr.usable_voltage_fraction),
+        (1.0, 2125, 1.0)
+    );
+    assert!((r.current_loop.voltage_limit_v - 24.0 / s3).abs() < 1e-9);
+}
+
+/// A settling time that leaves the NUCLEO too little duty is refused at that key: 10 µs
+/// at 40 kHz needs ±(0.5 + 10 + 0.006) µs of the 25 µs period, d_max = 1 − 2·10.506/25
+/// ≈ 0.16, below ½: no usable voltage at all. And a low-side shunt board without the
+/// settling time is refused at the key it lacks.
+#[test]
+fn a_window_leaving_too_little_duty_is_refused_at_the_board_key() {
+    let spec = read("motors/maxon-ec45-flat-70w.toml");
+    let board = read("boards/nucleo-g474re-ihm08m1.toml");
+    let slow = board.replace("settling_time = \"1 µs\"", "settling_time = \"10 µs\"");
+    assert_ne!(slow, board);
+    let e = codegen::design_with_board("m.toml", &spec, "b.toml", &slow).unwrap_err();
+    let d = refused_at(&e, &slow, "current_sensing.settling_time");
+    assert!(d.file == "b.toml" && d.problem.contains("10000 ns"), "{e}");
+    assert!(d.accepted.contains("switching at most"), "{e}");
+    let missing = board.replace("settling_time = \"1 µs\"\n", "");
+    assert_ne!(missing, board);
+    let e = codegen::board_source("b.toml", &missing).unwrap_err();
+    assert!(
+        e.0.iter()
+            .any(|d| d.key == "current_sensing.settling_time" && d.problem.contains("missing")),
+        "{e}"
+    );
+}

@@ -157,6 +157,12 @@ pub struct Hardware {
     /// The HSE crystal on OSC_IN/OSC_OUT \[Hz\], `None` where none is fitted: HSERDY
     /// follows HSEON only with one (RM0440 §7.4.1).
     pub hse_crystal_hz: Option<f64>,
+    /// Low-side shunt sensing: a phase current reaches its pin only while the leg's low
+    /// side conducts, and this long \[s\] after the low side switched on (the stage's
+    /// settling and the edge's ringing); `None` for in-line sensing, which reads the
+    /// current whatever the switches do. The strict rule "ADC sampling inside a switching
+    /// edge" (`Soc::convert`) holds every current conversion's sampling phase to it.
+    pub low_side_settling_s: Option<f64>,
 }
 
 /// The boards this crate has a hardware description of, by board-file stem.

@@ -123,6 +123,12 @@ pub fn hardware() -> Hardware {
         // NUCLEO-G474RE: X3, a 24 MHz crystal on PF0/PF1 (UM2505 §6.7.1 "HSE clock
         // (high-speed external clock)": the 24 MHz crystal is fitted by default).
         hse_crystal_hz: Some(24e6),
+        // The TSV994 stage behind each low-side shunt: 20 MHz GBP (DS4975) over its noise
+        // gain 5.7 is τ = 45 ns, 12 bits in 8.32·τ = 0.38 µs (thesis A (7.4)); the
+        // switching edge's ringing is not stated in UM1996. ST's motor-control SDK waits
+        // T_noise = T_rise = 1 µs after an edge on its 10 mΩ three-shunt stages (STMCWB 4.3
+        // power-stage parameters): 1 µs, as the board file states.
+        low_side_settling_s: Some(1e-6),
     }
 }
 

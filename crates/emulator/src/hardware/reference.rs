@@ -85,5 +85,7 @@ fn with_sensing(board: &'static str, variant_of: Option<&'static str>, sensitivi
         boot0_may_be_high: true,
         // No crystal: the reference design clocks the MCU from HSI16 only.
         hse_crystal_hz: None,
+        // Hall-type in-line sensors: the current reaches the pin whatever the switches do.
+        low_side_settling_s: None,
     }
 }

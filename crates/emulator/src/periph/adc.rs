@@ -36,6 +36,11 @@ pub const ADRDY_POLLS_WITHOUT_RETRY: u32 = 3;
 pub const JEXTSEL_TIM1_TRGO2: u32 = 8;
 /// SAR conversion cycles at 12 bits (RM0440 §21.4.16: t_CONV = t_SMPL + 12.5 cycles).
 pub const SAR_CYCLES: f64 = 12.5;
+/// From an injected hardware trigger to the first rank's sampling \[ADC cycles\]: the
+/// longest injected trigger latency t_LATRINJ with the synchronous clock HCLK/4
+/// (CKMODE = 0b11, DS12288 Table 66 "ADC characteristics"), the value the design's
+/// conversion time and duty limit take.
+pub const TRIGGER_LATENCY_CYCLES: f64 = 3.125;
 
 /// Sampling cycles of an SMPx code (RM0440 §21.7.6, ADC_SMPR1).
 pub fn sampling_cycles(code: u32) -> f64 {
@@ -173,7 +178,7 @@ impl Adc {
             return;
         }
         let ranks = (jsqr & 3) as usize + 1;
-        let mut t = now;
+        let mut t = now + TRIGGER_LATENCY_CYCLES * adc_clock_s;
         let mut out = Vec::new();
         for rank in 0..ranks {
             let ch = ((jsqr >> (9 + 6 * rank)) & 0x1F) as u8;

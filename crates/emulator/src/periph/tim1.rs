@@ -390,8 +390,15 @@ impl Tim1 {
     /// The six outputs at `t` (bus units) — the pins' levels for GPIO IDR reads — `None`
     /// where Hi-Z.
     pub fn outputs_at(&self, t: u64) -> [Option<bool>; 6] {
+        let phase = self.window_phase(t);
+        self.outputs(self.tick_s()).map(|w| w.map(|w| w.at(phase)))
+    }
+
+    /// Where `t` (bus units) falls in the window of [`Tim1::outputs`] (one carrier period
+    /// from the last update event) \[s\]; 0 with the counter stopped.
+    pub fn window_phase(&self, t: u64) -> f64 {
         let tick_s = self.tick_s();
-        let phase = match self.started_at {
+        match self.started_at {
             Some(start) if self.period_ticks() > 0 => {
                 let p = self.period_ticks();
                 let from_update = if self.update_at_overflow {
@@ -402,8 +409,24 @@ impl Tim1 {
                 ((t.saturating_sub(start) / self.tick + from_update) % p) as f64 * tick_s
             }
             _ => 0.0,
+        }
+    }
+
+    /// [`Tim1::window_phase`] of a time between bus units, `t_s` \[s\], without rounding
+    /// to the tick: `None` with the counter stopped.
+    pub fn window_phase_s(&self, t_s: f64) -> Option<f64> {
+        let start = self.started_at?;
+        let p = self.period_ticks();
+        if p == 0 {
+            return None;
+        }
+        let from_update = if self.update_at_overflow {
+            (p - u64::from(self.arr)) as f64
+        } else {
+            0.0
         };
-        self.outputs(tick_s).map(|w| w.map(|w| w.at(phase)))
+        let ticks = (t_s * crate::periph::UNITS_PER_S - start as f64) / self.tick as f64 + from_update;
+        Some(ticks.rem_euclid(p as f64) * self.tick_s())
     }
 
     /// Register read at `t`.

@@ -56,10 +56,10 @@ const SETTLE_S: f64 = 0.02;
 /// Standstill under the torque before the ramp \[s\].
 const STANDSTILL_S: f64 = 0.05;
 /// The ramp's duration where the drive's and the observer's accelerations allow \[s\].
-const RAMP_S: f64 = 0.5;
+pub(crate) const RAMP_S: f64 = 0.5;
 /// … and at most this many times the drive's largest acceleration (the field-weakening
 /// loop is designed for the drive's acceleration).
-const MAX_SPEEDUP: f64 = 3.0;
+pub(crate) const MAX_SPEEDUP: f64 = 3.0;
 /// The control interrupt's budget on every motor \[instructions\]: issue 30 set 900 (of
 /// 8 500 cycles at 20 kHz and 170 MHz); issue 26 added the start-up offset's per-phase
 /// correction and the compare writes' UDIS window (the at-speed maximum went from at most
@@ -76,9 +76,9 @@ pub const INTERRUPT_BUDGET: u64 = 950;
 /// image measures the DC link in 12 bits) moves the operating point along the
 /// constant-torque curve, i_d more than the torque (emrax-228-hv near 6 500 rpm: 3.1 A
 /// apart, the torque within 1.0 N·m of 44.9).
-const TORQUE_TOLERANCE: f64 = 0.02;
-const TORQUE_FLOOR: f64 = 0.01;
-const CURRENT_TOLERANCE: f64 = 0.04;
+pub(crate) const TORQUE_TOLERANCE: f64 = 0.02;
+pub(crate) const TORQUE_FLOOR: f64 = 0.01;
+pub(crate) const CURRENT_TOLERANCE: f64 = 0.04;
 /// Where the motor's current circle is beyond the board's: the circle of the envelope
 /// the frames follow in field weakening, as a share of the over-current trip, and the share
 /// of that envelope's torque they command — margins for the field-weakening loop's lag
@@ -90,10 +90,10 @@ const BOARD_ENVELOPE: f64 = 0.95;
 /// The electrical lag of the emulated board's observer the ramp may cause at its peak
 /// acceleration \[°\] where that is faster than the drive's (a third of the 10° of field
 /// orientation the design allows).
-const PROFILE_LAG_DEG: f64 = 3.0;
+pub(crate) const PROFILE_LAG_DEG: f64 = 3.0;
 
 /// The MTPA point on the circle `i` \[A\] (3.10): (i_d, i_q).
-fn mtpa_corner(psi: f64, dl: f64, i: f64) -> (f64, f64) {
+pub(crate) fn mtpa_corner(psi: f64, dl: f64, i: f64) -> (f64, f64) {
     codegen::design::loss_minimisation::mtpa_corner(psi, dl, i)
 }
 

@@ -7,6 +7,7 @@ mod boot;
 mod can;
 mod closed_loop;
 mod defects;
+mod duty_limit;
 mod first_power_up;
 mod frequency_response;
 mod preflight;

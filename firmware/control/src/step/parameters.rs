@@ -65,6 +65,11 @@ pub struct ControllerParameters {
     pub pwm_period: u16,
     /// The torque stage's constants (MTPA, field weakening, MTPV; [`crate::torque`]).
     pub torque: TorqueParameters,
+    /// Largest duty of a leg, the generated `board::MAX_DUTY` (1 without a limit).
+    pub max_duty: f32,
+    /// The fraction of U_dc/√3 that keeps the modulator within it, the generated
+    /// `board::USABLE_VOLTAGE_FRACTION` (1 without a limit).
+    pub usable_voltage_fraction: f32,
 }
 
 /// `n` as the `u16` of [`ResolverToElectrical`], saturating (no motor or resolver has
@@ -80,8 +85,10 @@ impl ControllerConfig {
     /// * observer: the Q1.31 gains and the error form they were scaled for;
     /// * angle: n_p, n_r, θ_off (4.5);
     /// * the current loop limits with the proportional voltage circle
-    ///   (`VoltageLimit::Proportional`) at margin 1: V_max = U_dc/√3 (2.50), the whole
-    ///   THPWM linear range (3.8) — the generated `VOLTAGE_LIMIT_V` at the nominal U_dc;
+    ///   (`VoltageLimit::Proportional`) at the usable fraction k of V_max = U_dc/√3
+    ///   (2.50): the whole THPWM linear range (3.8) without a duty limit (k = 1), else
+    ///   the part whose duties stay within `max_duty` — the generated `VOLTAGE_LIMIT_V`
+    ///   at the nominal U_dc;
     /// * the torque stage of [`TorqueConfig::from_parameters`].
     pub const fn from_parameters(p: &ControllerParameters) -> Self {
         Self {
@@ -126,8 +133,9 @@ impl ControllerConfig {
                 psi_m: p.psi_m,
             },
             dc_link_min: p.dc_link_min,
-            voltage_margin: 1.0,
+            voltage_margin: p.usable_voltage_fraction,
             pwm_period: p.pwm_period,
+            max_duty: p.max_duty,
             torque: TorqueConfig::from_parameters(&p.torque),
         }
     }
@@ -182,6 +190,8 @@ mod tests {
                 mtpa_torque_max: 31.27,
                 mtpa_id: [0.0; crate::torque::MTPA_POINTS],
             },
+            max_duty: 1.0,
+            usable_voltage_fraction: 1.0,
         }
     }
 
@@ -220,6 +230,20 @@ mod tests {
         assert_eq!(c.torque.delta_l, 0.0);
         assert!(!c.torque.mtpv);
         assert_eq!(c.torque.mtpa_per_torque, 16.0 / 31.27);
+    }
+
+    /// A duty limit reaches the modulator and the voltage circle: d_max = 0.8786 and its
+    /// usable fraction 0.7461 (the NUCLEO's with the maxon motor at 40 kHz).
+    #[test]
+    fn duty_limit_reaches_the_step() {
+        let p = ControllerParameters {
+            max_duty: 0.8786,
+            usable_voltage_fraction: 0.7461,
+            ..fischer()
+        };
+        let c = ControllerConfig::from_parameters(&p);
+        assert_eq!(c.max_duty, 0.8786);
+        assert_eq!(c.voltage_margin, 0.7461);
     }
 
     /// The choices: error form 1 is atan2 (4.10); two measured phases are u and v;

@@ -117,6 +117,7 @@ pub fn config(motor: Motor, current_loop: CurrentPiConfig) -> ControllerConfig {
         dc_link_min: 50.0,
         voltage_margin: 1.0,
         pwm_period: PWM_PERIOD,
+        max_duty: 1.0,
         torque: motor_control::torque::TorqueConfig::OFF,
     }
 }

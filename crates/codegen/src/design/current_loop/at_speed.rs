@@ -122,7 +122,8 @@ pub struct Drive {
     pub flux_linkage_wb: Option<f64>,
     /// Peak current amplitude √2·I_peak \[A\].
     pub peak_current_a: f64,
-    /// V_max = U_dc/√3 \[V\].
+    /// The usable voltage at the nominal U_dc \[V\]: V_max = U_dc/√3, or the fraction of
+    /// it a board's duty limit leaves (`design::duty_limit`).
     pub voltage_limit_v: f64,
     /// ω_e,max \[rad/s\].
     pub max_electrical_speed: f64,
@@ -248,7 +249,9 @@ impl<'a> Loop<'a> {
             },
             measured,
             u_ff,
-            (sampled_dc / 3f64.sqrt()) as f32,
+            // The usable voltage at the sampled U_dc (the step's `voltage_margin` of
+            // U_dc/√3, `design::duty_limit`).
+            (self.dr.voltage_limit_v * sampled_dc / self.dr.dc_link_voltage_v) as f32,
             self.dr.sample_period_s as f32,
             // The image's square root is the FPU's VSQRT.F32, bit-identical to libm's
             // (firmware/README.md, `cordic`): the same numbers as the board.

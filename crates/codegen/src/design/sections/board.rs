@@ -12,7 +12,10 @@
 //! image trips at the lower of the motor's limit and the board's ceiling ([`Trips`]), the
 //! motor's limits being the full scales of its design (the spec's `[scaling] margin` over
 //! its peak current, DC link and maximum speed, thesis A Table 4.1). Conversions that
-//! take more than a quarter of the control period are a warning.
+//! take more than a quarter of the control period are a warning. The duty limit of the
+//! current sensing's sampling window (`design::duty_limit`) is carried here; a window
+//! that leaves less than [`MIN_USABLE_VOLTAGE_FRACTION`] of U_dc/√3 is refused at the
+//! board key that set it.
 
 use serde::Serialize;
 
@@ -22,6 +25,7 @@ use crate::board::{
 };
 use crate::design::Design;
 use crate::design::current_loop::FIRMWARE_LOOP_DELAY_PERIODS;
+use crate::design::duty_limit::{self, DutyBound, DutyLimit};
 use crate::diagnostic::{Diagnostic, Source};
 use crate::firmware::{self, CanBitTiming};
 
@@ -102,6 +106,9 @@ pub struct BoardOut {
     /// The loop delay this timing makes \[s\]: trigger → update plus half a period, the
     /// mean delay of the voltage held over the period after the update (thesis A §4.6).
     pub loop_delay_s: f64,
+    /// The largest duty the current sensing's sampling window leaves and the voltage it
+    /// leaves the design (`design::duty_limit`).
+    pub duty_limit: DutyLimit,
     /// CAN nominal bit rate \[bit/s\].
     pub can_bit_rate: u32,
     /// FDCAN1's nominal bit timing for that rate from the FDCAN kernel clock
@@ -401,6 +408,16 @@ pub(in crate::design) fn board(
             );
         }
     }
+    let dead_s = d
+        .drive
+        .dead_time_s
+        .map_or(board.dead_time_s, |spec| spec.max(board.dead_time_s));
+    let limit = duty_limit::for_board(board, d.drive.switching_frequency_hz, dead_s);
+    if let Some(l) = &limit
+        && let Some(e) = refuse_duty_limit(board, board_src, l, d.drive.switching_frequency_hz)
+    {
+        errors.push(e);
+    }
     let mut warn = |key: &str, problem: String| warnings.push(warning_at(board, board_text, key, &problem));
     if t_conv > 0.25 * ts {
         warn(
@@ -427,11 +444,10 @@ pub(in crate::design) fn board(
         Signal::CanRx,
         Signal::CanTx,
     ];
-    let (Some(can_timing), Some(timing), true) = (can_timing, timing, errors.is_empty()) else {
+    let (Some(can_timing), Some(timing), Some(duty_limit), true) = (can_timing, timing, limit, errors.is_empty())
+    else {
         return Err(errors);
     };
-    let board_dead = board.dead_time_s;
-    let dead_s = d.drive.dead_time_s.map_or(board_dead, |spec| spec.max(board_dead));
     let trips = trips(board, d);
     let out = BoardOut {
         board: board.clone(),
@@ -471,6 +487,7 @@ pub(in crate::design) fn board(
         trips,
         trigger_to_update_ticks: timing.trigger_to_update_ticks,
         loop_delay_s: timing.loop_delay_s,
+        duty_limit,
         can_bit_rate: can_timing.bit_rate,
         can_timing,
         warnings: Vec::new(),
@@ -480,6 +497,58 @@ pub(in crate::design) fn board(
         ..out
     };
     Ok((out, warnings))
+}
+
+/// Smallest usable fraction of U_dc/√3 a board's sampling window may leave
+/// (`design::duty_limit`): below half of the modulator's linear range the sampling, not
+/// the motor or the DC link, would set the drive's voltage and so its speed range —
+/// a board file whose window needs that much of the carrier period has a wrong sampling
+/// or settling time, or the motor switches too fast for it. (The spec's own
+/// `field_weakening.voltage_fraction` stops at 0.5 of V_max for the same reason: below
+/// it the field-weakening gain grows without bound, thesis B (2.60).)
+pub const MIN_USABLE_VOLTAGE_FRACTION: f64 = 0.5;
+
+/// The board key of the condition that set a duty limit: the settling time, or the
+/// dead time where it is the larger part of the settling condition, or the current
+/// inputs' sampling time.
+pub fn duty_limit_key(l: &DutyLimit) -> &'static str {
+    match l.bound {
+        DutyBound::Settling if l.dead_time_s > l.settling_time_s => "pwm.dead_time",
+        DutyBound::Settling => "current_sensing.settling_time",
+        DutyBound::SamplingEnd | DutyBound::None => "sensing.source_resistance.current",
+    }
+}
+
+/// The refusal of a duty limit that leaves less than [`MIN_USABLE_VOLTAGE_FRACTION`] of
+/// U_dc/√3, at the board key of the condition that set it (the settling time, or the
+/// dead time where it is the larger part, or the current inputs' sampling time), with
+/// the switching frequency that would leave enough.
+pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs_hz: f64) -> Option<Diagnostic> {
+    if l.usable_voltage_fraction >= MIN_USABLE_VOLTAGE_FRACTION {
+        return None;
+    }
+    // d_floor: the duty whose usable fraction is the floor; T_s ≥ 2h/(1 − d_floor).
+    let d_floor = 0.5 + duty_limit::thpwm_phase_peak(MIN_USABLE_VOLTAGE_FRACTION);
+    let fs_max = (1.0 - d_floor) / (2.0 * l.half_window_s);
+    let key = duty_limit_key(l);
+    Some(board_src.error(
+        board.span(key),
+        key,
+        format!(
+            "the low-side shunts need the low side on for {:.2} µs either side of the carrier maximum (dead time {:.0} ns + settling {:.0} ns before the sampling, the current ranks' sampling to {:.0} ns after the trigger), so at f_s = {fs_hz} Hz the duty may reach only {:.3}, leaving {:.0} % of U_dc/√3 (at least {:.0} % is needed)",
+            l.half_window_s * 1e6,
+            l.dead_time_s * 1e9,
+            l.settling_time_s * 1e9,
+            l.ranks.iter().map(|r| r.end_s).fold(0.0, f64::max) * 1e9,
+            l.max_duty,
+            l.usable_voltage_fraction * 100.0,
+            MIN_USABLE_VOLTAGE_FRACTION * 100.0
+        ),
+        format!(
+            "a shorter settling, dead or sampling time, or a motor switching at most {:.0} Hz (d_max ≥ {d_floor:.3})",
+            fs_max.floor()
+        ),
+    ))
 }
 
 /// The ADC's noise taken for the offset average \[12-bit LSB rms\]: the ideal 12-bit

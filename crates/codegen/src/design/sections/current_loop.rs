@@ -73,7 +73,9 @@ pub struct CurrentLoopOut {
     pub q: AxisGains,
     /// The same design with R at the maximum winding temperature (thesis B 2.24), if `[thermal]` is given.
     pub hot: Option<HotVariant>,
-    /// Voltage limit of the PI output vector, U_dc/√3 \[V\] (thesis B 2.50).
+    /// Voltage limit of the PI output vector at the nominal U_dc \[V\]: V_max = U_dc/√3
+    /// (thesis B 2.50), or the usable fraction of it a board's duty limit leaves
+    /// (`design::duty_limit`).
     pub voltage_limit_v: f64,
     /// Feed-forward constants.
     pub feedforward: FeedForward,
@@ -135,7 +137,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         .ok();
     let promise = Promise::of(&requests[0]);
     let designed_os = promise.overshoot_pct;
-    let drive = drive(spec, r, ts, cx.max_electrical_frequency());
+    let drive = drive(spec, r, ts, cx.max_electrical_frequency(), cx.usable_voltage_v());
     // The floors on both axes, then the at-speed figures (`verify`'s decoupling and
     // DC-link-step criteria): the rules `pi_gains!` applies, and those of a motor.
     if let Some((gd, gq)) = &gains {
@@ -201,7 +203,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         d,
         q,
         hot,
-        voltage_limit_v: spec.drive.dc_link_voltage.value / 3f64.sqrt(),
+        voltage_limit_v: cx.usable_voltage_v(),
         feedforward: FeedForward {
             d_inductance_h: m.d_inductance.value,
             q_inductance_h: m.q_inductance.value,
@@ -213,7 +215,8 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
 }
 
 /// The drive the at-speed figures are judged on (`current_loop::at_speed`).
-fn drive(spec: &Spec, r: f64, ts: f64, max_electrical_frequency: f64) -> at_speed::Drive {
+/// `voltage_limit_v` is the usable voltage at the nominal U_dc ([`Context::usable_voltage_v`]).
+fn drive(spec: &Spec, r: f64, ts: f64, max_electrical_frequency: f64, voltage_limit_v: f64) -> at_speed::Drive {
     let m = &spec.motor;
     let c = &spec.current_loop;
     let zeta = c.damping.as_ref().map_or(0.0, |z| z.value);
@@ -223,7 +226,7 @@ fn drive(spec: &Spec, r: f64, ts: f64, max_electrical_frequency: f64) -> at_spee
         lq: m.q_inductance.value,
         flux_linkage_wb: m.flux_linkage.as_ref().map(|p| p.value),
         peak_current_a: std::f64::consts::SQRT_2 * m.peak_current.value,
-        voltage_limit_v: spec.drive.dc_link_voltage.value / 3f64.sqrt(),
+        voltage_limit_v,
         max_electrical_speed: 2.0 * PI * max_electrical_frequency,
         sample_period_s: ts,
         dc_link_voltage_v: spec.drive.dc_link_voltage.value,

@@ -39,7 +39,7 @@ pub(in crate::design) fn field_weakening(
                 .map(|i| field_weakening::inverter_loss(i, fs)),
             i_max: SQRT_2 * m.peak_current.value,
         },
-        voltage_max: spec.drive.dc_link_voltage.value / 3f64.sqrt(),
+        voltage_max: cx.usable_voltage_v(),
         voltage_fraction: f.voltage_fraction.value,
         current_bandwidth: spec.current_loop.bandwidth.value,
         rated_speed: m.rated_frequency.as_ref().map(|f| 2.0 * PI * f.value),

@@ -33,6 +33,10 @@ pub(super) struct Context<'a> {
     pub errors: Vec<Diagnostic>,
     /// Non-fatal observations so far.
     pub warnings: Vec<String>,
+    /// The fraction of the THPWM linear range U_dc/√3 the board's duty limit leaves
+    /// (`design::duty_limit`): 1 for a motor designed on its own or on a board with
+    /// in-line sensing.
+    pub usable_voltage_fraction: f64,
 }
 
 impl Context<'_> {
@@ -64,6 +68,13 @@ impl Context<'_> {
     /// A warning at `p`'s key and value.
     pub fn warn_at(&mut self, p: &crate::spec::Param, text: impl std::fmt::Display) {
         self.warn(p.span.clone(), &p.key.clone(), text);
+    }
+
+    /// The voltage the current loop and the field weakening may use \[V\]: the usable
+    /// fraction of V_max = U_dc/√3 (thesis B (2.50), `design::duty_limit`) at the nominal
+    /// U_dc.
+    pub fn usable_voltage_v(&self) -> f64 {
+        self.usable_voltage_fraction * self.spec.drive.dc_link_voltage.value / 3f64.sqrt()
     }
 
     /// f_e,max = n_p·n_max/60 [Hz] (Table 1.2).

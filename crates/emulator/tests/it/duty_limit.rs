@@ -1,0 +1,272 @@
+//! The duty at its limit (issue 26 item 3): a torque step at the top speed, where the
+//! back EMF leaves the current loop too little voltage, so the PI output reaches its
+//! voltage circle (the usable fraction of U_dc/√3, `codegen::design::duty_limit`) and
+//! the modulator's largest duty its limit `board::MAX_DUTY`. On the board with low-side
+//! shunts the emulator's strict rule "ADC sampling inside a switching edge" holds every
+//! phase-current conversion to its leg's low-side pulse, after the settling time; the
+//! currents the image regulates to, sampled that way, must then give the torque and
+//! currents `verify`'s bench gives with the same command and speed (the criteria and
+//! tolerances of the at-speed scenario, [`crate::at_speed`]), compared once the step's
+//! transient is over (the image takes a frame a period or two after verify's bench).
+//!
+//! The run: boot, 20 ms at zero torque, a ramp at zero torque to the at-speed scenario's
+//! top speed (its acceleration rule), [`HOLD_S`] there, then the MTPA torque on the
+//! board's current circle for [`AFTER_S`].
+//!
+//! Boards: the NUCLEO + X-NUCLEO-IHM08M1 (low-side shunts, d_max < 1) and the reference
+//! board (in-line Hall sensors: d_max = 1, the duty reaches the THPWM linear range's
+//! 100 %), each with its first motor (`rig::benches`; maxon-ec45-flat-70w on both). The
+//! 400 A variant of the reference board is the same hardware with another sensing gain
+//! and takes only the traction motors, whose ramps take seconds of simulated time
+//! (`at_speed`'s module documentation): it is left out here, as its sensing reads the
+//! currents whatever the switches do. The defect: the compare values one timer tick
+//! beyond `MAX_COMPARE` (`Patches::compare_beyond`) and the rule fires.
+
+use std::f64::consts::PI;
+
+use crate::BOOT_LIMIT_S;
+use crate::at_speed::{
+    CURRENT_TOLERANCE, MAX_SPEEDUP, PROFILE_LAG_DEG, RAMP_S, TORQUE_FLOOR, TORQUE_TOLERANCE, mtpa_corner,
+};
+use codegen::spec::ObserverError;
+use motor_emulator::Patches;
+use motor_emulator::drive::{Drive, Sample};
+use motor_emulator::rig::{Bench, Rig, benches};
+use motor_emulator::wiring;
+use motor_sim::plant::{Shaft, SpeedProfile};
+use motor_verify::Setup;
+use motor_verify::field_weakening::{run as verify_run, torque as machine_torque};
+
+/// Zero-torque time after the first enabled period \[s\] (the observer locks).
+const SETTLE_S: f64 = 0.02;
+/// Zero torque at the top speed before the step \[s\].
+const HOLD_S: f64 = 0.01;
+/// The step's length \[s\]; the comparison takes its second half.
+const AFTER_S: f64 = 0.03;
+
+/// What a run measured.
+struct Outcome {
+    /// Largest leg duty after the step (the bridge's volt-second average).
+    peak_duty: f64,
+    /// Periods with a duty within one compare tick of the limit.
+    at_limit: usize,
+    /// Worst |ΔT| over its tolerance, |Δi| and its tolerance, in the compared half.
+    torque_ratio: f64,
+    worst_i: f64,
+    i_tol: f64,
+    /// The design's limit and the auto-reload.
+    max_duty: f64,
+    arr: u16,
+    /// CPU seconds of the emulated run.
+    cpu_s: f64,
+}
+
+/// The motor of the scenario: the one `rig::benches` puts on the NUCLEO, which fits the
+/// reference board too (checked), with the shortest ramp to its top speed.
+const MOTOR: &str = "maxon-ec45-flat-70w";
+
+/// Panics unless `rig::benches` runs `MOTOR` on `board`.
+fn check_fits(board: &str) {
+    assert!(
+        benches().iter().any(|(m, b)| m == MOTOR && b == board),
+        "{MOTOR} does not fit {board}"
+    );
+}
+
+/// The run of the module documentation on `motor` × `board` with `patches`; `Err` with
+/// what stopped it (a strict-mode rule) or switched the drive off.
+fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outcome, String> {
+    let spec = wiring::spec(motor)?;
+    let bench = Bench::new(motor, board)?.patched(patches);
+    let mut rig = Rig::with_analog(bench, |d, hw| {
+        Ok(Box::new(Drive::new(
+            &Setup::new(&spec, d),
+            SpeedProfile::constant(0.0),
+            hw,
+        )))
+    })?;
+    rig.boot(BOOT_LIMIT_S).map_err(|e| format!("boot: {e}"))?;
+    let settled = rig.machine.soc().time_s() + SETTLE_S;
+    rig.run(settled, |_| Some(0.0), |_| false)
+        .map_err(|e| format!("zero torque: {e}"))?;
+    let design = rig.design.clone();
+    let setup = Setup::new(&spec, &design);
+    let out = design.board.as_ref().expect("a design on a board");
+    let b = &out.board;
+    let m = &design.motor;
+    let np = f64::from(m.pole_pairs);
+    let psi = m.flux_linkage_wb.unwrap_or(0.0);
+    let dl = m.q_inductance_h - m.d_inductance_h;
+    if design.field_weakening.is_none() {
+        return Err(format!("{motor}: no ψ_M, no torque stage to step"));
+    }
+    // The at-speed scenario's torque (MTPA on the board's circle) and top speed.
+    let i_lim = m.peak_current_a.min(0.9 * b.over_current_a);
+    let (id_c, iq_c) = mtpa_corner(psi, dl, i_lim);
+    let res = b.torque_resolution_nm;
+    let torque = (1.5 * np * iq_c * (psi - dl * id_c) / res).round() * res;
+    let v_prime = design.field_weakening.as_ref().map_or(0.0, |f| f.voltage_limit_v);
+    let w_board = if psi > m.d_inductance_h * i_lim {
+        v_prime / (psi - m.d_inductance_h * i_lim)
+    } else {
+        f64::INFINITY
+    };
+    let top_e = m
+        .max_electrical_speed_rad_s
+        .min(w_board)
+        .min(0.95 * b.over_speed_rad_s * np);
+    let obs = &design.angle_observer;
+    let nr = f64::from(obs.resolver_pole_pairs);
+    let allowed_r = PROFILE_LAG_DEG.to_radians() * nr / np;
+    let follows_r = match obs.error {
+        ObserverError::TrigIdentity => obs.gains.ki * wiring::RESOLVER_AMPLITUDE * allowed_r.sin(),
+        ObserverError::Atan2 => obs.gains.ki * allowed_r,
+    };
+    // At zero torque the ramp only has to keep the observer locked: as fast as its
+    // allowance, not the drive's acceleration (the field-weakening loop is not judged
+    // here), at least the at-speed scenario's.
+    let acc_drive = design.drive.max_acceleration_rad_s2;
+    let acc_at_speed = acc_drive.max((top_e / np / RAMP_S).min(follows_r / nr).min(MAX_SPEEDUP * acc_drive));
+    let acc_m = acc_at_speed.max(follows_r / nr);
+
+    let period = rig.setpoint_period_s();
+    let now = rig.machine.soc().time_s();
+    let at = (now / period).ceil() * period;
+    let imposed = SpeedProfile {
+        from: 0.0,
+        to: top_e / np,
+        start: at,
+        acceleration: acc_m,
+    };
+    let t_step = ((at + top_e / np / acc_m + HOLD_S) / period).ceil() * period;
+    let end = t_step + AFTER_S;
+    let command = move |tf: f64| if tf + 1e-9 >= t_step { torque } else { 0.0 };
+    rig.analog_as::<Drive>().unwrap().plant.shaft = Shaft::Imposed(imposed);
+    let started = std::time::Instant::now();
+    rig.run(end, |t| Some(command(t)), |_| false)
+        .map_err(|e| format!("{e}; {}", rig.machine.summary()))?;
+    let cpu_s = started.elapsed().as_secs_f64();
+    let s: Vec<Sample> = rig.analog_as::<Drive>().unwrap().samples.clone();
+    let k0 = s.iter().rposition(|x| x.t < at).expect("samples before the ramp") + 1;
+    if let Some(off) = s[k0..].iter().position(|x| x.duties.is_none()) {
+        return Err(format!(
+            "the drive switched off {:.4} s after the ramp's start (fault record: {})",
+            s[k0 + off].t - at,
+            rig.fault_cause().unwrap_or_else(|| "none".into())
+        ));
+    }
+    let t0 = s[k0].t;
+    let n = s.len() - k0;
+    let speed = move |t: f64| imposed.at(t);
+    let command_at = |tv: f64| command(t0 + (tv / period + 1e-9).floor() * period);
+    let reference = verify_run(&setup, &command_at, &|t| speed(t0 + t), n, wiring::RESOLVER_AMPLITUDE);
+
+    let arr = design.drive.pwm_period;
+    let max_duty = out.duty_limit.max_duty;
+    let tick = 1.0 / f64::from(arr);
+    let after: Vec<&Sample> = s.iter().filter(|x| x.t >= t_step).collect();
+    let leg_max = |x: &Sample| x.duties.map_or(0.0, |d| d[0].max(d[1]).max(d[2]));
+    let peak_duty = after.iter().map(|x| leg_max(x)).fold(0.0, f64::max);
+    let at_limit = after.iter().filter(|x| leg_max(x) >= max_duty - tick).count();
+
+    let lsb = b.adc_reference_v / 4096.0 / b.current.gain_v_per_a.abs();
+    let quantisation = 3.0 * lsb * 1.5 * np * psi.max(1e-9);
+    let i_tol = CURRENT_TOLERANCE * i_lim + 3.0 * lsb;
+    let (mut torque_ratio, mut worst_i) = (0.0f64, 0.0f64);
+    for (k, r) in reference.iter().enumerate() {
+        let img = &s[k0 + k];
+        if img.t < t_step + 0.5 * AFTER_S {
+            continue;
+        }
+        let dt = (machine_torque(&setup.motor, img.i[0], img.i[1]) - r.torque_nm).abs();
+        let tol = TORQUE_TOLERANCE * torque + TORQUE_FLOOR * torque + quantisation;
+        torque_ratio = torque_ratio.max(dt / tol);
+        worst_i = worst_i.max((img.i[0] - r.sample.i[0]).hypot(img.i[1] - r.sample.i[1]));
+    }
+    println!(
+        "{motor} on {board}: {torque:.3} N·m at {:.0} rpm (ramp {:.0} rpm/s): peak duty {peak_duty:.5} (limit {max_duty:.5}, compare {} of {arr}), {at_limit} periods within a tick of it; |ΔT| ≤ {torque_ratio:.2} of its tolerance, |Δi| ≤ {worst_i:.3} A (tolerance {i_tol:.3}); {:.3} s simulated in {cpu_s:.1} s",
+        top_e / np * 30.0 / PI,
+        acc_m * 30.0 / PI,
+        out.duty_limit.max_compare,
+        end - at
+    );
+    Ok(Outcome {
+        peak_duty,
+        at_limit,
+        torque_ratio,
+        worst_i,
+        i_tol,
+        max_duty,
+        arr,
+        cpu_s,
+    })
+}
+
+/// On every board but the 400 A variant (module documentation): the duty reaches its
+/// limit and never passes it, no conversion samples inside a switching edge (the strict
+/// rule would have stopped the run), and the image's torque and currents are verify's.
+#[test]
+fn torque_step_at_top_speed_reaches_the_duty_limit() {
+    for board in ["nucleo-g474re-ihm08m1", "motorgen-reference"] {
+        let motor = MOTOR;
+        check_fits(board);
+        let o =
+            step_at_top_speed(motor, board, Patches::default()).unwrap_or_else(|e| panic!("{motor} on {board}: {e}"));
+        let tick = 1.0 / f64::from(o.arr);
+        assert!(
+            o.peak_duty >= o.max_duty - tick && o.at_limit > 0,
+            "{motor} on {board}: the duty reached only {} (limit {})",
+            o.peak_duty,
+            o.max_duty
+        );
+        assert!(
+            o.peak_duty <= o.max_duty + 1e-9,
+            "{motor} on {board}: duty {} beyond the limit {}",
+            o.peak_duty,
+            o.max_duty
+        );
+        assert!(
+            o.torque_ratio <= 1.0,
+            "{motor} on {board}: torque off verify's by {} of the tolerance",
+            o.torque_ratio
+        );
+        assert!(
+            o.worst_i <= o.i_tol,
+            "{motor} on {board}: currents off verify's by {} A (tolerance {})",
+            o.worst_i,
+            o.i_tol
+        );
+        println!("{motor} on {board}: {:.1} s CPU", o.cpu_s);
+    }
+}
+
+/// The defect: compare values one tick beyond the NUCLEO's `MAX_COMPARE` (a modulator
+/// without the limit) — the conversion that samples the phase at the limit now ends
+/// after its low side switched off, and the rule stops the run.
+#[test]
+fn a_duty_one_tick_beyond_the_limit_samples_inside_an_edge() {
+    let board = "nucleo-g474re-ihm08m1";
+    let motor = MOTOR;
+    check_fits(board);
+    let (file, text) = wiring::read(&format!("boards/{board}.toml")).unwrap();
+    let limit = wiring::design(motor, &file, &text)
+        .unwrap_or_else(|e| panic!("{motor} on {board}: {e}"))
+        .board
+        .expect("a design on a board")
+        .duty_limit
+        .max_compare;
+    let patches = Patches {
+        compare_beyond: Some(limit),
+        ..Patches::default()
+    };
+    match step_at_top_speed(motor, board, patches) {
+        Err(e) => {
+            println!("{motor} on {board}, compare {} (one beyond the limit): {e}", limit + 1);
+            assert!(e.contains("ADC sampling inside a switching edge"), "{e}");
+        }
+        Ok(o) => panic!(
+            "{motor} on {board}: compare values one tick beyond the limit passed (peak duty {})",
+            o.peak_duty
+        ),
+    }
+}
