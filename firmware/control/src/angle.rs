@@ -17,7 +17,7 @@ pub fn from_radians(rad: f32) -> i32 {
     (rad / RADIANS_PER_LSB) as i32
 }
 
-/// Any angle [rad] → π-scaled Q1.31 stored integer (4.20), rounded to nearest and
+/// Any angle \[rad\] → π-scaled Q1.31 stored integer (4.20), rounded to nearest and
 /// wrapped into one turn: θ and θ + 2π give the same integer, +π gives −2^31 (= −π).
 /// The host-side conversion: the code generator writes θ_off with it, and the
 /// simulations lock the observer with it.
