@@ -78,7 +78,7 @@ fn mtpa_iq(d: &codegen::design::Design, torque: f64, iq_per_nm: f64) -> f64 {
 /// The rig with the closed-loop drive, booted and settled at zero torque, and the spec
 /// (for `verify`'s `Setup`: the same machine model). `Err` names what stopped it first:
 /// a strict-mode rule, or the criterion "boot" / "zero torque" with the fault record.
-fn closed_loop(bench: Bench) -> Result<(Rig, codegen::spec::Spec), String> {
+pub(crate) fn closed_loop(bench: Bench) -> Result<(Rig, codegen::spec::Spec), String> {
     let spec = motor_emulator::wiring::spec(&bench.motor)?;
     let mut rig = Rig::with_analog(bench, |d, hw| {
         Ok(Box::new(Drive::new(

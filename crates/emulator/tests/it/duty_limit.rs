@@ -24,21 +24,18 @@
 
 use std::f64::consts::PI;
 
-use crate::BOOT_LIMIT_S;
 use crate::at_speed::{
     CURRENT_TOLERANCE, MAX_SPEEDUP, PROFILE_LAG_DEG, RAMP_S, TORQUE_FLOOR, TORQUE_TOLERANCE, mtpa_corner,
 };
 use codegen::spec::ObserverError;
 use motor_emulator::Patches;
 use motor_emulator::drive::{Drive, Sample};
-use motor_emulator::rig::{Bench, Rig, benches};
+use motor_emulator::rig::{Bench, benches};
 use motor_emulator::wiring;
 use motor_sim::plant::{Shaft, SpeedProfile};
 use motor_verify::Setup;
 use motor_verify::field_weakening::{run as verify_run, torque as machine_torque};
 
-/// Zero-torque time after the first enabled period \[s\] (the observer locks).
-const SETTLE_S: f64 = 0.02;
 /// Zero torque at the top speed before the step \[s\].
 const HOLD_S: f64 = 0.01;
 /// The step's length \[s\]; the comparison takes its second half.
@@ -76,19 +73,7 @@ fn check_fits(board: &str) {
 /// The run of the module documentation on `motor` × `board` with `patches`; `Err` with
 /// what stopped it (a strict-mode rule) or switched the drive off.
 fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outcome, String> {
-    let spec = wiring::spec(motor)?;
-    let bench = Bench::new(motor, board)?.patched(patches);
-    let mut rig = Rig::with_analog(bench, |d, hw| {
-        Ok(Box::new(Drive::new(
-            &Setup::new(&spec, d),
-            SpeedProfile::constant(0.0),
-            hw,
-        )))
-    })?;
-    rig.boot(BOOT_LIMIT_S).map_err(|e| format!("boot: {e}"))?;
-    let settled = rig.machine.soc().time_s() + SETTLE_S;
-    rig.run(settled, |_| Some(0.0), |_| false)
-        .map_err(|e| format!("zero torque: {e}"))?;
+    let (mut rig, spec) = crate::closed_loop::closed_loop(Bench::new(motor, board)?.patched(patches))?;
     let design = rig.design.clone();
     let setup = Setup::new(&spec, &design);
     let out = design.board.as_ref().expect("a design on a board");

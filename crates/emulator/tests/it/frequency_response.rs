@@ -19,16 +19,8 @@ use motor_commission::sim_drive::SimulatedDrive;
 use motor_control::can_protocol::{Quantity, Reason};
 use motor_control::commissioning::Axis;
 use motor_emulator::can_bus::CanBus;
-use motor_emulator::drive::Drive;
 use motor_emulator::rig::{Bench, Rig};
-use motor_sim::plant::SpeedProfile;
 use motor_verify::Setup;
-
-use crate::BOOT_LIMIT_S;
-
-/// Zero-torque time after the first enabled period before the command \[s\]: the angle
-/// observer locks onto the resolver (as in the closed-loop test).
-const SETTLE_S: f64 = 0.02;
 
 /// The session's options: the host's defaults (amplitude, lines), as a bench user runs it.
 fn options(axis: Axis) -> Options {
@@ -53,19 +45,7 @@ struct Pair {
 /// Boots `motor` on `board` with the closed-loop drive, runs the frequency response of
 /// each axis in `axes` over the emulated CAN, then the same plan on the simulated drive.
 fn measure(motor: &str, board: &str, axes: &[Axis]) -> Result<Vec<Pair>, String> {
-    let bench = Bench::new(motor, board)?;
-    let spec = motor_emulator::wiring::spec(motor)?;
-    let mut rig = Rig::with_analog(bench, |d, hw| {
-        Ok(Box::new(Drive::new(
-            &Setup::new(&spec, d),
-            SpeedProfile::constant(0.0),
-            hw,
-        )))
-    })?;
-    rig.boot(BOOT_LIMIT_S).map_err(|e| format!("boot: {e}"))?;
-    let t = rig.machine.soc().time_s() + SETTLE_S;
-    rig.run(t, |_| Some(0.0), |_| false)
-        .map_err(|e| format!("zero torque: {e}; {}", rig.machine.summary()))?;
+    let (mut rig, spec) = crate::closed_loop::closed_loop(Bench::new(motor, board)?)?;
     let design = rig.design.clone();
     let rel = format!("motors/{motor}.toml");
     refuses_above_the_limit(&mut rig, &design, &rel)?;
