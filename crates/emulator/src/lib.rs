@@ -123,6 +123,32 @@ fn uc_err(e: unicorn_engine::unicorn_const::uc_error) -> Stop {
     Stop::Emulator(format!("{e:?}"))
 }
 
+/// WFI, Thumb encoding T1 (ARMv7-M A7.7.261).
+const WFI: u16 = 0xBF30;
+
+/// The addresses of every WFI encoding in the image's flash, at the flash address and at
+/// its alias at 0 (the boot mapping), sorted: a superset of the WFI instructions (a
+/// halfword of data or of a 32-bit instruction can read 0xBF30 too), told apart at the
+/// fetch by the instruction's width and address.
+fn wfi_sites(image: &Image) -> Vec<u64> {
+    let mut sites = Vec::new();
+    for (seg_addr, bytes) in &image.segments {
+        let a = u64::from(*seg_addr);
+        if !(FLASH.0..FLASH.0 + FLASH.1 as u64).contains(&a) {
+            continue;
+        }
+        let skew = (a & 1) as usize;
+        for (k, h) in bytes[skew..].chunks_exact(2).enumerate() {
+            if u16::from_le_bytes([h[0], h[1]]) == WFI {
+                let at = a + (skew + 2 * k) as u64;
+                sites.extend([at, at - FLASH.0]);
+            }
+        }
+    }
+    sites.sort_unstable();
+    sites
+}
+
 impl Machine {
     /// Loads `image` and resets the core: SP and PC from the vector table (ARMv7-M
     /// B1.5.5).
@@ -169,10 +195,21 @@ impl Machine {
         }
         // Time: one instruction per HCLK cycle; stop at the deadline, and at a WFI (Thumb
         // encoding 0xBF30, ARMv7-M A7.7.261) outside a handler, whose sleep the harness
-        // skips (`run_while`).
-        uc.add_code_hook(1, 0, |uc: &mut Unicorn<'_, Soc>, addr: u64, size: u32| {
-            let mut op = [0u8; 2];
-            let wfi = size == 2 && uc.mem_read(addr, &mut op).is_ok() && u16::from_le_bytes(op) == 0xBF30;
+        // skips (`run_while`). Flash is mapped read/execute only, so its halfwords never
+        // change: the WFI encodings in it are found once here, and an instruction fetched
+        // from flash is a WFI when it is 16 bits wide at one of them. Code anywhere else
+        // (RAM) is read at the fetch. (Reading every instruction back through
+        // `uc_mem_read` cost about a fifth of the emulator's time.)
+        let wfi_sites = wfi_sites(image);
+        let in_flash = |a: u64| (FLASH.0..FLASH.0 + FLASH.1 as u64).contains(&a) || a < FLASH.1 as u64;
+        uc.add_code_hook(1, 0, move |uc: &mut Unicorn<'_, Soc>, addr: u64, size: u32| {
+            let wfi = size == 2
+                && if in_flash(addr) {
+                    wfi_sites.binary_search(&addr).is_ok()
+                } else {
+                    let mut op = [0u8; 2];
+                    uc.mem_read(addr, &mut op).is_ok() && u16::from_le_bytes(op) == WFI
+                };
             let soc = uc.get_data_mut();
             if soc.now + soc.cost > soc.deadline || soc.violation.is_some() {
                 let _ = uc.emu_stop();
@@ -227,8 +264,17 @@ impl Machine {
         self.uc.reg_write(r, u64::from(v)).map_err(uc_err)
     }
 
-    fn write_word(&mut self, addr: u32, v: u32) -> Result<(), Stop> {
-        self.uc.mem_write(u64::from(addr), &v.to_le_bytes()).map_err(uc_err)
+    fn write_words(&mut self, addr: u32, words: &[u32]) -> Result<(), Stop> {
+        let bytes: Vec<u8> = words.iter().flat_map(|w| w.to_le_bytes()).collect();
+        self.uc.mem_write(u64::from(addr), &bytes).map_err(uc_err)
+    }
+
+    fn read_words<const N: usize>(&self, addr: u32) -> Result<[u32; N], Stop> {
+        let mut b = vec![0; 4 * N];
+        self.uc.mem_read(u64::from(addr), &mut b).map_err(uc_err)?;
+        Ok(std::array::from_fn(|k| {
+            u32::from_le_bytes([b[4 * k], b[4 * k + 1], b[4 * k + 2], b[4 * k + 3]])
+        }))
     }
 
     fn read_word(&self, addr: u32) -> Result<u32, Stop> {
@@ -274,18 +320,19 @@ impl Machine {
         if pad != 0 {
             xpsr |= 1 << 9;
         }
+        // The frame is assembled here and written with one store: each `uc_mem_write`
+        // looks for translated code to invalidate in the pages it touches.
+        let mut frame = [0u32; FRAME_BYTES as usize / 4];
         let core = [R0, R1, R2, R3, R12, LR, PC];
         for (k, r) in core.iter().enumerate() {
-            let v = self.reg(*r)?;
-            self.write_word(sp + 4 * k as u32, v)?;
+            frame[k] = self.reg(*r)?;
         }
-        self.write_word(sp + 28, xpsr)?;
-        for k in 0..16u32 {
-            let v = self.uc.reg_read(i32::from(S0) + k as i32).map_err(uc_err)? as u32;
-            self.write_word(sp + 32 + 4 * k, v)?;
+        frame[7] = xpsr;
+        for k in 0..16 {
+            frame[8 + k] = self.uc.reg_read(i32::from(S0) + k as i32).map_err(uc_err)? as u32;
         }
-        let fpscr = self.reg(FPSCR)?;
-        self.write_word(sp + 96, fpscr)?;
+        frame[24] = self.reg(FPSCR)?;
+        self.write_words(sp, &frame)?;
         let handler = self.vector(n)?;
         self.reg_w(SP, sp)?;
         self.reg_w(LR, EXC_RETURN)?;
@@ -305,20 +352,18 @@ impl Machine {
     fn exit(&mut self) -> Result<(), Stop> {
         use RegisterARM::*;
         let sp = self.reg(SP)?;
+        let frame: [u32; FRAME_BYTES as usize / 4] = self.read_words(sp)?;
         let core = [R0, R1, R2, R3, R12, LR, PC];
         for (k, r) in core.iter().enumerate() {
-            let v = self.read_word(sp + 4 * k as u32)?;
-            self.reg_w(*r, v)?;
+            self.reg_w(*r, frame[k])?;
         }
-        let xpsr = self.read_word(sp + 28)?;
-        for k in 0..16u32 {
-            let v = self.read_word(sp + 32 + 4 * k)?;
+        let xpsr = frame[7];
+        for k in 0..16 {
             self.uc
-                .reg_write(i32::from(S0) + k as i32, u64::from(v))
+                .reg_write(i32::from(S0) + k as i32, u64::from(frame[8 + k]))
                 .map_err(uc_err)?;
         }
-        let fpscr = self.read_word(sp + 96)?;
-        self.reg_w(FPSCR, fpscr)?;
+        self.reg_w(FPSCR, frame[24])?;
         self.reg_w(APSR_NZCVQ, xpsr & 0xF800_0000)?;
         self.reg_w(SP, sp + FRAME_BYTES + ((xpsr >> 9) & 1) * 4)?;
         if let Some((n, ins, at)) = self.active.pop() {
