@@ -96,7 +96,7 @@ pub fn mode_config(d: &Design) -> Option<(ModeConfig, usize)> {
                 sample_period: d.drive.sample_period_s as f32,
                 tau_offset: f("PREFLIGHT_TAU_OFFSET")?,
                 rotation_voltage: f("PREFLIGHT_VOLTAGE")?,
-                rotation_step: num(g, "ROTATION_STEP")? as i32,
+                rotation_step: num(g, "PREFLIGHT_ROTATION_STEP")? as i32,
                 settle_samples: u("ROTATION_SETTLE_SAMPLES")?,
                 ratio: f("PREFLIGHT_RATIO")?,
                 ratio_bound: f("PREFLIGHT_RATIO_BOUND")?,

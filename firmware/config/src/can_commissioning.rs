@@ -52,7 +52,8 @@ pub const MODE: ModeConfig = ModeConfig {
 };
 
 /// The pre-flight check (issue 26 item 2): the generated `PREFLIGHT_*` figures; the
-/// rotation turns at the §6.4 rotation's rate and holds as long.
+/// rotation holds as long as the §6.4 rotation and turns at its rate, or slower where a
+/// following rotor's back-EMF would eat the rotation's voltage (`PREFLIGHT_ROTATION_STEP`).
 pub const PREFLIGHT: Preflight = Preflight {
     voltage: commissioning::PREFLIGHT_VOLTAGE,
     level_samples: commissioning::PREFLIGHT_LEVEL_SAMPLES,
@@ -68,7 +69,7 @@ pub const PREFLIGHT: Preflight = Preflight {
     sample_period: crate::config::CONTROLLER.sample_period,
     tau_offset: commissioning::PREFLIGHT_TAU_OFFSET,
     rotation_voltage: commissioning::PREFLIGHT_VOLTAGE,
-    rotation_step: commissioning::ROTATION_STEP,
+    rotation_step: commissioning::PREFLIGHT_ROTATION_STEP,
     settle_samples: commissioning::ROTATION_SETTLE_SAMPLES,
     ratio: commissioning::PREFLIGHT_RATIO,
     ratio_bound: commissioning::PREFLIGHT_RATIO_BOUND,

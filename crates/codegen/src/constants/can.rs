@@ -354,6 +354,39 @@ impl<'a> Commissioning<'a> {
             json: Json::None,
         },
         Decl {
+            name: "PREFLIGHT_ROTATION_STEP",
+            value: Custom(|c| {
+                let rate = c.preflight_rotation_rate();
+                let step = (4_294_967_296.0 * rate / std::f64::consts::TAU * c.ts)
+                    .round()
+                    .clamp(1.0, f64::from(i32::MAX));
+                (
+                    intv(step as i64, "i32", "int32_t"),
+                    format!(
+                        "{step} LSB per period ({:.4} electrical turns/s, the turn in {})",
+                        rate / std::f64::consts::TAU,
+                        phys(std::f64::consts::TAU / rate, "s")
+                    ),
+                )
+            }),
+            formula: Lit(
+                "2^32·T_s·ω/2π, ω = min(2π rad/s, R·I_p/(2·ψ_M)): the pre-flight's field turns at §6.4's once a second unless a rotor following it would induce ψ_M·ω beyond half the rotation's voltage V = R·I_p — the rotor follows at the load angle δ with sin δ = ψ_M·ω/V (≤ 30° here); at ψ_M·ω ≥ V it cannot follow at all",
+            ),
+            equation: Lit("thesis A §6.4, (2.25)"),
+            inputs: Of(|c| {
+                format!(
+                    "ψ_M = {}, R = {}, I_p = {}, {}",
+                    c.d.motor
+                        .flux_linkage_wb
+                        .map_or("— (none: no back-EMF)".into(), |p| phys(p, "Wb")),
+                    phys(c.d.motor.phase_resistance_ohm, "Ω"),
+                    phys(c.preflight_current(), "A"),
+                    c.ts_in
+                )
+            }),
+            json: Json::None,
+        },
+        Decl {
             name: "ROTATION_TURNS",
             value: Custom(|c| {
                 let o = &c.d.angle_observer;
@@ -618,6 +651,16 @@ impl<'a> Commissioning<'a> {
     /// The pre-flight current I_p = ¼·min(rated amplitude, over-current trip) \[A\].
     fn preflight_current(&self) -> f64 {
         0.25 * self.rated_amplitude().min(self.b.trips.over_current_a.value)
+    }
+
+    /// The pre-flight rotation's electrical rate ω = min(2π, R·I_p/(2·ψ_M)) \[rad/s\]:
+    /// the back-EMF ψ_M·ω of a following rotor at most half the rotation's voltage.
+    fn preflight_rotation_rate(&self) -> f64 {
+        let v = self.d.motor.phase_resistance_ohm * self.preflight_current();
+        match self.d.motor.flux_linkage_wb {
+            Some(psi) if psi > 0.0 => std::f64::consts::TAU.min(0.5 * v / psi),
+            _ => std::f64::consts::TAU,
+        }
     }
 
     /// The rating's amplitude: √2·I_n, else √2·I_peak \[A\].
