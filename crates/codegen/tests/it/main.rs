@@ -2,6 +2,7 @@
 //! would otherwise be a binary of its own, linking every dependency again).
 
 mod board_files;
+mod commissioning;
 mod contract;
 mod firmware_limits;
 mod fuzz;
