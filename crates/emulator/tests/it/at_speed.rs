@@ -97,6 +97,47 @@ pub(crate) fn mtpa_corner(psi: f64, dl: f64, i: f64) -> (f64, f64) {
     codegen::design::loss_minimisation::mtpa_corner(psi, dl, i)
 }
 
+/// The scenario's top speed and the fastest ramp its observer follows (module doc).
+pub(crate) struct TopSpeed {
+    /// Top electrical speed \[rad/s\]: the motor's, the board's at the current limit
+    /// (V'/(ψ_M − L_d·i_lim), above which the voltage no longer carries that current),
+    /// and 95 % of the over-speed trip, whichever is lowest.
+    pub(crate) top_e: f64,
+    /// The mechanical acceleration \[rad/s²\] at which the angle observer lags by
+    /// [`PROFILE_LAG_DEG`] electrical: its type-2 loop's steady lag is the resolver
+    /// acceleration over K_i (times the trig identity's amplitude, through its sine).
+    pub(crate) follows_m: f64,
+}
+
+/// [`TopSpeed`] of `design` (on a board) at the current limit `i_lim` \[A\].
+pub(crate) fn top_speed(design: &codegen::design::Design, i_lim: f64) -> TopSpeed {
+    let m = &design.motor;
+    let board = &design.board.as_ref().expect("a design on a board").board;
+    let np = f64::from(m.pole_pairs);
+    let psi = m.flux_linkage_wb.unwrap_or(0.0);
+    let v_prime = design.field_weakening.as_ref().map_or(0.0, |f| f.voltage_limit_v);
+    let w_board = if psi > m.d_inductance_h * i_lim {
+        v_prime / (psi - m.d_inductance_h * i_lim)
+    } else {
+        f64::INFINITY
+    };
+    let top_e = m
+        .max_electrical_speed_rad_s
+        .min(w_board)
+        .min(0.95 * board.over_speed_rad_s * np);
+    let obs = &design.angle_observer;
+    let nr = f64::from(obs.resolver_pole_pairs);
+    let allowed_r = PROFILE_LAG_DEG.to_radians() * nr / np;
+    let follows_r = match obs.error {
+        ObserverError::TrigIdentity => obs.gains.ki * wiring::RESOLVER_AMPLITUDE * allowed_r.sin(),
+        ObserverError::Atan2 => obs.gains.ki * allowed_r,
+    };
+    TopSpeed {
+        top_e,
+        follows_m: follows_r / nr,
+    }
+}
+
 #[test]
 fn torque_along_a_speed_ramp_matches_verify() {
     let pairs = benches();
@@ -144,31 +185,11 @@ fn torque_along_a_speed_ramp_matches_verify() {
         let quantised = move |nm: f64| (nm / res).round().clamp(-32768.0, 32767.0) * res;
         let torque = quantised(torque_want);
         let v_prime = design.field_weakening.as_ref().map_or(0.0, |f| f.voltage_limit_v);
-        let w_board = if psi > m.d_inductance_h * i_lim {
-            v_prime / (psi - m.d_inductance_h * i_lim)
-        } else {
-            f64::INFINITY
-        };
-        let top_e = m
-            .max_electrical_speed_rad_s
-            .min(w_board)
-            .min(0.95 * board.over_speed_rad_s * np);
-        // The ramp's acceleration (module doc): the observer's allowance on this board.
-        let obs = &design.angle_observer;
-        let nr = f64::from(obs.resolver_pole_pairs);
-        let allowed_r = PROFILE_LAG_DEG.to_radians() * nr / np;
-        let gain = match obs.error {
-            ObserverError::TrigIdentity => obs.gains.ki * wiring::RESOLVER_AMPLITUDE,
-            ObserverError::Atan2 => obs.gains.ki,
-        };
-        let follows_r = match obs.error {
-            ObserverError::TrigIdentity => gain * allowed_r.sin(),
-            ObserverError::Atan2 => gain * allowed_r,
-        };
+        let TopSpeed { top_e, follows_m } = top_speed(&design, i_lim);
         let acc_drive = design.drive.max_acceleration_rad_s2;
         // Without ψ_M the stage gives no current at any speed: the ramp takes RAMP_S.
         let acc_m = if torque > 0.0 {
-            acc_drive.max((top_e / np / RAMP_S).min(follows_r / nr).min(MAX_SPEEDUP * acc_drive))
+            acc_drive.max((top_e / np / RAMP_S).min(follows_m).min(MAX_SPEEDUP * acc_drive))
         } else {
             top_e / np / RAMP_S
         };

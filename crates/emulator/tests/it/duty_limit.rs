@@ -25,9 +25,8 @@
 use std::f64::consts::PI;
 
 use crate::at_speed::{
-    CURRENT_TOLERANCE, MAX_SPEEDUP, PROFILE_LAG_DEG, RAMP_S, TORQUE_FLOOR, TORQUE_TOLERANCE, mtpa_corner,
+    CURRENT_TOLERANCE, MAX_SPEEDUP, RAMP_S, TORQUE_FLOOR, TORQUE_TOLERANCE, TopSpeed, mtpa_corner, top_speed,
 };
-use codegen::spec::ObserverError;
 use motor_emulator::Patches;
 use motor_emulator::drive::{Drive, Sample};
 use motor_emulator::rig::{Bench, benches};
@@ -90,29 +89,13 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     let (id_c, iq_c) = mtpa_corner(psi, dl, i_lim);
     let res = b.torque_resolution_nm;
     let torque = (1.5 * np * iq_c * (psi - dl * id_c) / res).round() * res;
-    let v_prime = design.field_weakening.as_ref().map_or(0.0, |f| f.voltage_limit_v);
-    let w_board = if psi > m.d_inductance_h * i_lim {
-        v_prime / (psi - m.d_inductance_h * i_lim)
-    } else {
-        f64::INFINITY
-    };
-    let top_e = m
-        .max_electrical_speed_rad_s
-        .min(w_board)
-        .min(0.95 * b.over_speed_rad_s * np);
-    let obs = &design.angle_observer;
-    let nr = f64::from(obs.resolver_pole_pairs);
-    let allowed_r = PROFILE_LAG_DEG.to_radians() * nr / np;
-    let follows_r = match obs.error {
-        ObserverError::TrigIdentity => obs.gains.ki * wiring::RESOLVER_AMPLITUDE * allowed_r.sin(),
-        ObserverError::Atan2 => obs.gains.ki * allowed_r,
-    };
+    let TopSpeed { top_e, follows_m } = top_speed(&design, i_lim);
     // At zero torque the ramp only has to keep the observer locked: as fast as its
     // allowance, not the drive's acceleration (the field-weakening loop is not judged
     // here), at least the at-speed scenario's.
     let acc_drive = design.drive.max_acceleration_rad_s2;
-    let acc_at_speed = acc_drive.max((top_e / np / RAMP_S).min(follows_r / nr).min(MAX_SPEEDUP * acc_drive));
-    let acc_m = acc_at_speed.max(follows_r / nr);
+    let acc_at_speed = acc_drive.max((top_e / np / RAMP_S).min(follows_m).min(MAX_SPEEDUP * acc_drive));
+    let acc_m = acc_at_speed.max(follows_m);
 
     let period = rig.setpoint_period_s();
     let now = rig.machine.soc().time_s();
