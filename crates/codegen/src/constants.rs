@@ -77,6 +77,24 @@ pub struct Group {
     pub constants: Vec<Constant>,
 }
 
+impl Group {
+    /// The constant called `name` in this group.
+    pub fn constant(&self, name: &str) -> Option<&Constant> {
+        self.constants.iter().find(|k| k.name == name)
+    }
+
+    /// The machine value of the constant called `name` as a number (`None` when the group
+    /// has no such constant or its value is not a single number).
+    pub fn number(&self, name: &str) -> Option<f64> {
+        self.constant(name)?.value.number.as_f64()
+    }
+}
+
+/// The group called `name` among `groups` (the output of [`constants`]).
+pub fn group_named<'a>(groups: &'a [Group], name: &str) -> Option<&'a Group> {
+    groups.iter().find(|g| g.name == name)
+}
+
 /// All constants of `d`, grouped: current loop, observer, scalings, filter, limits, field
 /// weakening, sensorless estimator, and on a board the board, CAN and commissioning groups.
 pub fn constants(d: &Design) -> Vec<Group> {

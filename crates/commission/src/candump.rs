@@ -19,7 +19,7 @@ use motor_control::commissioning_mode::ModeConfig;
 use motor_control::preflight::Preflight;
 
 use super::recording::{RecordingKind, StepRun, write_step_csv};
-use codegen::constants::{Group, constants};
+use codegen::constants::{Group, constants, group_named};
 use codegen::design::Design;
 use codegen::diagnostic::{Diagnostic, Diagnostics, Source};
 
@@ -31,10 +31,9 @@ pub fn layout(d: &Design) -> Option<Layout> {
 
 /// The [`Layout`] described by the `can` group of `groups`.
 pub fn layout_of(groups: &[Group]) -> Option<Layout> {
-    let g = groups.iter().find(|g| g.name == "can")?;
-    let num = |name: &str| g.constants.iter().find(|k| k.name == name)?.value.number.as_f64();
-    let id = |name: &str| num(name).map(|x| x as u16);
-    let f = |name: &str| num(name).map(|x| x as f32);
+    let g = group_named(groups, "can")?;
+    let id = |name: &str| g.number(name).map(|x| x as u16);
+    let f = |name: &str| g.number(name).map(|x| x as f32);
     Some(Layout {
         status_id: id("STATUS_ID")?,
         command_id: id("COMMAND_ID")?,
@@ -53,16 +52,15 @@ pub fn layout_of(groups: &[Group]) -> Option<Layout> {
 pub fn mode_config(d: &Design) -> Option<(ModeConfig, usize)> {
     let groups = constants(d);
     let layout = layout_of(&groups)?;
-    let g = groups.iter().find(|g| g.name == "commissioning")?;
-    let can = groups.iter().find(|g| g.name == "can")?;
-    let num = |g: &Group, name: &str| g.constants.iter().find(|k| k.name == name)?.value.number.as_f64();
-    let u = |name: &str| num(g, name).map(|x| x as u32);
-    let f = |name: &str| num(g, name).map(|x| x as f32);
+    let g = group_named(&groups, "commissioning")?;
+    let can = group_named(&groups, "can")?;
+    let u = |name: &str| g.number(name).map(|x| x as u32);
+    let f = |name: &str| g.number(name).map(|x| x as f32);
     Some((
         ModeConfig {
             layout,
-            sample_period_units: num(can, "SAMPLE_PERIOD_UNITS")? as u16,
-            standstill_speed: num(g, "STANDSTILL_SPEED")? as f32,
+            sample_period_units: can.number("SAMPLE_PERIOD_UNITS")? as u16,
+            standstill_speed: g.number("STANDSTILL_SPEED")? as f32,
             zero_torque: 0.5 * d.board.as_ref()?.board.torque_resolution_nm as f32,
             step_samples: (u("STEP_PRE_SAMPLES")?, u("STEP_SAMPLES")?),
             align_samples: (
@@ -71,16 +69,16 @@ pub fn mode_config(d: &Design) -> Option<(ModeConfig, usize)> {
                 u("ALIGN_AVERAGE_SAMPLES")?,
             ),
             rotation: (
-                num(g, "ROTATION_STEP")? as i32,
+                g.number("ROTATION_STEP")? as i32,
                 u("ROTATION_TURNS")?,
                 u("ROTATION_SETTLE_SAMPLES")?,
             ),
             flux: FluxLinkage {
                 settle_samples: u("FLUX_SETTLE_SAMPLES")?,
                 average_samples: u("FLUX_AVERAGE_SAMPLES")?,
-                min_speed: num(g, "FLUX_MIN_SPEED")? as f32,
+                min_speed: g.number("FLUX_MIN_SPEED")? as f32,
             },
-            injection_limit: num(g, "INJECTION_LIMIT")? as f32,
+            injection_limit: g.number("INJECTION_LIMIT")? as f32,
             preflight: Preflight {
                 voltage: f("PREFLIGHT_VOLTAGE")?,
                 level_samples: u("PREFLIGHT_LEVEL_SAMPLES")?,
@@ -96,11 +94,11 @@ pub fn mode_config(d: &Design) -> Option<(ModeConfig, usize)> {
                 sample_period: d.drive.sample_period_s as f32,
                 tau_offset: f("PREFLIGHT_TAU_OFFSET")?,
                 rotation_voltage: f("PREFLIGHT_VOLTAGE")?,
-                rotation_step: num(g, "PREFLIGHT_ROTATION_STEP")? as i32,
+                rotation_step: g.number("PREFLIGHT_ROTATION_STEP")? as i32,
                 settle_samples: u("ROTATION_SETTLE_SAMPLES")?,
                 ratio: f("PREFLIGHT_RATIO")?,
                 ratio_bound: f("PREFLIGHT_RATIO_BOUND")?,
-                angle_bound: num(g, "PREFLIGHT_ANGLE_BOUND")? as i32,
+                angle_bound: g.number("PREFLIGHT_ANGLE_BOUND")? as i32,
             },
         },
         u("CAPTURE_CAPACITY")? as usize,

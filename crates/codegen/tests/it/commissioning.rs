@@ -15,11 +15,9 @@ fn design(motor: &str, board: &str) -> Design {
 
 /// A generated constant of the `commissioning` group.
 fn constant(d: &Design, name: &str) -> f64 {
-    codegen::constants::constants(d)
-        .iter()
-        .find(|g| g.name == "commissioning")
-        .and_then(|g| g.constants.iter().find(|k| k.name == name))
-        .and_then(|k| k.value.number.as_f64())
+    let groups = codegen::constants::constants(d);
+    codegen::constants::group_named(&groups, "commissioning")
+        .and_then(|g| g.number(name))
         .unwrap_or_else(|| panic!("no constant {name}"))
 }
 

@@ -31,7 +31,7 @@ fn design(name: &str, text: &str) -> Design {
 }
 
 fn group<'a>(groups: &'a [Group], name: &str) -> &'a Group {
-    groups.iter().find(|g| g.name == name).unwrap()
+    codegen::constants::group_named(groups, name).unwrap()
 }
 
 /// Thesis B's motor with and without `rated_frequency`/`nominal_speed`: f_n enters none of

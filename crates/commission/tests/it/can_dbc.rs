@@ -208,14 +208,8 @@ fn generated_dbc_matches_the_firmware_encoders() {
         // The fault report: identifier and i_q unit from the generated `can` group (the
         // firmware's `motor_config::fault_frame` uses the same constants and encoder).
         let groups = codegen::constants::constants(&d);
-        let can = groups.iter().find(|g| g.name == "can").unwrap();
-        let num = |name: &str| {
-            can.constants
-                .iter()
-                .find(|k| k.name == name)
-                .and_then(|k| k.value.number.as_f64())
-                .unwrap_or_else(|| panic!("{name} missing"))
-        };
+        let can = codegen::constants::group_named(&groups, "can").unwrap();
+        let num = |name: &str| can.number(name).unwrap_or_else(|| panic!("{name} missing"));
         let (fault_id, amps) = (num("FAULT_REPORT_ID") as u16, num("FAULT_CURRENT_PER_LSB") as f32);
         assert!(fault_id < l.status_id.min(board.setpoint_id), "{stem}: {fault_id:#x}");
         let sigs = message(&dbc, "FAULT_REPORT", fault_id, p::FAULT_REPORT_LEN);

@@ -42,11 +42,9 @@ enum Defect {
 
 /// A generated constant of the design's `commissioning` group.
 fn constant(d: &Design, name: &str) -> f64 {
-    codegen::constants::constants(d)
-        .iter()
-        .find(|g| g.name == "commissioning")
-        .and_then(|g| g.constants.iter().find(|k| k.name == name))
-        .and_then(|k| k.value.number.as_f64())
+    let groups = codegen::constants::constants(d);
+    codegen::constants::group_named(&groups, "commissioning")
+        .and_then(|g| g.number(name))
         .unwrap_or_else(|| panic!("no constant {name}"))
 }
 

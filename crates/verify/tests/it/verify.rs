@@ -266,10 +266,8 @@ fn estimator_without_resetting_term_slips_cycles() {
 }
 
 fn number(groups: &[codegen::constants::Group], group: &str, name: &str) -> f64 {
-    let c: &Constant = groups
-        .iter()
-        .find(|g| g.name == group)
-        .and_then(|g| g.constants.iter().find(|c| c.name == name))
+    let c: &Constant = codegen::constants::group_named(groups, group)
+        .and_then(|g| g.constant(name))
         .unwrap_or_else(|| panic!("no constant {group}::{name}"));
     c.value.number.as_f64().unwrap()
 }
@@ -365,10 +363,8 @@ fn controller_config_is_the_generated_constants() {
 
 /// The generated array constant `group::name` as f32 values.
 fn array(groups: &[codegen::constants::Group], group: &str, name: &str) -> Vec<f32> {
-    let c: &Constant = groups
-        .iter()
-        .find(|g| g.name == group)
-        .and_then(|g| g.constants.iter().find(|c| c.name == name))
+    let c: &Constant = codegen::constants::group_named(groups, group)
+        .and_then(|g| g.constant(name))
         .unwrap_or_else(|| panic!("no constant {group}::{name}"));
     let values = c
         .value
