@@ -176,6 +176,17 @@ fn aligning_pairs() -> Vec<(String, String)> {
     out
 }
 
+/// The first (sorted) of [`aligning_pairs`] on each board in `boards/`.
+fn one_pair_per_board() -> Vec<(String, String)> {
+    let mut out: Vec<(String, String)> = Vec::new();
+    for (motor, board) in aligning_pairs() {
+        if !out.iter().any(|(_, b)| *b == board) {
+            out.push((motor, board));
+        }
+    }
+    out
+}
+
 /// Correct wiring passes on every motor a free rotor aligns, on its board: no fault
 /// record, the drive back in torque mode (enabled at zero torque), the check's current
 /// reached (≥ ½·I_p: it ran) and never beyond its trip.
@@ -208,19 +219,19 @@ fn correct_wiring_passes() {
     }
 }
 
-/// `defect` refused with `cause` on every pair a free rotor aligns ([`aligning_pairs`]:
-/// every motor with a flux linkage on every board it fits), the gates off from the
-/// verdict on (20 ms watched), the current never beyond the check's trip. Each defect is
+/// `defect` refused with `cause` on one motor per board ([`one_pair_per_board`]), the
+/// gates off from the verdict on (20 ms watched), the current never beyond the check's
+/// trip. One pair per board, not every motor (CI time: the check runs 2.2–5.4 s of
+/// emulated time, the one-second turn and its two half-second holds at thesis A §6.4's
+/// rate, and the pulses — 6–25 s of wall time per run on CI's two cores); each defect is
 /// its own test so that they run in parallel.
 fn refused(defect: Defect, cause: &str) {
-    let pairs = aligning_pairs();
+    let pairs = one_pair_per_board();
     let filtered = std::env::var_os("EMULATOR_MOTORS").is_some();
-    for board in motor_test_support::board_stems() {
-        assert!(
-            filtered || pairs.iter().any(|(_, b)| *b == board),
-            "no pair on {board}: {pairs:?}"
-        );
-    }
+    assert!(
+        filtered || pairs.len() == motor_test_support::board_stems().len(),
+        "not every board has a pair: {pairs:?}"
+    );
     for (motor, board) in pairs {
         refused_on(&motor, &board, defect, cause);
     }
