@@ -342,7 +342,7 @@ impl<'a> Commissioning<'a> {
             name: "ROTATION_STEP",
             value: Custom(|c| {
                 // One electrical turn per second: 2^32 LSB of the π-scaled angle per second.
-                let step = (4_294_967_296.0 * c.ts).round().clamp(1.0, f64::from(i32::MAX));
+                let step = angle_step(1.0, c.ts);
                 (
                     intv(step as i64, "i32", "int32_t"),
                     format!("{step} LSB per period (1 electrical turn/s)"),
@@ -357,9 +357,7 @@ impl<'a> Commissioning<'a> {
             name: "PREFLIGHT_ROTATION_STEP",
             value: Custom(|c| {
                 let rate = c.preflight_rotation_rate();
-                let step = (4_294_967_296.0 * rate / std::f64::consts::TAU * c.ts)
-                    .round()
-                    .clamp(1.0, f64::from(i32::MAX));
+                let step = angle_step(rate / std::f64::consts::TAU, c.ts);
                 (
                     intv(step as i64, "i32", "int32_t"),
                     format!(
@@ -867,4 +865,13 @@ pub fn dbc_values(groups: &[Group]) -> BTreeMap<String, String> {
         }
     }
     out
+}
+
+/// The per-period increment of a π-scaled Q1.31 angle (2^32 LSB per electrical turn)
+/// turning at `turns_per_s` electrical turns per second, sampled every `ts` seconds:
+/// 2^32·T_s·turns/s, rounded, at least 1 LSB and at most i32::MAX.
+fn angle_step(turns_per_s: f64, ts: f64) -> f64 {
+    (4_294_967_296.0 * ts * turns_per_s)
+        .round()
+        .clamp(1.0, f64::from(i32::MAX))
 }
