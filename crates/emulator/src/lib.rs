@@ -127,7 +127,7 @@ fn uc_err(e: unicorn_engine::unicorn_const::uc_error) -> Stop {
 const WFI: u16 = 0xBF30;
 
 /// The addresses of every WFI encoding in the image's flash, at the flash address and at
-/// its alias at 0 (the boot mapping), sorted: a superset of the WFI instructions (a
+/// its alias at 0 (the boot mapping): a superset of the WFI instructions (a
 /// halfword of data or of a 32-bit instruction can read 0xBF30 too), told apart at the
 /// fetch by the instruction's width and address.
 fn wfi_sites(image: &Image) -> Vec<u64> {
@@ -145,7 +145,6 @@ fn wfi_sites(image: &Image) -> Vec<u64> {
             }
         }
     }
-    sites.sort_unstable();
     sites
 }
 
@@ -196,16 +195,19 @@ impl Machine {
         // Time: one instruction per HCLK cycle; stop at the deadline, and at a WFI (Thumb
         // encoding 0xBF30, ARMv7-M A7.7.261) outside a handler, whose sleep the harness
         // skips (`run_while`). Flash is mapped read/execute only, so its halfwords never
-        // change: the WFI encodings in it are found once here, and an instruction fetched
-        // from flash is a WFI when it is 16 bits wide at one of them. Code anywhere else
-        // (RAM) is read at the fetch. (Reading every instruction back through
-        // `uc_mem_read` cost about a fifth of the emulator's time.)
+        // change: the WFI encodings in it are found once here (the images have one, at
+        // two addresses with the boot alias), and an instruction fetched from flash is a
+        // WFI when it is 16 bits wide at one of them. Code anywhere else (RAM) is read at
+        // the fetch. One hook does both: Unicorn walks its list of code hooks at every
+        // instruction, and separate hooks on the WFI sites and RAM made that walk a
+        // quarter of the emulator's time (`perf`, issue 29); reading every instruction
+        // back through `uc_mem_read` cost about a fifth.
         let wfi_sites = wfi_sites(image);
         let in_flash = |a: u64| (FLASH.0..FLASH.0 + FLASH.1 as u64).contains(&a) || a < FLASH.1 as u64;
         uc.add_code_hook(1, 0, move |uc: &mut Unicorn<'_, Soc>, addr: u64, size: u32| {
             let wfi = size == 2
                 && if in_flash(addr) {
-                    wfi_sites.binary_search(&addr).is_ok()
+                    wfi_sites.contains(&addr)
                 } else {
                     let mut op = [0u8; 2];
                     uc.mem_read(addr, &mut op).is_ok() && u16::from_le_bytes(op) == WFI
@@ -436,7 +438,14 @@ impl Machine {
                 continue;
             }
             let pc = self.reg(RegisterARM::PC)?;
-            match self.uc.emu_start(u64::from(pc | 1), u64::from(EXC_RETURN & !1), 0, 0) {
+            // No `until` address (0): Unicorn invalidates the translated code at the
+            // `until` address after every run it stops (`resume_all_vcpus`), unless it is
+            // 0, and the harness starts one run per peripheral event — that invalidation
+            // was an eighth of the emulator's time (`perf`, issue 29). A handler's return,
+            // the branch to EXC_RETURN, ends the run as an error instead (below). Address
+            // 0 is flash's boot alias, the initial stack pointer's word: execution never
+            // gets there but by a branch to a null pointer, where the run stops.
+            match self.uc.emu_start(u64::from(pc | 1), 0, 0, 0) {
                 Ok(()) => {
                     if let Some(at) = self.uc.get_data_mut().wfi_at.take() {
                         // The WFI (a 16-bit instruction) is done: the core sleeps after it.
@@ -444,15 +453,25 @@ impl Machine {
                         self.uc.get_data_mut().sleeping = true;
                     } else if self.reg(RegisterARM::PC)? == EXC_RETURN & !1 {
                         self.exit()?;
+                    } else if self.reg(RegisterARM::PC)? == 0 {
+                        // A branch to address 0 executes the initial stack pointer (a RAM
+                        // address, 0x2000_xxxx) as Thumb code: on the G474 an undefined
+                        // instruction or a bus fault, escalated to HardFault (ARMv7-M
+                        // B1.5.14) — here the fault at once.
+                        let soc = self.uc.get_data_mut();
+                        soc.pc = 0;
+                        self.last_fault = Some("a branch to address 0 (a null function pointer)".to_string());
+                        self.fault()?;
                     }
                 }
                 Err(e) => {
                     if self.uc.get_data().violation.is_some() {
                         continue;
                     }
-                    // The M33 model in secure state raises its exception-exit exception for
-                    // a branch to EXC_RETURN even in thread mode (QEMU's FNC_RETURN /
-                    // EXC_RETURN check): that is the handler's return.
+                    // A branch to EXC_RETURN is the handler's return: the M33 model in
+                    // secure state raises its exception-exit exception for it even in
+                    // thread mode (QEMU's FNC_RETURN / EXC_RETURN check), or the fetch
+                    // from the unmapped address fails.
                     let pc = self.reg(RegisterARM::PC)?;
                     if !self.active.is_empty() && pc >= 0xFEFF_FFFE {
                         self.exit()?;

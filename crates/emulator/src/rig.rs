@@ -2,6 +2,8 @@
 //! board (its own description, [`crate::hardware`]), at standstill unless the test gives
 //! another analog source, with the vehicle unit's setpoint frames on the CAN bus.
 
+use std::sync::OnceLock;
+
 use codegen::design::Design;
 
 use crate::hardware::{self, Hardware};
@@ -274,10 +276,10 @@ pub fn fits(motor: &str, board: &str) -> Result<bool, String> {
     let b = BoardFile::shipped(board)?;
     let spec_file = format!("motors/{motor}.toml");
     let spec_text = std::fs::read_to_string(image::repo().join(&spec_file)).map_err(|e| format!("{spec_file}: {e}"))?;
-    // The spec alone must design (else the motor file is broken, not a misfit).
-    codegen::design_source(&spec_file, &spec_text).map_err(|e| e.to_string())?;
-    // A refusal of the pair (errors at the board's keys) is a misfit.
-    let Ok(d) = codegen::design_with_board(&spec_file, &spec_text, &b.file_name(), &b.text) else {
+    // A refusal of the pair (errors at the board's keys) is a misfit, if the spec alone
+    // designs (else the motor file is broken, not a misfit).
+    let Ok(d) = wiring::design(motor, &b.file_name(), &b.text) else {
+        codegen::design_source(&spec_file, &spec_text).map_err(|e| e.to_string())?;
         return Ok(false);
     };
     let spec = wiring::spec(motor)?;
@@ -294,6 +296,13 @@ pub fn fits(motor: &str, board: &str) -> Result<bool, String> {
 /// the same hardware is not run twice with the same motor; a board no motor fits fails
 /// too (its scenarios would run zero times).
 pub fn benches() -> Vec<(String, String)> {
+    static BENCHES: OnceLock<Vec<(String, String)>> = OnceLock::new();
+    // Once per process: deciding every pair designs every motor on every board.
+    BENCHES.get_or_init(find_benches).clone()
+}
+
+/// [`benches`], computed.
+fn find_benches() -> Vec<(String, String)> {
     let mut out = Vec::new();
     for board in motor_test_support::board_stems() {
         let hw = hardware::for_board(&board).unwrap_or_else(|| {

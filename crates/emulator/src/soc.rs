@@ -39,16 +39,24 @@ pub struct Wiring {
     pub excitation: (u8, u8),
     /// V_REF+ \[V\].
     pub vref: f64,
+    /// The pin each channel of ADC1 and ADC2 converts (the chip's table,
+    /// [`Hardware::adc_pin`]), looked up once here instead of at every conversion.
+    pub adc_pins: [[Option<&'static str>; ADC_CHANNELS]; 2],
 }
+
+/// Channels of one ADC, 0–18 (RM0440 §21.4.4: ADCx_INP0 … ADCx_INP18).
+const ADC_CHANNELS: usize = 19;
 
 impl Wiring {
     /// The wiring of `hw`.
     pub fn new(hw: Hardware) -> Self {
+        let adc_pins = std::array::from_fn(|k| std::array::from_fn(|ch| hw.adc_pin(k + 1, ch as u8)));
         Self {
             gates: hw.gate_inputs().map(|i| port_pin(i.pin)),
             break_pin: port_pin(hw.break_pin),
             excitation: port_pin(hw.excitation_pin),
             vref: hw.vref,
+            adc_pins,
             hw,
         }
     }
@@ -1059,27 +1067,28 @@ impl Soc {
         let vref = self.wiring.vref;
         let clk = self.adc_clock_s().unwrap_or(0.0);
         for k in 0..2 {
-            let hw = self.wiring.hw.clone();
+            let hw = &self.wiring.hw;
+            let pins = &self.wiring.adc_pins[k];
             let analog = &mut self.analog;
             let tim3 = &self.tim3;
             let mut problem = None;
-            let smp: Vec<(u8, f64)> = (0..19).map(|ch| (ch, self.adc[k].smp_cycles(ch))).collect();
+            let smp: [f64; ADC_CHANNELS] = std::array::from_fn(|ch| self.adc[k].smp_cycles(ch as u8));
             let name = self.adc[k].name;
             let mut currents = Vec::new();
             self.adc[k].complete(ts, |ch, at| {
-                let input = hw.adc_pin(k + 1, ch).and_then(|p| hw.analog_at(p));
-                let Some(input) = input else {
+                let pin = pins.get(usize::from(ch)).copied().flatten();
+                let Some(input) = pin.and_then(|p| hw.analog_at(p)) else {
                     problem.get_or_insert(Broken::new(
                         format!("{name}_JSQR"),
                         format!(
                             "channel {ch} ({}) converted but the board wires no signal to it",
-                            hw.adc_pin(k + 1, ch).unwrap_or("no pin")
+                            pin.unwrap_or("no pin")
                         ),
                     ));
                     return 0;
                 };
                 let fast = codegen::board::chip::is_fast_channel(ch);
-                let cycles = smp.iter().find(|(c, _)| *c == ch).map_or(0.0, |s| s.1);
+                let cycles = smp.get(usize::from(ch)).copied().unwrap_or(0.0);
                 let sampled = cycles * clk;
                 let need = codegen::board::sampling::table_time(input.source_ohm, fast);
                 let short = match need {

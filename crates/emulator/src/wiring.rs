@@ -3,6 +3,8 @@
 //! hardware has it ([`crate::hardware`], not the board file): a drive at standstill as
 //! the default analog source.
 
+use std::sync::{Mutex, PoisonError};
+
 use codegen::design::Design;
 use codegen::spec::Spec;
 
@@ -10,11 +12,33 @@ use crate::hardware::{Analog as Signal, Hardware};
 use crate::soc::Analog;
 
 /// The design of `motors/<motor>.toml` on the board file `board_file` with text
-/// `board_text` (what the image is built from).
+/// `board_text` (what the image is built from), computed once per process for each
+/// pair and board text ([`DESIGNS`]).
 pub fn design(motor: &str, board_file: &str, board_text: &str) -> Result<Design, String> {
+    let key = (motor.to_string(), board_file.to_string(), board_text.to_string());
+    let known = |designs: &DesignCache| designs.iter().find(|(k, _)| *k == key).map(|(_, d)| d.clone());
+    if let Some(d) = known(&DESIGNS.lock().unwrap_or_else(PoisonError::into_inner)) {
+        return d;
+    }
+    // Designed outside the lock: the other test thread may design another pair meanwhile.
     let (spec_file, spec) = read(&format!("motors/{motor}.toml"))?;
-    codegen::design_with_board(&spec_file, &spec, board_file, board_text).map_err(|e| e.to_string())
+    let d = codegen::design_with_board(&spec_file, &spec, board_file, board_text).map_err(|e| e.to_string());
+    DESIGNS
+        .lock()
+        .unwrap_or_else(PoisonError::into_inner)
+        .push((key, d.clone()));
+    d
 }
+
+/// (motor, board file, board text) and the design of the pair.
+type DesignCache = Vec<((String, String, String), Result<Design, String>)>;
+
+/// The designs [`design`] has computed in this process. The test binary builds well over
+/// a hundred rigs of about twenty pairs, and designing a pair (the FIR's Remez searches,
+/// the loss-minimisation table) took two thirds of a closed-loop scenario's CPU time
+/// (`perf`, issue 29); a pair's design cannot change while the process runs (its inputs
+/// are the repository's files and the variant's text in the key).
+static DESIGNS: Mutex<DesignCache> = Mutex::new(Vec::new());
 
 /// `motors/<motor>.toml` parsed: the machine data `motorgen verify`'s plant takes beyond
 /// the design (harmonics, L_q saturation).
