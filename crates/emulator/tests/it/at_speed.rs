@@ -107,6 +107,23 @@ pub(crate) struct TopSpeed {
     /// [`PROFILE_LAG_DEG`] electrical: its type-2 loop's steady lag is the resolver
     /// acceleration over K_i (times the trig identity's amplitude, through its sine).
     pub(crate) follows_m: f64,
+    /// The top mechanical speed \[rad/s\]: `top_e` over the pole pairs.
+    pub(crate) top_m: f64,
+    /// The drive's largest mechanical acceleration \[rad/s²\] (`drive.max_acceleration`).
+    pub(crate) acc_drive: f64,
+}
+
+impl TopSpeed {
+    /// The ramp's mechanical acceleration \[rad/s²\] under torque (module doc): the one
+    /// that reaches the top in [`RAMP_S`], as far as the observer follows it and at most
+    /// [`MAX_SPEEDUP`] times the drive's, and never less than the drive's.
+    pub(crate) fn ramp_acceleration(&self) -> f64 {
+        self.acc_drive.max(
+            (self.top_m / RAMP_S)
+                .min(self.follows_m)
+                .min(MAX_SPEEDUP * self.acc_drive),
+        )
+    }
 }
 
 /// [`TopSpeed`] of `design` (on a board) at the current limit `i_lim` \[A\].
@@ -135,6 +152,8 @@ pub(crate) fn top_speed(design: &codegen::design::Design, i_lim: f64) -> TopSpee
     TopSpeed {
         top_e,
         follows_m: follows_r / nr,
+        top_m: top_e / np,
+        acc_drive: design.drive.max_acceleration_rad_s2,
     }
 }
 
@@ -185,13 +204,13 @@ fn torque_along_a_speed_ramp_matches_verify() {
         let quantised = move |nm: f64| (nm / res).round().clamp(-32768.0, 32767.0) * res;
         let torque = quantised(torque_want);
         let v_prime = design.field_weakening.as_ref().map_or(0.0, |f| f.voltage_limit_v);
-        let TopSpeed { top_e, follows_m } = top_speed(&design, i_lim);
-        let acc_drive = design.drive.max_acceleration_rad_s2;
+        let top = top_speed(&design, i_lim);
+        let (top_e, acc_drive) = (top.top_e, top.acc_drive);
         // Without ψ_M the stage gives no current at any speed: the ramp takes RAMP_S.
         let acc_m = if torque > 0.0 {
-            acc_drive.max((top_e / np / RAMP_S).min(follows_m).min(MAX_SPEEDUP * acc_drive))
+            top.ramp_acceleration()
         } else {
-            top_e / np / RAMP_S
+            top.top_m / RAMP_S
         };
 
         // The frame, then standstill, the ramp and the hold (times from the frame).

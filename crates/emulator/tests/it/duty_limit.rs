@@ -24,9 +24,7 @@
 
 use std::f64::consts::PI;
 
-use crate::at_speed::{
-    CURRENT_TOLERANCE, MAX_SPEEDUP, RAMP_S, TORQUE_FLOOR, TORQUE_TOLERANCE, TopSpeed, mtpa_corner, top_speed,
-};
+use crate::at_speed::{CURRENT_TOLERANCE, TORQUE_FLOOR, TORQUE_TOLERANCE, mtpa_corner, top_speed};
 use motor_emulator::Patches;
 use motor_emulator::drive::{Drive, Sample};
 use motor_emulator::rig::{Bench, benches};
@@ -89,13 +87,12 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     let (id_c, iq_c) = mtpa_corner(psi, dl, i_lim);
     let res = b.torque_resolution_nm;
     let torque = (1.5 * np * iq_c * (psi - dl * id_c) / res).round() * res;
-    let TopSpeed { top_e, follows_m } = top_speed(&design, i_lim);
+    let top = top_speed(&design, i_lim);
+    let top_e = top.top_e;
     // At zero torque the ramp only has to keep the observer locked: as fast as its
     // allowance, not the drive's acceleration (the field-weakening loop is not judged
     // here), at least the at-speed scenario's.
-    let acc_drive = design.drive.max_acceleration_rad_s2;
-    let acc_at_speed = acc_drive.max((top_e / np / RAMP_S).min(follows_m).min(MAX_SPEEDUP * acc_drive));
-    let acc_m = acc_at_speed.max(follows_m);
+    let acc_m = top.ramp_acceleration().max(top.follows_m);
 
     let period = rig.setpoint_period_s();
     let now = rig.machine.soc().time_s();
