@@ -13,7 +13,7 @@ use crate::soc::Analog;
 
 /// The design of `motors/<motor>.toml` on the board file `board_file` with text
 /// `board_text` (what the image is built from), computed once per process for each
-/// pair and board text ([`DESIGNS`]).
+/// pair and board text (`DESIGNS`).
 pub fn design(motor: &str, board_file: &str, board_text: &str) -> Result<Design, String> {
     let key = (motor.to_string(), board_file.to_string(), board_text.to_string());
     let known = |designs: &DesignCache| designs.iter().find(|(k, _)| *k == key).map(|(_, d)| d.clone());
