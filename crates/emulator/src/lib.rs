@@ -615,14 +615,7 @@ impl Machine {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::hardware::Analog as Signal;
-
-    struct Quiet;
-    impl Analog for Quiet {
-        fn volts(&mut self, _: Signal, _: f64, _: bool) -> f64 {
-            0.0
-        }
-    }
+    use crate::soc::tests::Quiet;
 
     /// A branch to address 0 (flash's boot alias, where the initial stack pointer's word
     /// is) is a HardFault: with no `until` address a run that stopped at 0 must not be

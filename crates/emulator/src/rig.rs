@@ -274,11 +274,10 @@ pub fn first_enabled_period(m: &Machine) -> Option<f64> {
 /// every board it fits.
 pub fn fits(motor: &str, board: &str) -> Result<bool, String> {
     let b = BoardFile::shipped(board)?;
-    let spec_file = format!("motors/{motor}.toml");
-    let spec_text = std::fs::read_to_string(image::repo().join(&spec_file)).map_err(|e| format!("{spec_file}: {e}"))?;
     // A refusal of the pair (errors at the board's keys) is a misfit, if the spec alone
     // designs (else the motor file is broken, not a misfit).
     let Ok(d) = wiring::design(motor, &b.file_name(), &b.text) else {
+        let (spec_file, spec_text) = wiring::read(&format!("motors/{motor}.toml"))?;
         codegen::design_source(&spec_file, &spec_text).map_err(|e| e.to_string())?;
         return Ok(false);
     };

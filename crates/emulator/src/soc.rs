@@ -1209,11 +1209,12 @@ impl Soc {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use crate::hardware;
 
-    struct Quiet;
+    /// Every analog input at 0 V (the unit tests' source).
+    pub(crate) struct Quiet;
     impl Analog for Quiet {
         fn volts(&mut self, _: Signal, _: f64, _: bool) -> f64 {
             0.0
