@@ -579,8 +579,8 @@ fn c_div(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
 }
 
 /// A plant the loop is modelled with: R \[Ω\], L \[H\] and the loop delay in sample
-/// periods (the design's is the firmware's, `codegen::design::current_loop::
-/// FIRMWARE_LOOP_DELAY_PERIODS` through the design's request).
+/// periods (the design's through its request: the board's timing,
+/// `codegen::design::timing_of`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PlantModel {
     /// R \[Ω\].
@@ -782,15 +782,11 @@ impl Default for SimScale {
     }
 }
 
-/// The simulated bench's own loop delay \[periods\]: the duties computed at t_n act
-/// during [t_{n+1}, t_{n+2}) (`motor_sim::bench`), 1.5 with the ZOH's half period.
-pub const BENCH_DELAY_PERIODS: f64 = 1.5;
-
 impl SimScale {
     /// `KEY=FACTOR` options (`R`, `Ld`, `Lq`, `delay`; a key given twice is refused).
     /// `design_delay` is the design's loop delay \[periods\]: the perturbed delay
-    /// `delay`·design_delay must lie within one period above the bench's own
-    /// ([`BENCH_DELAY_PERIODS`]), which [`SimScale::apply`] lengthens.
+    /// `delay`·design_delay must lie within what the simulated bench makes
+    /// ([`motor_sim::plant::SIMULATED_LOOP_DELAY`]), which [`SimScale::apply`] sets.
     pub fn parse(options: &[String], design_delay: f64) -> Result<SimScale, Error> {
         let accepted = "KEY=FACTOR with KEY one of R, Ld, Lq, delay and a factor from 0.1 to 10, e.g. Lq=0.7";
         let mut s = SimScale::default();
@@ -814,17 +810,17 @@ impl SimScale {
                 "Lq" => s.lq = f,
                 "delay" => {
                     let d = f * design_delay;
-                    if !(BENCH_DELAY_PERIODS..BENCH_DELAY_PERIODS + 1.0).contains(&d) {
+                    let (lo, hi) = motor_sim::plant::SIMULATED_LOOP_DELAY;
+                    if d <= lo || d >= hi {
                         return Err(bad_option(
                             "--sim-scale",
                             format!(
-                                "delay={value} makes the loop delay {d:.3} periods; the simulated bench delays from {BENCH_DELAY_PERIODS} to below {} periods",
-                                BENCH_DELAY_PERIODS + 1.0
+                                "delay={value} makes the loop delay {d:.3} periods; the simulated bench delays from above {lo} to below {hi} periods"
                             ),
                             &format!(
-                                "a delay factor from {:.3} to below {:.3}",
-                                BENCH_DELAY_PERIODS / design_delay,
-                                (BENCH_DELAY_PERIODS + 1.0) / design_delay
+                                "a delay factor from above {:.3} to below {:.3}",
+                                lo / design_delay,
+                                hi / design_delay
                             ),
                         ));
                     }
@@ -851,15 +847,15 @@ impl SimScale {
         }
     }
 
-    /// Perturbs the simulated `plant` (its motor's R, L_d, L_q; the delay beyond the
-    /// bench's own as [`motor_sim::plant::Plant::extra_delay`]) for a design whose loop
-    /// delay is `design_delay` periods.
+    /// Perturbs the simulated `plant` (its motor's R, L_d, L_q; its loop delay,
+    /// [`motor_sim::plant::Plant::loop_delay_periods`]) for a design whose loop delay is
+    /// `design_delay` periods.
     pub fn apply(&self, plant: &mut motor_sim::plant::Plant, design_delay: f64) {
         plant.motor.resistance *= self.resistance;
         plant.motor.ld *= self.ld;
         plant.motor.lq *= self.lq;
         plant.motor.q_saturation.iter_mut().for_each(|(_, l)| *l *= self.lq);
-        plant.extra_delay = (self.delay * design_delay - BENCH_DELAY_PERIODS).max(0.0);
+        plant.loop_delay_periods = self.delay * design_delay;
     }
 }
 

@@ -338,7 +338,7 @@ pub fn pi_gains(input: TokenStream) -> syn::Result<TokenStream> {
         bandwidth_rad_s: alpha,
         damping: zeta,
         sample_period_s: ts,
-        loop_delay_s: current_loop::FIRMWARE_LOOP_DELAY_PERIODS * ts,
+        loop_delay_s: current_loop::NOMINAL_LOOP_DELAY_PERIODS * ts,
         compensate_delay,
     };
     let gains = rules::verdict(&[req])

@@ -1,8 +1,10 @@
 //! The firmware's control step and the simulated drive, stepped together with the
 //! timing of thesis A §4.6: at t_n the ADCs sample currents, DC link and resolver; the
-//! step computes duties which the timer loads at the next period, so they act during
-//! [t_{n+1}, t_{n+2}) — one period of computation plus the PWM's half-period
-//! averaging, the 1.5·T_s the angle lead (4.23) compensates.
+//! step computes duties which the timer loads at the next update, so that they act for
+//! the period after it — with the update one period after the sample, one period of
+//! computation plus the PWM's half-period averaging, the 1.5·T_s the angle lead (4.23)
+//! compensates; a board's update comes a little less than a period after its currents'
+//! sample, the loop delay its design is made for ([`Plant::loop_delay_periods`]).
 
 use std::f64::consts::PI;
 
@@ -100,7 +102,8 @@ impl Bench {
         }
     }
 
-    /// One period: sample, control, then the plant runs with the previous duties.
+    /// One period: sample, control, then the plant runs with the duties the loop delay
+    /// makes act ([`Plant::step_with`]).
     pub fn step(&mut self, demand: Demand) -> Sample {
         let sample = self.adc();
         let before = Sample {
@@ -112,11 +115,10 @@ impl Bench {
             omega_m: self.plant.omega_m(),
         };
         let out = self.cfg.process(&mut self.state, &mut SoftTrig, &sample, demand);
-        self.plant.advance();
-        self.plant.pending = match demand {
+        self.plant.step_with(match demand {
             Demand::Off => None,
             _ => Some(out.duties),
-        };
+        });
         Sample { out, ..before }
     }
 }

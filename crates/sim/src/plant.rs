@@ -167,6 +167,10 @@ pub enum Shaft {
     },
 }
 
+/// The loop delays [`Plant::step_with`] simulates [periods of T_s], both ends excluded:
+/// the update from just after the sample to just before two periods after it.
+pub const SIMULATED_LOOP_DELAY: (f64, f64) = (0.5, 2.5);
+
 /// The drive's state: currents, rotor angle, DC link, pending duties.
 #[derive(Clone, Debug)]
 pub struct Plant {
@@ -192,10 +196,16 @@ pub struct Plant {
     pub dc_link: f64,
     /// Duties loaded for the next period (computed at the previous sample); `None` = gates off.
     pub pending: Option<[f32; 3]>,
-    /// Extra loop delay as a fraction of T_s in [0, 1) (`motorgen commission --sim-scale
-    /// delay=…`): the pending duties act only after this part of the period, the
-    /// previous period's before; 0 is the bench's timing of thesis A §4.6.
+    /// The part of the period in [0, 1) during which the previous period's duties still
+    /// act before the pending ones ([`Plant::advance`]; set by [`Plant::step_with`] from
+    /// [`Plant::loop_delay_periods`]); 0: the pending duties for the whole period.
     pub extra_delay: f64,
+    /// The loop delay D [periods of T_s] [`Plant::step_with`] simulates: the duties
+    /// computed from a sample act from (D − 1/2)·T_s after it for one period, so their
+    /// mean is D·T_s after the sample. Default 1.5 (thesis A §4.6: sampled at the update);
+    /// `verify` sets the design's (a board samples a little after its trigger), `motorgen
+    /// commission --sim-scale delay=…` a perturbed one; within [`SIMULATED_LOOP_DELAY`].
+    pub loop_delay_periods: f64,
     /// The duties of the previous period (for [`Plant::extra_delay`]).
     pub previous: Option<[f32; 3]>,
     /// A winding open (0 = u, 1 = v, 2 = w; a broken lead or connector): its current is
@@ -223,6 +233,7 @@ impl Plant {
             dc_link,
             pending: None,
             extra_delay: 0.0,
+            loop_delay_periods: 1.5,
             previous: None,
             open_phase: None,
         }
@@ -270,6 +281,25 @@ impl Plant {
             phase_currents: [alpha, -0.5 * alpha + k * beta, -0.5 * alpha - k * beta],
             theta_r: self.theta_r(),
             dc_link: self.dc_link,
+        }
+    }
+
+    /// One period from the sample the `computed` duties were computed from (`None`: gates
+    /// off), with the loop delay [`Plant::loop_delay_periods`] = D: λ = D − 1/2 after the
+    /// sample the update loads them. λ < 1: the previous sample's duties for λ·T_s, then
+    /// these; λ ≥ 1: the duties of two samples ago for (λ − 1)·T_s, then the previous
+    /// sample's, these pending for the next period. A D outside [`SIMULATED_LOOP_DELAY`]
+    /// is taken at its nearest end.
+    pub fn step_with(&mut self, computed: Option<[f32; 3]>) {
+        let lag = (self.loop_delay_periods - 0.5).clamp(1e-9, 2.0 - 1e-9);
+        if lag < 1.0 {
+            self.pending = computed;
+            self.extra_delay = lag;
+            self.advance();
+        } else {
+            self.extra_delay = lag - 1.0;
+            self.advance();
+            self.pending = computed;
         }
     }
 

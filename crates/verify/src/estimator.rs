@@ -150,8 +150,7 @@ fn simulate(s: &Setup<'_>, c: &EstimatorConfig, w: f64, seconds: f64) -> Run {
             est.omega_increment,
             est.injection,
         );
-        b.plant.advance();
-        b.plant.pending = Some(out.duties);
+        b.plant.step_with(Some(out.duties));
         prev = out;
         r.t.push(t);
         r.theta_err.push(unwrapped);

@@ -353,6 +353,9 @@ impl<'a> Setup<'a> {
         );
         p.resolver_pole_pairs = d.angle_observer.resolver_pole_pairs;
         p.resolver_offset = controller::resolver_offset_rad(d);
+        // The loop delay the current loop is designed for: the board's timing
+        // (`codegen` `sections::board::control_timing`), 1.5·T_s without a board.
+        p.loop_delay_periods = d.current_loop.loop_delay_s / d.drive.sample_period_s;
         p
     }
 

@@ -276,9 +276,11 @@ pub const LOCK_LEVEL_1: u8 = 0b01;
 ///   and RCR = 1 written right after the start, before the first overflow half a period
 ///   later: the update at every overflow.
 ///
-/// Either way the compare values a control step computes from a sample take effect one
-/// period after it and hold for one period, the loop delay of 1.5·T_s the current loop
-/// is designed for (thesis A §4.6; `codegen`'s `FIRMWARE_LOOP_DELAY_PERIODS`). With the
+/// Either way the compare values a control step computes from a trigger's conversions
+/// take effect one period after the trigger and hold for one period: the loop delay of
+/// thesis A §4.6, 1.5·T_s, less the time from the trigger to the end of the currents'
+/// sampling phases (`codegen`'s `sections::board::control_timing`, which the current loop
+/// is designed with). With the
 /// update at the underflow and the sample at the maximum they would act after half a
 /// period: a faster loop than designed. Returns (RCR at init, RCR after the start —
 /// `None`: no write).

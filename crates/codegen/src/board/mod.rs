@@ -334,6 +334,30 @@ pub fn sequence_time(board: &Board, adc_hz: f64) -> f64 {
         .fold(0.0, f64::max)
 }
 
+/// The mean instant after the ADC trigger at which the phase currents the firmware uses
+/// (u and v, and w where the board senses it) are sampled \[s\]: a rank's input is held
+/// at the end of its sampling phase (RM0440 §21.4.12: t_CONV = t_SMPL + t_SAR, the input
+/// is sampled during t_SMPL), i.e. after the trigger latency (DS12288 Table 66,
+/// t_LATRINJ ≤ 3.125 cycles with CKMODE = 0b11), the ranks before it (sampling + 12.5
+/// cycles each) and its own sampling. The d and q currents mix the phases, so the loop
+/// sees their mean (a padding repeat of `sequence::lock_step` is not read).
+pub fn current_sample_instant(board: &Board, adc_hz: f64) -> f64 {
+    let phases: &[Signal] = if board.pin(Signal::CurrentW).is_some() {
+        &[Signal::CurrentU, Signal::CurrentV, Signal::CurrentW]
+    } else {
+        &[Signal::CurrentU, Signal::CurrentV]
+    };
+    let instant = |signal: Signal| {
+        board.adc.iter().find_map(|q| {
+            let rank = q.iter().position(|s| s.signal == signal && !s.padding)?;
+            let before: f64 = q[..rank].iter().map(|s| s.sampling.cycles + 12.5).sum();
+            Some((3.125 + before + q[rank].sampling.cycles) / adc_hz)
+        })
+    };
+    let held: Vec<f64> = phases.iter().filter_map(|&s| instant(s)).collect();
+    held.iter().sum::<f64>() / held.len().max(1) as f64
+}
+
 /// Whether the image must check the BOOT0 option bytes at start-up.
 pub fn checks_option_bytes(board: &Board) -> bool {
     board.boot0 == Some(Boot0Handling::OptionBytes)

@@ -754,8 +754,8 @@ pub fn lines_spanning(first: u32, n: u32) -> Option<(u16, u8)> {
 /// The routine injects d = Σ a_j·sin(ω_j·t + φ_j) (clamped to ±A) at the controller's
 /// output, a_j = A·w_j/√(2·Σw²) (`motor_control::commissioning::FrequencyResponse::
 /// line_amplitude`), on the design's default lines ([`default_lines`], the capture
-/// buffer's period). On the design's sampled loop (gains, plant R, L, the 1.5·T_s delay:
-/// L(z) of `design::current_loop::analysis::open_loop`, plant P(z) = b/(z·(z − a))) the
+/// buffer's period). On the design's sampled loop (gains, plant R, L, the loop delay:
+/// L(z) of `design::current_loop::analysis::open_loop`, plant P(z) = (b₀·z + b)/(z·(z − a))) the
 /// injection reaches the current through P/(1 + L) and the controller's output through
 /// −L/(1 + L); in periodic steady state each line's peak adds at most:
 ///
@@ -791,7 +791,7 @@ pub fn injection_limit(d: &Design) -> Option<InjectionLimit> {
             lines,
         };
         let req = d.current_loop_request(axis);
-        let plant = discrete::SampledPlant::new(req.resistance_ohm, req.inductance_h, ts);
+        let plant = discrete::plant(&req);
         let gains = match axis {
             Axis::D => &d.current_loop.d,
             Axis::Q => &d.current_loop.q,
@@ -802,7 +802,7 @@ pub fn injection_limit(d: &Design) -> Option<InjectionLimit> {
             let omega = 2.0 * std::f64::consts::PI * f64::from(k) / (f64::from(n) * ts);
             let l = analysis::open_loop(&gains, &plant, omega);
             let z = nalgebra::Complex::from_polar(1.0, omega * ts);
-            let p = plant.b / (z * (z - plant.a));
+            let p = plant.transfer(z);
             let one = nalgebra::Complex::new(1.0, 0.0);
             let a = f64::from(r.line_amplitude(j));
             gi += a * (p / (one + l)).norm();

@@ -37,7 +37,7 @@ use sections::Context;
 pub use sections::adc::AdcOut;
 pub use sections::angle_observer::ObserverOut;
 pub use sections::board::{
-    BoardOut, MIN_USABLE_VOLTAGE_FRACTION, Trip, TripSource, Trips, duty_limit_key, refuse_duty_limit,
+    BoardOut, MIN_USABLE_VOLTAGE_FRACTION, Trip, TripSource, Trips, duty_limit_key, refuse_duty_limit, timing_of,
 };
 pub use sections::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
 pub use sections::drive::DriveOut;
@@ -91,13 +91,35 @@ pub struct Design {
 /// Computes the design, or every rule it breaks, each at its key; a design with a
 /// non-finite number is never returned ([`finite`]).
 pub fn design(spec: &Spec, src: Source<'_>) -> Result<Design, Diagnostics> {
-    design_with_duty_limit(spec, src, 1.0)
+    design_on(spec, src, BoardTerms::NONE)
 }
 
-/// [`design()`] for a drive whose duty cycles may reach `max_duty` only (a board's
-/// [`duty_limit`]): the current loop's voltage limit and the field weakening's V_max
-/// are the usable fraction of U_dc/√3 it leaves ([`duty_limit::usable_voltage_fraction`]).
-pub fn design_with_duty_limit(spec: &Spec, src: Source<'_>, max_duty: f64) -> Result<Design, Diagnostics> {
+/// What a board imposes on a motor's design before its own section checks the pair
+/// (`crate::design_with_board`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BoardTerms {
+    /// The largest duty its current sensing's sampling window leaves ([`duty_limit`]): the
+    /// current loop's voltage limit and the field weakening's V_max are the usable
+    /// fraction of U_dc/√3 it leaves ([`duty_limit::usable_voltage_fraction`]).
+    pub max_duty: f64,
+    /// The loop delay D its timing makes, in periods of T_s
+    /// ([`timing_of`]): the current loop is designed for it
+    /// ([`current_loop::discrete`]).
+    pub loop_delay_periods: f64,
+}
+
+impl BoardTerms {
+    /// No board: the whole linear range and thesis A §4.6's 1.5·T_s
+    /// ([`current_loop::NOMINAL_LOOP_DELAY_PERIODS`]).
+    pub const NONE: BoardTerms = BoardTerms {
+        max_duty: 1.0,
+        loop_delay_periods: current_loop::NOMINAL_LOOP_DELAY_PERIODS,
+    };
+}
+
+/// [`design()`] for a drive on a board with `terms`.
+pub fn design_on(spec: &Spec, src: Source<'_>, terms: BoardTerms) -> Result<Design, Diagnostics> {
+    let max_duty = terms.max_duty;
     let usable = duty_limit::usable_voltage_fraction(max_duty);
     let mut cx = Context {
         spec,
@@ -105,6 +127,7 @@ pub fn design_with_duty_limit(spec: &Spec, src: Source<'_>, max_duty: f64) -> Re
         errors: Vec::new(),
         warnings: Vec::new(),
         usable_voltage_fraction: usable,
+        loop_delay_periods: terms.loop_delay_periods,
     };
     // The motor values against each other and the drive first: a value off by a unit
     // prefix is refused at its key before it makes the sections below fail confusingly.

@@ -193,6 +193,8 @@ fn check_verdict_matches_the_simulated_step() {
                         let zeta = s.current_loop.damping.as_ref().map_or(0.0, |z| z.value);
                         let ts = 1.0 / fs;
                         let r = m.phase_resistance.value;
+                        // The loop delay of this board at this f_s, as the design has it.
+                        let delay_s = d.current_loop.loop_delay_s;
                         let request = |axis, l| current_loop::Request {
                             method: s.current_loop.method,
                             axis,
@@ -201,7 +203,7 @@ fn check_verdict_matches_the_simulated_step() {
                             bandwidth_rad_s: alpha,
                             damping: zeta,
                             sample_period_s: ts,
-                            loop_delay_s: current_loop::FIRMWARE_LOOP_DELAY_PERIODS * ts,
+                            loop_delay_s: delay_s,
                             compensate_delay: compensate,
                         };
                         let (Ok(gd), Ok(gq)) = (

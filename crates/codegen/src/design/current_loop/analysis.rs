@@ -6,16 +6,18 @@
 //!
 //! # The loop
 //!
-//! With `a = e^(−R·T_s/L)`, `b = (1 − a)/R` (ZOH of 1/(Ls + R), thesis A (5.5)) and one
-//! period of computation delay (the duties computed from the samples at t_n act during
-//! [t_{n+1}, t_{n+2}): with the ZOH's half period the 1.5·T_s of thesis A §4.6):
+//! With `a = e^(−R·T_s/L)` and the ZOH of 1/(Ls + R) (thesis A (5.5)) whose voltage
+//! switches λ·T_s after the sample, `b = (e^(−R·(1−λ)·T_s/L) − a)/R` and
+//! `b₀ = (1 − e^(−R·(1−λ)·T_s/L))/R` ([`super::discrete`]; the loop delay is (λ + 1/2)·T_s;
+//! λ = 1, b₀ = 0 is the 1.5·T_s of thesis A §4.6: the duties computed from the samples
+//! at t_n act during [t_{n+1}, t_{n+2})):
 //!
 //! ```text
-//! P(z) = b / (z·(z − a))                                   plant seen from the PI output
+//! P(z) = (b₀·z + b) / (z·(z − a))                          plant seen from the PI output
 //! C(z) = k_p + k_i·T_s/(z − 1)                              forward-difference PI (4.17b)
 //! u    = C·(r_f − i) − R_a·i                                active damping (thesis B 2.31)
 //! L(z) = P(z)·(C(z) + R_a)
-//!      = b·[(k_p + R_a)(z − 1) + k_i·T_s] / [z·(z − a)·(z − 1)]
+//!      = (b₀·z + b)·[(k_p + R_a)(z − 1) + k_i·T_s] / [z·(z − a)·(z − 1)]
 //! ```
 //!
 //! `L` is the loop broken at the plant input (the inverter), where the motor's gain
@@ -23,7 +25,7 @@
 //! damping) pass through it. The closed-loop poles are the roots of `1 + L = 0`:
 //!
 //! ```text
-//! z³ − (1 + a)·z² + (a + b·K)·z + b·(k_i·T_s − K) = 0,     K = k_p + R_a
+//! z³ + (b₀·K − 1 − a)·z² + (a + b·K + b₀·M)·z + b·M = 0,   K = k_p + R_a, M = k_i·T_s − K
 //! ```
 //!
 //! found as the eigenvalues of the companion matrix (nalgebra). The reference reaches
@@ -68,7 +70,7 @@ use serde::Serialize;
 
 use super::Request;
 use super::continuous::{Pi, Prefilter, Promise, rise_time};
-use super::discrete::{LoopGains, MODELLED_DELAY_PERIODS, SampledPlant, step_response};
+use super::discrete::{LoopGains, SampledPlant, step_response};
 
 /// Smallest accepted phase margin [°] (Åström & Murray §10.3: 30°–60° typical).
 pub const MIN_PHASE_MARGIN_DEG: f64 = 45.0;
@@ -80,9 +82,11 @@ pub const OVERSHOOT_ALLOWANCE_PCT: f64 = 2.0;
 /// (with `compensate_delay`).
 pub const RISE_TOLERANCE: f64 = 0.10;
 
-/// The sampled loop's figures for one axis (all with the 1.5·T_s delay).
+/// The sampled loop's figures for one axis (all with its loop delay).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct SampledLoop {
+    /// The loop delay D = λ + 1/2 the figures are computed with [periods of T_s].
+    pub loop_delay_periods: f64,
     /// Gain margin \[dB\] at the phase crossover; null when the phase never reaches −180°
     /// below the Nyquist frequency (infinite margin).
     pub gain_margin_db: Option<f64>,
@@ -171,7 +175,8 @@ impl SampledLoop {
     pub fn describe(&self) -> String {
         let opt = |x: Option<f64>, unit: &str, none: &str| x.map_or(none.to_string(), |v| format!("{v:.1}{unit}"));
         format!(
-            "sampled loop ({MODELLED_DELAY_PERIODS}·T_s delay): phase margin {}, gain margin {}, step overshoot {}, poles |z| ≤ {:.3}",
+            "sampled loop ({:.4}·T_s delay): phase margin {}, gain margin {}, step overshoot {}, poles |z| ≤ {:.3}",
+            self.loop_delay_periods,
             opt(self.phase_margin_deg, "°", "∞"),
             opt(self.gain_margin_db, " dB", "∞"),
             opt(self.overshoot_pct, " %", "— (unstable)"),
@@ -219,14 +224,15 @@ pub fn open_loop(g: &LoopGains, p: &SampledPlant, omega: f64) -> Complex<f64> {
     let z = Complex::from_polar(1.0, omega * p.ts);
     let one = Complex::new(1.0, 0.0);
     let k = g.kp + g.active_damping;
-    p.b * (k * (z - one) + g.ki * p.ts) / (z * (z - p.a) * (z - one))
+    p.transfer(z) * (k * (z - one) + g.ki * p.ts) / (z - one)
 }
 
 /// Coefficients [c₀, c₁, c₂] of the monic characteristic polynomial
 /// z³ + c₂·z² + c₁·z + c₀ of the module documentation.
 pub fn characteristic(g: &LoopGains, p: &SampledPlant) -> [f64; 3] {
     let k = g.kp + g.active_damping;
-    [p.b * (g.ki * p.ts - k), p.a + p.b * k, -(1.0 + p.a)]
+    let m = g.ki * p.ts - k;
+    [p.b * m, p.a + p.b * k + p.b0 * m, p.b0 * k - 1.0 - p.a]
 }
 
 /// Roots of z³ + c₂z² + c₁z + c₀ (eigenvalues of the companion matrix), sorted by
@@ -339,6 +345,7 @@ pub fn analyse(g: &LoopGains, p: &SampledPlant) -> SampledLoop {
         (None, None)
     };
     SampledLoop {
+        loop_delay_periods: p.lag + 0.5,
         gain_margin_db: gm.map(|x| x.0),
         phase_crossover_rad_s: gm.map(|x| x.1),
         phase_margin_deg: pm.map(|x| x.0),

@@ -23,11 +23,12 @@
 //! (`motor_control::pi::CurrentPiConfig::process` with the generated gains, `f32`, the
 //! voltage circle and back-calculation included) and feed-forward
 //! (`motor_control::feedforward`), on the dq machine (thesis A (2.26)) at the imposed
-//! speed, integrated with RK4 on four sub-steps per period; the duties computed from the
-//! samples at t_n act during [t_{n+1}, t_{n+2}) with the angle lead of 1.5 periods (4.23),
-//! so the applied dq voltage turns by ω_e·(1.5·T_s − τ) over the period, scaled by the
-//! DC link it meets over the one it was computed for; the gates are off in the first
-//! period. The scenarios' start, settling, length and criteria are `verify`'s (it uses the
+//! speed, integrated with RK4 on four sub-steps per segment; the duties computed from the
+//! samples at t_n act from the update λ·T_s later for one period (λ = D − 1/2 of the loop
+//! delay D, [`Drive::loop_delay_periods`]; λ = 1 at thesis A §4.6's 1.5·T_s) with the
+//! angle lead of 1.5 periods (4.23), so the applied dq voltage turns by ω_e·(1.5·T_s − age)
+//! with the time since its sample, scaled by the DC link it meets over the one it was
+//! computed for; the gates are off in the first period. The scenarios' start, settling, length and criteria are `verify`'s (it uses the
 //! constants and functions here). What the model leaves out against the simulation
 //! `verify` runs — ADC quantisation, the angle observer, L_q saturation and flux
 //! harmonics — is why the search asks for a [`DESIGN_MARGIN`] beyond each criterion; on the
@@ -138,6 +139,10 @@ pub struct Drive {
     pub method: Method,
     /// ζ of pole placement (else not read).
     pub damping: f64,
+    /// The loop delay D from a current sample to the mean of the voltage it causes, in
+    /// periods (the current loop's, `current_loop::discrete`): the duties act from
+    /// (D − 1/2)·T_s after their sample.
+    pub loop_delay_periods: f64,
 }
 
 /// The decoupling scenario's figures.
@@ -257,41 +262,50 @@ impl<'a> Loop<'a> {
             // (firmware/README.md, `cordic`): the same numbers as the board.
             &mut motor_control::SoftTrig,
         );
-        self.i = self.advance();
-        self.pending = Some(([f64::from(u.d), f64::from(u.q)], sampled_dc));
+        let now = ([f64::from(u.d), f64::from(u.q)], sampled_dc);
+        self.i = self.advance(now);
+        self.pending = Some(now);
         self.i
     }
 
-    /// One period of the plant under the pending command (computed one period before,
-    /// applied with the 1.5-period angle lead: in the rotor frame it turns by
-    /// ω_e·(1.5·T_s − τ) at τ into the period's start plus one period; scaled by the DC link
-    /// it meets over the one its duties were computed with, (5.1)).
-    fn advance(&self) -> [f64; 2] {
-        let Some((u, computed_for)) = self.pending else {
+    /// One period of the plant from this sample: the pending command (computed one
+    /// period before) until the update λ·T_s into the period, then `now` (computed from
+    /// this sample), each applied with the 1.5-period angle lead — in the rotor frame it
+    /// turns by ω_e·(1.5·T_s − age), its age the time since its sample — and scaled by
+    /// the DC link it meets over the one its duties were computed with, (5.1).
+    fn advance(&self, now: ([f64; 2], f64)) -> [f64; 2] {
+        let Some(before) = self.pending else {
             // Gates off: no current (as the simulated inverter).
             return [0.0, 0.0];
         };
         let (dr, w, psi) = (self.dr, self.w, self.psi);
-        let scale = self.dc_link / computed_for;
         let ts = dr.sample_period_s;
-        let h = ts / SUBSTEPS as f64;
-        let v = |tau: f64| {
-            let a = w * (LEAD_PERIODS * ts - (ts + tau));
-            let (s, c) = a.sin_cos();
-            [scale * (c * u[0] - s * u[1]), scale * (s * u[0] + c * u[1])]
-        };
-        let f = |t: f64, x: [f64; 2]| derivative(dr, w, psi, x, v(t));
+        let update = (dr.loop_delay_periods - 0.5).clamp(0.0, 1.0) * ts;
         let mut x = self.i;
-        for k in 0..SUBSTEPS {
-            let t = k as f64 * h;
-            let k1 = f(t, x);
-            let k2 = f(t + h / 2.0, [x[0] + h / 2.0 * k1[0], x[1] + h / 2.0 * k1[1]]);
-            let k3 = f(t + h / 2.0, [x[0] + h / 2.0 * k2[0], x[1] + h / 2.0 * k2[1]]);
-            let k4 = f(t + h, [x[0] + h * k3[0], x[1] + h * k3[1]]);
-            x = [
-                x[0] + h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
-                x[1] + h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
-            ];
+        // (command, its age at the period's start, segment start, segment end)
+        for ((u, computed_for), age0, t0, t1) in [(before, ts, 0.0, update), (now, 0.0, update, ts)] {
+            if t1 <= t0 {
+                continue;
+            }
+            let scale = self.dc_link / computed_for;
+            let v = |tau: f64| {
+                let a = w * (LEAD_PERIODS * ts - (age0 + tau));
+                let (s, c) = a.sin_cos();
+                [scale * (c * u[0] - s * u[1]), scale * (s * u[0] + c * u[1])]
+            };
+            let f = |t: f64, x: [f64; 2]| derivative(dr, w, psi, x, v(t));
+            let h = (t1 - t0) / SUBSTEPS as f64;
+            for k in 0..SUBSTEPS {
+                let t = t0 + k as f64 * h;
+                let k1 = f(t, x);
+                let k2 = f(t + h / 2.0, [x[0] + h / 2.0 * k1[0], x[1] + h / 2.0 * k1[1]]);
+                let k3 = f(t + h / 2.0, [x[0] + h / 2.0 * k2[0], x[1] + h / 2.0 * k2[1]]);
+                let k4 = f(t + h, [x[0] + h * k3[0], x[1] + h * k3[1]]);
+                x = [
+                    x[0] + h / 6.0 * (k1[0] + 2.0 * k2[0] + 2.0 * k3[0] + k4[0]),
+                    x[1] + h / 6.0 * (k1[1] + 2.0 * k2[1] + 2.0 * k3[1] + k4[1]),
+                ];
+            }
         }
         x
     }

@@ -1,21 +1,31 @@
 //! Stage 2 of the current-loop pipeline ([`super`]): the loop as the firmware realises
-//! it, sampled at T_s, with the forward-difference PI (thesis A (4.17b)) and the 1.5·T_s
-//! loop delay of thesis A §4.6 (the ADC samples at t_n, the duties computed from it act
-//! during [t_{n+1}, t_{n+2})); and the delay compensation that designs the gains for it.
+//! it, sampled at T_s, with the forward-difference PI (thesis A (4.17b)) and the loop
+//! delay D·T_s from a current sample to the mean of the voltage it causes. Thesis A §4.6
+//! samples at the update instant: the duties computed from the samples at t_n act during
+//! [t_{n+1}, t_{n+2}), D = 1.5. A board samples a little after its ADC trigger (the
+//! sampling phase ends later than the trigger: `sections::board::control_timing`), so
+//! the update that loads the step's duties falls λ·T_s after the sample with
+//! λ = D − 1/2 ≤ 1, and the duties of t_n act during [t_n + λ·T_s, t_{n+1} + λ·T_s).
+//! Over [t_n, t_{n+1}) the plant then sees v(n−1) for λ·T_s and v(n) for the rest (the
+//! modified z-transform of the ZOH plant, Franklin, Powell & Workman, *Digital Control
+//! of Dynamic Systems*, §4.4.2):
 //!
 //! ```text
 //! v(n)   = k_p·(r_f(n) − i(n)) + k_i·I(n) − R_a·i(n)        PI, active damping (B 2.31)
 //! I(n+1) = I(n) + T_s·(r_f(n) − i(n))                       forward difference (4.17b)
-//! i(n+1) = a·i(n) + b·v(n−1),  a = e^(−R·T_s/L), b = (1 − a)/R
-//!          ZOH of 1/(Ls + R) (thesis A (5.5)) plus one period of computation delay
+//! i(n+1) = a·i(n) + b·v(n−1) + b₀·v(n),  a = e^(−R·T_s/L),
+//!          b = (e^(−R·(1−λ)·T_s/L) − a)/R,  b₀ = (1 − e^(−R·(1−λ)·T_s/L))/R
+//!          ZOH of 1/(Ls + R) (thesis A (5.5)) switching λ·T_s into the period
 //! r_f(n+1) = r_f(n) + c·(1 − r_f(n))                         prefilter (5.16), c = 1 − e^(−T_s/τ_f)
 //! ```
+//!
+//! At λ = 1 (D = 1.5) b₀ = 0 and b = (1 − a)/R: one whole period of computation delay.
 //!
 //! The continuous designs ([`super::continuous`]; IMC (5.8)/(2.41): rise time ln 9/α;
 //! pole placement (5.14): poles at −ζω_n ± jω_n√(1 − ζ²)) hold while α·T_s ≪ 1. Close to
 //! the sampling rate the delay speeds the loop up and then destabilises it (the discrete
 //! integrator and the delay turn the first-order loop into a second-order one: for IMC
-//! z² − z + α·T_s = 0; [`super::analysis`] computes its poles and margins).
+//! at D = 1.5 z² − z + α·T_s = 0; [`super::analysis`] computes its poles and margins).
 //!
 //! # Delay compensation (`current_loop.compensate_delay`, on by default)
 //!
@@ -35,9 +45,9 @@ use super::Request;
 use super::continuous::{self, CurrentLoopError, Pi, Prefilter, natural_frequency, rise_time};
 use crate::spec::Method;
 
-/// The loop delay this model carries, in sample periods: one period of computation
-/// (the z⁻¹ of v(n−1) above) and the ZOH's half period (thesis A §4.6).
-pub const MODELLED_DELAY_PERIODS: f64 = 1.5;
+/// The loop delays this model carries, in sample periods: from the ZOH's half period
+/// plus a sample-to-update lag λ just above 0 (exclusive) to λ = 1 (thesis A §4.6: 1.5).
+pub const MODELLED_DELAY_PERIODS: std::ops::RangeInclusive<f64> = 0.5..=1.5;
 
 /// The gains of one axis as the sampled loop sees them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -52,26 +62,49 @@ pub struct LoopGains {
     pub prefilter: f64,
 }
 
-/// The plant 1/(Ls + R) sampled with a ZOH at T_s.
+/// The plant 1/(Ls + R) sampled with a ZOH at T_s, its voltage switching λ·T_s after
+/// the sample (module documentation).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SampledPlant {
     /// a = e^(−R·T_s/L).
     pub a: f64,
-    /// b = (1 − a)/R [A/V].
+    /// b = (e^(−R·(1−λ)·T_s/L) − a)/R [A/V]: the weight of the previous period's voltage.
     pub b: f64,
+    /// b₀ = (1 − e^(−R·(1−λ)·T_s/L))/R [A/V]: the weight of the voltage computed from
+    /// this period's sample (0 at λ = 1).
+    pub b0: f64,
+    /// λ: sample to update, in periods (the loop delay is λ + 1/2 periods).
+    pub lag: f64,
     /// T_s \[s\].
     pub ts: f64,
 }
 
 impl SampledPlant {
-    /// The ZOH equivalent of 1/(Ls + R) at sample period `ts`.
+    /// The ZOH equivalent of 1/(Ls + R) at sample period `ts` with one whole period of
+    /// computation delay (λ = 1, D = 1.5: thesis A §4.6).
     pub fn new(r: f64, l: f64, ts: f64) -> Self {
+        Self::with_lag(r, l, ts, 1.0)
+    }
+
+    /// The same with the voltage switching `lag` = λ periods (0 < λ ≤ 1) after the
+    /// sample: b and b₀ of the module documentation.
+    pub fn with_lag(r: f64, l: f64, ts: f64, lag: f64) -> Self {
         let x = -r * ts / l;
+        // e^(−R·(1−λ)·T_s/L) − 1, without cancellation for small R·T_s/L.
+        let rest = (x * (1.0 - lag)).exp_m1();
         Self {
             a: x.exp(),
-            b: -x.exp_m1() / r,
+            b: (x.exp_m1() - rest) / -r,
+            b0: -rest / r,
+            lag,
             ts,
         }
+    }
+
+    /// P(z) = (b₀·z + b)/(z·(z − a)) at `z`: the current per volt of the PI output
+    /// ([`super::analysis`]).
+    pub fn transfer(&self, z: nalgebra::Complex<f64>) -> nalgebra::Complex<f64> {
+        (self.b0 * z + self.b) / (z * (z - self.a))
     }
 }
 
@@ -87,21 +120,24 @@ impl LoopGains {
     }
 }
 
-/// The sampled plant of `req`'s axis (R, L, T_s), seen through its loop delay.
+/// The sampled plant of `req`'s axis (R, L, T_s), seen through its loop delay
+/// D = `req.loop_delay_s`/T_s: λ = D − 1/2.
 ///
 /// # Panics
 ///
-/// If `req.loop_delay_s` is not [`MODELLED_DELAY_PERIODS`]·T_s (to 10⁻⁹ of T_s): the
-/// difference equations above hold exactly one period of computation delay, and another
-/// delay needs another model.
+/// If D lies outside [`MODELLED_DELAY_PERIODS`] (beyond 10⁻⁹ of T_s) or equals its lower
+/// end: the difference equations above hold a voltage that switches inside the period
+/// after the sample, and another delay needs another model. The board section refuses a
+/// board whose timing makes one (`sections::board`).
 pub fn plant(req: &Request) -> SampledPlant {
     let ts = req.sample_period_s;
     let periods = req.loop_delay_s / ts;
+    let (lo, hi) = (*MODELLED_DELAY_PERIODS.start(), *MODELLED_DELAY_PERIODS.end());
     assert!(
-        (periods - MODELLED_DELAY_PERIODS).abs() < 1e-9,
-        "the sampled current-loop model carries a loop delay of {MODELLED_DELAY_PERIODS}·T_s, not {periods}·T_s"
+        periods > lo && periods < hi + 1e-9,
+        "the sampled current-loop model carries a loop delay from above {lo}·T_s to {hi}·T_s, not {periods}·T_s"
     );
-    SampledPlant::new(req.resistance_ohm, req.inductance_h, ts)
+    SampledPlant::with_lag(req.resistance_ohm, req.inductance_h, ts, (periods - 0.5).min(1.0))
 }
 
 /// Unit step response of one axis with gains `g` on plant `p` at the sample instants t_n
@@ -118,7 +154,7 @@ pub fn step_response(g: &LoopGains, p: &SampledPlant, n: usize) -> Vec<f64> {
         let e = rf - i;
         let v = g.kp * e + g.ki * integral - g.active_damping * i;
         integral += ts * e;
-        i = p.a * i + p.b * v_prev;
+        i = p.a * i + p.b * v_prev + p.b0 * v;
         v_prev = v;
     }
     out
@@ -181,14 +217,17 @@ pub fn first_order_compensated(req: &Request) -> Result<(Pi, f64), CurrentLoopEr
 }
 
 /// Pole placement on the sampled loop (module documentation): the roots p₁, p₂ = e^{s·T_s}
-/// of the designed pair (5.13)–(5.15) and the third p₃ = 1 + a − (p₁ + p₂) (the z² coefficient
-/// −(1 + a) is fixed by the plant and the delay) give, from
-/// z³ − (1 + a)z² + (a + b·k_p)z + b(k_i·T_s − k_p) = (z² − S·z + P)(z − p₃),
-/// S = p₁ + p₂, P = p₁·p₂:
+/// of the designed pair (5.13)–(5.15), S = p₁ + p₂, P = p₁·p₂, and the third root p₃,
+/// from the characteristic polynomial of [`super::analysis`] with M = k_i·T_s − k_p,
+/// z³ + (b₀·k_p − 1 − a)z² + (a + b·k_p + b₀·M)z + b·M = (z² − S·z + P)(z − p₃):
+/// matching z², z¹ and z⁰ gives p₃ = 1 + a − S − b₀·k_p, M = −P·p₃/b and
 ///
 /// ```text
-/// k_p = (P + S·p₃ − a)/b,   k_i·T_s = k_p − P·p₃/b,   c = k_i·T_s/k_p
+/// k_p = (P + (1 + a − S)·σ − a)/(b + b₀·σ),  σ = S + b₀·P/b
+/// k_i·T_s = k_p − P·p₃/b,   c = k_i·T_s/k_p
 /// ```
+///
+/// (at λ = 1, b₀ = 0: p₃ = 1 + a − S, k_p = (P + S·p₃ − a)/b).
 ///
 /// A k_p ≤ 0 within twice the continuous rule's smallest bandwidth (the discrete
 /// counterpart of ω_n·ζ < R/(2L), thesis A §5.4.1) is refused as a right-half-plane zero
@@ -215,8 +254,9 @@ pub fn pole_placement(req: &Request) -> Result<Pi, CurrentLoopError> {
         let (s1, s2) = (-zeta * wn * ts + d, -zeta * wn * ts - d);
         (s1.exp() + s2.exp(), (s1 + s2).exp())
     };
-    let p3 = 1.0 + p.a - sum;
-    let kp = (product + sum * p3 - p.a) / p.b;
+    let sigma = sum + p.b0 * product / p.b;
+    let kp = (product + (1.0 + p.a - sum) * sigma - p.a) / (p.b + p.b0 * sigma);
+    let p3 = 1.0 + p.a - sum - p.b0 * kp;
     let ki_ts = kp - product * p3 / p.b;
     // k_p ≤ 0 near the continuous rule's limit is its right-half-plane zero; far above it
     // (poles faster than one period of delay lets the loop place) the gains go to the

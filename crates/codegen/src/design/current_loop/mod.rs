@@ -34,10 +34,13 @@ pub use motor_control::commissioning::Axis;
 
 use crate::spec::Method;
 
-/// The loop delay of the firmware's timing in sample periods (thesis A §4.6): the ADC
-/// samples at t_n, and the duties computed from those samples act during
-/// [t_{n+1}, t_{n+2}), 1.5·T_s on average. [`Request::loop_delay_s`] is set from it.
-pub const FIRMWARE_LOOP_DELAY_PERIODS: f64 = 1.5;
+/// The loop delay of thesis A §4.6 in sample periods: the ADC samples at the update
+/// instant t_n, and the duties computed from those samples act during [t_{n+1}, t_{n+2}),
+/// 1.5·T_s on average. A motor designed without a board, and the thesis's published
+/// numbers, take it; on a board the design takes the delay its timing makes
+/// (`sections::board::control_timing`: the sampling phase ends after the trigger, so a
+/// little less).
+pub const NOMINAL_LOOP_DELAY_PERIODS: f64 = 1.5;
 
 /// One axis's current-loop request: everything the stages of the pipeline read.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -56,9 +59,10 @@ pub struct Request {
     pub damping: f64,
     /// Sample period T_s = 1/f_s \[s\].
     pub sample_period_s: f64,
-    /// Delay from a current sample to the voltage it causes \[s\]:
-    /// [`FIRMWARE_LOOP_DELAY_PERIODS`]·T_s. The sampled model of [`discrete`] carries
-    /// this delay and no other ([`discrete::plant`]).
+    /// Delay from a current sample to the mean of the voltage it causes \[s\]: the
+    /// board's (`sections::board::control_timing`), or [`NOMINAL_LOOP_DELAY_PERIODS`]·T_s
+    /// without one. The sampled model of [`discrete`] carries delays from just above
+    /// 0.5·T_s to 1.5·T_s ([`discrete::plant`]).
     pub loop_delay_s: f64,
     /// Design for the sampled loop (`current_loop.compensate_delay`, [`discrete`]); else
     /// the continuous rules as they stand.
@@ -103,7 +107,7 @@ pub(crate) fn test_request(method: Method, r: f64, l: f64, alpha: f64, zeta: f64
         bandwidth_rad_s: alpha,
         damping: zeta,
         sample_period_s: ts,
-        loop_delay_s: FIRMWARE_LOOP_DELAY_PERIODS * ts,
+        loop_delay_s: NOMINAL_LOOP_DELAY_PERIODS * ts,
         compensate_delay: false,
     }
 }

@@ -11,7 +11,7 @@ use std::fmt;
 use super::analysis::{AxisGains, MIN_GAIN_MARGIN_DB, MIN_PHASE_MARGIN_DEG, OVERSHOOT_ALLOWANCE_PCT, RISE_TOLERANCE};
 use super::at_speed::Drive;
 use super::continuous::{CurrentLoopError, Promise};
-use super::{FIRMWARE_LOOP_DELAY_PERIODS, Request, axis_letter, bandwidth, design};
+use super::{Request, axis_letter, bandwidth, design};
 
 /// Why a current-loop request is refused: what is wrong (the rule and the figure that
 /// breaks it) and what would be accepted (the bandwidth that works).
@@ -162,7 +162,8 @@ pub fn floor_breach(axes: &[Request], gains: &[AxisGains], drive: Option<&Drive>
     };
     Some(Refusal {
         problem: format!(
-            "the {which} at α = {alpha:.1} rad/s (f_s = {fs} Hz, {FIRMWARE_LOOP_DELAY_PERIODS}·T_s delay{}) is {breach}; the floors are phase margin ≥ {MIN_PHASE_MARGIN_DEG}°, gain margin ≥ {MIN_GAIN_MARGIN_DB} dB (Åström & Murray §10.3), overshoot ≤ {:.1} % (designed {designed_os:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %){}",
+            "the {which} at α = {alpha:.1} rad/s (f_s = {fs} Hz, {:.4}·T_s delay{}) is {breach}; the floors are phase margin ≥ {MIN_PHASE_MARGIN_DEG}°, gain margin ≥ {MIN_GAIN_MARGIN_DB} dB (Åström & Murray §10.3), overshoot ≤ {:.1} % (designed {designed_os:.1} % + {OVERSHOOT_ALLOWANCE_PCT} %){}",
+            first.loop_delay_s / first.sample_period_s,
             if first.compensate_delay {
                 ", delay-compensated"
             } else {

@@ -20,11 +20,10 @@
 use serde::Serialize;
 
 use crate::board::{
-    ADC_CLOCK_HZ, Board, PinUse, Signal, break_active_high, break_pull, checks_option_bytes, gates,
-    samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle, warning_at,
+    ADC_CLOCK_HZ, Board, PinUse, Signal, break_active_high, break_pull, checks_option_bytes, current_sample_instant,
+    gates, samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle, warning_at,
 };
 use crate::design::Design;
-use crate::design::current_loop::FIRMWARE_LOOP_DELAY_PERIODS;
 use crate::design::duty_limit::{self, DutyBound, DutyLimit};
 use crate::diagnostic::{Diagnostic, Source};
 use crate::firmware::{self, CanBitTiming};
@@ -103,8 +102,12 @@ pub struct BoardOut {
     /// to the update event that loads the compare values the control step computed from
     /// that trigger's conversions (`control_timing`).
     pub trigger_to_update_ticks: u32,
-    /// The loop delay this timing makes \[s\]: trigger → update plus half a period, the
-    /// mean delay of the voltage held over the period after the update (thesis A §4.6).
+    /// From the ADC trigger to the mean end of the phase currents' sampling phases \[s\]
+    /// (`board::current_sample_instant`).
+    pub current_sample_instant_s: f64,
+    /// The loop delay this timing makes, which the current loop is designed for \[s\]:
+    /// from the currents' sample to the update, plus half a period, the mean delay of the
+    /// voltage held over the period after the update (thesis A §4.6).
     pub loop_delay_s: f64,
     /// The largest duty the current sensing's sampling window leaves and the voltage it
     /// leaves the design (`design::duty_limit`).
@@ -375,36 +378,37 @@ pub(in crate::design) fn board(
         }
     };
     let t_conv = sequence_time(board, ADC_CLOCK_HZ);
-    let timing = firmware::pwm_period(1.0 / ts)
-        .ok()
-        .map(|arr| control_timing(samples_at_carrier_maximum(board), arr, ts));
+    let timing = timing_of(board, d.drive.switching_frequency_hz);
     if let Some(t) = &timing {
-        let tick = 1.0 / f64::from(firmware::TIMER_CLOCK_HZ);
-        let designed = FIRMWARE_LOOP_DELAY_PERIODS * ts;
+        let designed = d.current_loop.loop_delay_s;
         // The conversions must end (and the step run) before the update that is to
-        // load its compare values; past it they would act a period later: 2.5·T_s.
+        // load its compare values; past it they would act a period later, a loop
+        // delay the sampled model does not carry (`current_loop::discrete::plant`).
         if t_conv >= t.trigger_to_update_s {
             refuse(
                 "sensing.source_resistance.current",
                 format!(
-                    "the conversions take {:.2} µs after the trigger, beyond the {:.2} µs to the update event that loads the step's compare values: the loop delay would be 2.5·T_s, not the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s the current loop of {} ({spec}) is designed for",
+                    "the conversions take {:.2} µs after the trigger, beyond the {:.2} µs to the update event that loads the step's compare values: the duties would act a period later, a loop delay of {:.2}·T_s the current loop of {} ({spec}) cannot be designed for",
                     t_conv * 1e6,
                     t.trigger_to_update_s * 1e6,
+                    t.loop_delay_s / ts + 1.0,
                     d.name
                 ),
                 "source resistances whose sampling times fit well inside one control period".into(),
             );
-        } else if (t.loop_delay_s - designed).abs() > 2.0 * tick + 1e-12 {
-            // Two ticks: the low-side trigger's one before its extreme, and ARR rounded
-            // to whole ticks (the carrier period 2·ARR ticks against 1/f_s).
+        } else if (t.loop_delay_s - designed).abs() > 1e-9 * ts {
+            // `crate::design_with_board` designs the current loop for this board's
+            // delay; a design made for another board or none is not this pair's.
             refuse(
                 "sensing.sample_instant",
                 format!(
-                    "the sampling instant and TIM1's update scheme make a loop delay of {:.3} µs, not the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s = {:.3} µs the current loop is designed for",
+                    "the sampling instant and TIM1's update scheme make a loop delay of {:.4} µs ({:.4}·T_s), but the current loop of {} ({spec}) was designed for {:.4} µs",
                     t.loop_delay_s * 1e6,
+                    t.loop_delay_s / ts,
+                    d.name,
                     designed * 1e6
                 ),
-                "high_side_centre or low_side_centre (the update event at the sampling instant)".into(),
+                "the motor designed on this board (`codegen::design_with_board`)".into(),
             );
         }
     }
@@ -486,6 +490,7 @@ pub(in crate::design) fn board(
         over_speed_electrical_rad_s: trips.over_speed_rad_s.value * f64::from(d.motor.pole_pairs),
         trips,
         trigger_to_update_ticks: timing.trigger_to_update_ticks,
+        current_sample_instant_s: timing.current_sample_instant_s,
         loop_delay_s: timing.loop_delay_s,
         duty_limit,
         can_bit_rate: can_timing.bit_rate,
@@ -601,16 +606,33 @@ pub fn offset_bound_code(board: &Board) -> i32 {
 ///   trigger, loads them — for the low-side trigger one tick later, as the trigger
 ///   precedes its extreme by one tick.
 ///
-/// The loop delay is that plus half a period: the voltage is held for the period after
-/// the update, its mean half a period later (thesis A §4.6: 1.5·T_s).
-pub fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64) -> ControlTiming {
+/// The currents are sampled `sample_instant_s` after the trigger (the end of their
+/// sampling phases, `board::current_sample_instant`), so the loop delay is the time from
+/// there to the update plus half a period: the voltage is held for the period after the
+/// update, its mean half a period later (thesis A §4.6, which samples at the update:
+/// 1.5·T_s). The current loop is designed for it (`current_loop::discrete`).
+pub fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64, sample_instant_s: f64) -> ControlTiming {
     let ticks = 2 * u32::from(arr) + u32::from(at_carrier_maximum);
     let s = f64::from(ticks) / f64::from(firmware::TIMER_CLOCK_HZ);
     ControlTiming {
         trigger_to_update_ticks: ticks,
         trigger_to_update_s: s,
-        loop_delay_s: s + 0.5 * ts,
+        current_sample_instant_s: sample_instant_s,
+        loop_delay_s: s - sample_instant_s + 0.5 * ts,
     }
+}
+
+/// [`control_timing`] of `board` at switching frequency `fs_hz` (T_s = 1/f_s, TIM1's
+/// period for it, the board's sampling instant and ADC sequences); `None` where TIM1
+/// cannot make f_s (`firmware::pwm_period`, refused at `drive.switching_frequency`).
+pub fn timing_of(board: &Board, fs_hz: f64) -> Option<ControlTiming> {
+    let arr = firmware::pwm_period(fs_hz).ok()?;
+    Some(control_timing(
+        samples_at_carrier_maximum(board),
+        arr,
+        1.0 / fs_hz,
+        current_sample_instant(board, ADC_CLOCK_HZ),
+    ))
 }
 
 /// `control_timing`'s figures.
@@ -620,7 +642,9 @@ pub struct ControlTiming {
     pub trigger_to_update_ticks: u32,
     /// The same in seconds.
     pub trigger_to_update_s: f64,
-    /// Trigger → update plus T_s/2 \[s\].
+    /// Trigger → the currents' mean sample instant \[s\].
+    pub current_sample_instant_s: f64,
+    /// Sample → update plus T_s/2 \[s\].
     pub loop_delay_s: f64,
 }
 

@@ -1,5 +1,5 @@
 //! The current-loop section: both axes through the pipeline of `design::current_loop`,
-//! judged on the sampled loop with its 1.5·T_s delay (poles, margins, overshoot:
+//! judged on the sampled loop with the board's loop delay (1.5·T_s without a board; poles, margins, overshoot:
 //! `current_loop::analysis`; a breach of its floors is an error at
 //! `current_loop.bandwidth` naming the largest bandwidth that meets them, in the words of
 //! `current_loop::rules`, which `pi_gains!` prints too), the bandwidth guidelines of thesis A §5.4.1 (warnings), the
@@ -16,7 +16,7 @@ use crate::design::current_loop::analysis::{
 };
 use crate::design::current_loop::at_speed;
 use crate::design::current_loop::continuous::{self, CurrentLoopError, Promise};
-use crate::design::current_loop::{self, Axis, FIRMWARE_LOOP_DELAY_PERIODS, Request, discrete, rules};
+use crate::design::current_loop::{self, Axis, Request, discrete, rules};
 use crate::design::thermal;
 use crate::diagnostic::{Diagnostic, Source};
 use crate::spec::{Method, Spec};
@@ -53,9 +53,12 @@ pub struct CurrentLoopOut {
     /// Designed 10–90 % rise time \[s\]: ln 9/α for first-order loops, the second-order
     /// step's with ω_n, ζ for pole placement (`current_loop::continuous`).
     pub rise_time_s: Option<f64>,
-    /// 10–90 % rise time \[s\] of the sampled d- and q-axis loops with the 1.5·T_s delay
+    /// 10–90 % rise time \[s\] of the sampled d- and q-axis loops with the loop delay
     /// (`current_loop::discrete`).
     pub sampled_rise_time_s: Option<[f64; 2]>,
+    /// The loop delay the gains are designed and judged with \[s\]: the board's
+    /// (`sections::board::control_timing`), or 1.5·T_s without one (thesis A §4.6).
+    pub loop_delay_s: f64,
     /// Each axis designed so that the sampled loop delivers α (`current_loop::discrete`): on unless
     /// the spec sets `compensate_delay = false`.
     pub compensate_delay: bool,
@@ -128,7 +131,8 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         );
     }
     let r = m.phase_resistance.value;
-    let requests = requests(spec, r, ts);
+    let delay = cx.loop_delay_periods;
+    let requests = requests(spec, r, ts, delay);
     let gains = axes(&requests)
         .map_err(|e| {
             cx.errors
@@ -137,7 +141,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         .ok();
     let promise = Promise::of(&requests[0]);
     let designed_os = promise.overshoot_pct;
-    let drive = drive(spec, r, ts, cx.max_electrical_frequency(), cx.usable_voltage_v());
+    let drive = drive(cx, r, ts);
     // The floors on both axes, then the at-speed figures (`verify`'s decoupling and
     // DC-link-step criteria): the rules `pi_gains!` applies, and those of a motor.
     if let Some((gd, gq)) = &gains {
@@ -155,7 +159,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
         let worst = t[0].min(t[1]);
         if (worst / want - 1.0).abs() > 0.10 {
             let text = format!(
-                "current loop: sampled at f_s = {fs} Hz with the {FIRMWARE_LOOP_DELAY_PERIODS}·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
+                "current loop: sampled at f_s = {fs} Hz with the {delay:.4}·T_s delay the step rises in {:.3} ms, not ln 9/α = {:.3} ms; {}",
                 worst * 1e3,
                 want * 1e3,
                 if c.compensate_delay {
@@ -169,7 +173,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             cx.warn_at(&c.bandwidth, text);
         }
     }
-    let hot = hot_variant(cx, r, ts);
+    let hot = hot_variant(cx, r, ts, delay);
     let (d, q) = gains?;
     let ramp_lag = [(&d, &requests[0]), (&q, &requests[1])]
         .iter()
@@ -191,6 +195,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             continuous::second_order(&requests[0]),
         )),
         sampled_rise_time_s: sampled_rise,
+        loop_delay_s: delay * ts,
         compensate_delay: c.compensate_delay,
         overshoot: designed_os / 100.0,
         floors: Floors {
@@ -215,8 +220,10 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
 }
 
 /// The drive the at-speed figures are judged on (`current_loop::at_speed`).
-/// `voltage_limit_v` is the usable voltage at the nominal U_dc ([`Context::usable_voltage_v`]).
-fn drive(spec: &Spec, r: f64, ts: f64, max_electrical_frequency: f64, voltage_limit_v: f64) -> at_speed::Drive {
+/// Its voltage limit is the usable voltage at the nominal U_dc ([`Context::usable_voltage_v`]),
+/// its loop delay the board's ([`Context::loop_delay_periods`]).
+fn drive(cx: &Context<'_>, r: f64, ts: f64) -> at_speed::Drive {
+    let spec = cx.spec;
     let m = &spec.motor;
     let c = &spec.current_loop;
     let zeta = c.damping.as_ref().map_or(0.0, |z| z.value);
@@ -226,19 +233,20 @@ fn drive(spec: &Spec, r: f64, ts: f64, max_electrical_frequency: f64, voltage_li
         lq: m.q_inductance.value,
         flux_linkage_wb: m.flux_linkage.as_ref().map(|p| p.value),
         peak_current_a: std::f64::consts::SQRT_2 * m.peak_current.value,
-        voltage_limit_v,
-        max_electrical_speed: 2.0 * PI * max_electrical_frequency,
+        voltage_limit_v: cx.usable_voltage_v(),
+        max_electrical_speed: 2.0 * PI * cx.max_electrical_frequency(),
         sample_period_s: ts,
         dc_link_voltage_v: spec.drive.dc_link_voltage.value,
         dc_link_voltage_min_v: spec.drive.dc_link_voltage_min.value,
         method: c.method,
         damping: zeta,
+        loop_delay_periods: cx.loop_delay_periods,
     }
 }
 
 /// The spec's current-loop requests for the d and q axes with resistance `r` \[Ω\] at
-/// sample period `ts` \[s\], with the firmware's loop delay.
-fn requests(spec: &Spec, r: f64, ts: f64) -> [Request; 2] {
+/// sample period `ts` \[s\], with the loop delay `delay` [periods of T_s].
+fn requests(spec: &Spec, r: f64, ts: f64, delay: f64) -> [Request; 2] {
     let c = &spec.current_loop;
     let m = &spec.motor;
     [(Axis::D, m.d_inductance.value), (Axis::Q, m.q_inductance.value)].map(|(axis, l)| Request {
@@ -249,15 +257,9 @@ fn requests(spec: &Spec, r: f64, ts: f64) -> [Request; 2] {
         bandwidth_rad_s: c.bandwidth.value,
         damping: c.damping.as_ref().map_or(0.0, |d| d.value),
         sample_period_s: ts,
-        loop_delay_s: loop_delay_s(ts),
+        loop_delay_s: delay * ts,
         compensate_delay: c.compensate_delay,
     })
-}
-
-/// The loop delay of the firmware's timing at sample period `ts` \[s\]
-/// ([`FIRMWARE_LOOP_DELAY_PERIODS`]·T_s), the one place the design takes it from.
-fn loop_delay_s(ts: f64) -> f64 {
-    FIRMWARE_LOOP_DELAY_PERIODS * ts
 }
 
 impl Design {
@@ -278,7 +280,7 @@ impl Design {
             bandwidth_rad_s: c.bandwidth_rad_s,
             damping: c.damping.unwrap_or(0.0),
             sample_period_s: ts,
-            loop_delay_s: loop_delay_s(ts),
+            loop_delay_s: c.loop_delay_s,
             compensate_delay: c.compensate_delay,
         }
     }
@@ -286,10 +288,10 @@ impl Design {
 
 /// The same gains for R_s at the maximum winding temperature (2.24), if `[thermal]` is given;
 /// a warning (not an error) when that design is infeasible.
-fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
+fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64, delay: f64) -> Option<HotVariant> {
     let t = cx.spec.thermal.as_ref()?;
     let r_hot = thermal::resistance_at(r, t.reference_temperature.value, t.max_winding_temperature.value);
-    let requests = requests(cx.spec, r_hot, ts);
+    let requests = requests(cx.spec, r_hot, ts, delay);
     match axes(&requests) {
         Ok((d, q)) => {
             let promise = Promise::of(&requests[0]);

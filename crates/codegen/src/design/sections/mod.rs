@@ -37,6 +37,9 @@ pub(super) struct Context<'a> {
     /// (`design::duty_limit`): 1 for a motor designed on its own or on a board with
     /// in-line sensing.
     pub usable_voltage_fraction: f64,
+    /// The loop delay the current loop is designed for, in periods of T_s (the board's,
+    /// `design::BoardTerms`).
+    pub loop_delay_periods: f64,
 }
 
 impl Context<'_> {
