@@ -75,10 +75,10 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
     let max_duty = limit.as_ref().map_or(1.0, |l| l.max_duty);
     // The current loop is designed for the delay the board's timing makes; where TIM1
     // cannot make f_s the drive section refuses it, with the nominal delay meanwhile.
-    let loop_delay_periods = design::timing_of(&board, fs).map_or(
-        design::current_loop::NOMINAL_LOOP_DELAY_PERIODS,
-        |t| t.loop_delay_s * fs,
-    );
+    let loop_delay_periods = design::timing_of(&board, fs)
+        .map_or(design::current_loop::NOMINAL_LOOP_DELAY_PERIODS, |t| {
+            t.loop_delay_s * fs
+        });
     let terms = design::BoardTerms {
         max_duty,
         loop_delay_periods,
@@ -91,14 +91,7 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
             // board does not fit for other reasons (its sensing, ratings) gets those; one
             // that only lacks the voltage gets the duty limit as the board's error, with
             // the motor's rule as a note.
-            let alone = design::design_on(
-                &spec,
-                source,
-                design::BoardTerms {
-                    max_duty: 1.0,
-                    ..terms
-                },
-            )?;
+            let alone = design::design_on(&spec, source, design::BoardTerms { max_duty: 1.0, ..terms })?;
             design::on_board(alone, &board, board_src)?;
             let l = limit.as_ref().expect("a duty limit below 1 comes from one");
             let key = design::duty_limit_key(l);

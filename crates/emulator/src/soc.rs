@@ -220,6 +220,14 @@ pub struct Soc {
     pub sleeping: bool,
     /// Address of a WFI the code hook stopped at (it then resumes after it, asleep).
     pub wfi_at: Option<u32>,
+    /// The phase currents held since the last ADC trigger: (that trigger \[bus units\],
+    /// Σ held instant − trigger \[s\], phases seen as bits, count).
+    current_held: (u64, f64, u8, u32),
+    /// Measured: per ADC trigger, the mean instant after it at which its conversions
+    /// held the phase currents \[s\] (min, max, triggers) — each phase's first
+    /// conversion, a later one of the same phase being a repeat the image discards
+    /// (ES0430 lock-step padding).
+    pub current_sample_instant: Option<(f64, f64, u64)>,
 }
 
 /// Which block an address belongs to.
@@ -340,6 +348,8 @@ impl Soc {
             switches_enabled: false,
             sleeping: false,
             wfi_at: None,
+            current_held: (0, 0.0, 0, 0),
+            current_sample_instant: None,
         };
         soc.clocks.hse_crystal_hz = soc.wiring.hw.hse_crystal_hz;
         soc.update_clock();
@@ -1123,10 +1133,36 @@ impl Soc {
                 self.fail(b);
             }
             for (ch, phase, sampling) in currents {
+                self.held_current(phase, sampling.1);
                 if let Some(b) = self.sampling_window(name, ch, phase, sampling) {
                     self.fail(b);
                 }
             }
+        }
+    }
+
+    /// Records phase `phase`'s current held at `held` \[s\] for
+    /// [`Soc::current_sample_instant`]: the held instants after the same trigger are
+    /// averaged, and a new trigger closes the last one's mean.
+    fn held_current(&mut self, phase: usize, held: f64) {
+        let Some(trigger) = self.tim1.last_trigger_at else {
+            return;
+        };
+        if self.current_held.0 != trigger {
+            let (_, sum, _, n) = self.current_held;
+            if n > 0 {
+                let mean = sum / f64::from(n);
+                self.current_sample_instant = Some(match self.current_sample_instant {
+                    None => (mean, mean, 1),
+                    Some((lo, hi, k)) => (lo.min(mean), hi.max(mean), k + 1),
+                });
+            }
+            self.current_held = (trigger, 0.0, 0, 0);
+        }
+        let bit = 1u8 << phase.min(7);
+        let (at, sum, seen, n) = self.current_held;
+        if seen & bit == 0 {
+            self.current_held = (at, sum + held - at as f64 / UNITS_PER_S, seen | bit, n + 1);
         }
     }
 

@@ -210,15 +210,45 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
             tim1.updates_disabled, 0,
             "{motor}: an update event fell inside the compare writes"
         );
+        // The loop delay the current loop is designed for (`control_timing`: from the
+        // currents' sample to the update, plus T_s/2), measured: the emulated ADCs hold
+        // each current at the end of its sampling phase; from there to the update that
+        // made the compare values active, plus half the period they are held for — within
+        // one timer tick of the design's, in every measured period.
         let loop_delay = rig.design.board.as_ref().unwrap().loop_delay_s;
+        let ts = rig.design.drive.sample_period_s;
+        let (held_lo, held_hi, held_n) = rig
+            .machine
+            .soc()
+            .current_sample_instant
+            .unwrap_or_else(|| panic!("{motor}: no phase current converted after a trigger"));
+        let units_per_s = motor_emulator::UNITS_PER_S;
+        let tick_s = units_per_tick / units_per_s;
+        let delay = [
+            lo as f64 / units_per_s - held_hi + 0.5 * ts,
+            hi as f64 / units_per_s - held_lo + 0.5 * ts,
+        ];
+        for m in delay {
+            assert!(
+                (m - loop_delay).abs() <= tick_s,
+                "{motor}: loop delay measured {:.4} µs, the design's {:.4} µs (one tick {:.2} ns)",
+                m * 1e6,
+                loop_delay * 1e6,
+                tick_s * 1e9
+            );
+        }
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
-             {:.1} % of the {cycles:.0} cycles of a period; trigger → compare values active {}–{} ticks over {n} periods (design {design_ticks}), loop delay {:.2} µs = {:.4}·T_s",
+             {:.1} % of the {cycles:.0} cycles of a period; trigger → compare values active {}–{} ticks over {n} periods (design {design_ticks}); currents held {:.4}–{:.4} µs after the trigger over {held_n} triggers; loop delay measured {:.4}–{:.4} µs, designed {:.4} µs = {:.4}·T_s",
             mean / cycles * 100.0,
             lo as f64 / units_per_tick,
             hi as f64 / units_per_tick,
+            held_lo * 1e6,
+            held_hi * 1e6,
+            delay[0] * 1e6,
+            delay[1] * 1e6,
             loop_delay * 1e6,
-            loop_delay / rig.design.drive.sample_period_s
+            loop_delay / ts
         );
         measured.push(motor_test_support::budget::Figure {
             figure: "control_interrupt".into(),

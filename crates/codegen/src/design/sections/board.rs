@@ -670,6 +670,36 @@ mod tests {
         .unwrap()
     }
 
+    /// Hand calculation (RM0440 §21.4.12, DS12288 Table 66; ADC clock 170 MHz/4 =
+    /// 42.5 MHz): both boards sense three phases, u and v first on ADC1 and ADC2, w second
+    /// on ADC1, every current sampled 24.5 cycles (the board files' sequences). Held at
+    /// 3.125 + 24.5 = 27.625 cycles (u, v) and 3.125 + 24.5 + 12.5 + 24.5 = 64.625 (w):
+    /// mean 39.958 cycles = 0.940 196 µs.
+    /// * motorgen-reference at 20 kHz (ARR 4250, trigger at the minimum): update 8500
+    ///   ticks = 50 µs after the trigger; D = (50 − 0.940 196 + 25) µs = 74.059 804 µs =
+    ///   1.481 196·T_s.
+    /// * nucleo-g474re-ihm08m1 at 40 kHz (ARR 2125, low-side trigger one tick before the
+    ///   maximum): 4251 ticks = 25.005 882 µs; D = (25.005 882 − 0.940 196 + 12.5) µs =
+    ///   36.565 686 µs = 1.462 627·T_s.
+    #[test]
+    fn loop_delay_by_hand() {
+        let reference = timing_of(&board_of("motorgen-reference"), 20e3).unwrap();
+        assert_eq!(reference.trigger_to_update_ticks, 8500);
+        assert!((reference.current_sample_instant_s - 0.940_196e-6).abs() < 1e-12);
+        assert!(
+            (reference.loop_delay_s - 74.059_804e-6).abs() < 1e-12,
+            "{}",
+            reference.loop_delay_s
+        );
+        let nucleo = timing_of(&board_of("nucleo-g474re-ihm08m1"), 40e3).unwrap();
+        assert_eq!(nucleo.trigger_to_update_ticks, 4251);
+        assert!(
+            (nucleo.loop_delay_s - 36.565_686e-6).abs() < 1e-12,
+            "{}",
+            nucleo.loop_delay_s
+        );
+    }
+
     /// N: (3·1 LSB/0.25 LSB)² = 144 → the next power of two, 256.
     #[test]
     fn offset_samples_by_hand() {
