@@ -16,7 +16,7 @@
 /* Current loop: PI gains per axis, feed-forward, torque → i_q. */
 
 /** 0.275619 V/A: k_p = α_c·L, thesis B (2.38), (2.39).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_KP = 0.2756192f;
 
 /** 330.287 V/(A·s): k_i = α_c·(R + R_a), thesis B (2.38), (2.39).
@@ -44,7 +44,7 @@ static const float CHALMERS_HEV50_CURRENT_LOOP_D_ANTI_WINDUP = 3.628194f;
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_PREFILTER = 1.0f;
 
 /** 0.671673 V/A: k_p = α_c·L, thesis B (2.38), (2.39).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KP = 0.6716734f;
 
 /** 805.616 V/(A·s): k_i = α_c·(R + R_a), thesis B (2.38), (2.39).

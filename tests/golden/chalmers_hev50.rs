@@ -10,7 +10,7 @@
 pub mod current_loop {
     /// 0.275619 V/A: `k_p = α_c·L`, thesis B (2.38), (2.39).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
     pub const D_KP: f32 = 0.2756192;
     /// 330.287 V/(A·s): `k_i = α_c·(R + R_a)`, thesis B (2.38), (2.39).
     ///
@@ -38,7 +38,7 @@ pub mod current_loop {
     pub const D_PREFILTER: f32 = 1.0;
     /// 0.671673 V/A: `k_p = α_c·L`, thesis B (2.38), (2.39).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
     pub const Q_KP: f32 = 0.6716734;
     /// 805.616 V/(A·s): `k_i = α_c·(R + R_a)`, thesis B (2.38), (2.39).
     ///

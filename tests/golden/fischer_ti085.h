@@ -16,7 +16,7 @@
 /* Current loop: PI gains per axis, feed-forward, torque → i_q. */
 
 /** 0.0389382 V/A: K_p = K_a = L·α, thesis A (5.9), (5.7).
- *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995. */
+ *  Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995. */
 static const float FISCHER_TI085_CURRENT_LOOP_D_KP = 0.03893817f;
 
 /** 12.484 V/(A·s): K_i = K_a·K_b = R·α, thesis A (5.9), (5.7).
@@ -44,7 +44,7 @@ static const float FISCHER_TI085_CURRENT_LOOP_D_ANTI_WINDUP = 25.681744f;
 static const float FISCHER_TI085_CURRENT_LOOP_D_PREFILTER = 1.0f;
 
 /** 0.0389382 V/A: K_p = K_a = L·α, thesis A (5.9), (5.7).
- *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995. */
+ *  Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995. */
 static const float FISCHER_TI085_CURRENT_LOOP_Q_KP = 0.03893817f;
 
 /** 12.484 V/(A·s): K_i = K_a·K_b = R·α, thesis A (5.9), (5.7).

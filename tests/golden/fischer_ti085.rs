@@ -10,7 +10,7 @@
 pub mod current_loop {
     /// 0.0389382 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
     pub const D_KP: f32 = 0.03893817;
     /// 12.484 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
     ///
@@ -38,7 +38,7 @@ pub mod current_loop {
     pub const D_PREFILTER: f32 = 1.0;
     /// 0.0389382 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
     pub const Q_KP: f32 = 0.03893817;
     /// 12.484 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
     ///

@@ -16,7 +16,7 @@
 /* Current loop: PI gains per axis, feed-forward, torque → i_q. */
 
 /** 0.117836 V/A: K_p = 2ζω_n·L − R, thesis A (5.14), (5.15).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5·T_s delay): phase margin 67.6°, gain margin 59.3 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 67.6°, gain margin 59.3 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_KP = 0.1178365f;
 
 /** 53.9127 V/(A·s): K_i = L·ω_n², thesis A (5.14), (5.15).
@@ -44,7 +44,7 @@ static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_ANTI_WINDUP = 8.486335f;
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_PREFILTER = 0.022876063f;
 
 /** 0.427852 V/A: K_p = 2ζω_n·L − R, thesis A (5.14), (5.15).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5·T_s delay): phase margin 70.0°, gain margin 51.0 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 70.0°, gain margin 51.0 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_KP = 0.42785177f;
 
 /** 75.6796 V/(A·s): K_i = L·ω_n², thesis A (5.14), (5.15).

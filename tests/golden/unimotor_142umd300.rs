@@ -10,7 +10,7 @@
 pub mod current_loop {
     /// 0.117836 V/A: `K_p = 2ζω_n·L − R`, thesis A (5.14), (5.15).
     ///
-    /// Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5·T_s delay): phase margin 67.6°, gain margin 59.3 dB, step overshoot 4.3 %, poles |z| ≤ 0.996.
+    /// Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 67.6°, gain margin 59.3 dB, step overshoot 4.3 %, poles |z| ≤ 0.996.
     pub const D_KP: f32 = 0.1178365;
     /// 53.9127 V/(A·s): `K_i = L·ω_n²`, thesis A (5.14), (5.15).
     ///
@@ -38,7 +38,7 @@ pub mod current_loop {
     pub const D_PREFILTER: f32 = 0.022876063;
     /// 0.427852 V/A: `K_p = 2ζω_n·L − R`, thesis A (5.14), (5.15).
     ///
-    /// Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5·T_s delay): phase margin 70.0°, gain margin 51.0 dB, step overshoot 4.3 %, poles |z| ≤ 0.996.
+    /// Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 70.0°, gain margin 51.0 dB, step overshoot 4.3 %, poles |z| ≤ 0.996.
     pub const Q_KP: f32 = 0.42785177;
     /// 75.6796 V/(A·s): `K_i = L·ω_n²`, thesis A (5.14), (5.15).
     ///

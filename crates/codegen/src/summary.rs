@@ -57,8 +57,9 @@ pub fn summary(d: &Design) -> String {
         if let Some([td, tq]) = c.sampled_rise_time_s {
             writeln!(
                 s,
-                "  rise time 10–90 %: ln 9/α = {:.3} ms; sampled loop with 1.5·T_s delay: d {:.3} ms, q {:.3} ms{}",
+                "  rise time 10–90 %: ln 9/α = {:.3} ms; sampled loop with {:.4}·T_s delay: d {:.3} ms, q {:.3} ms{}",
                 9f64.ln() / c.bandwidth_rad_s * 1e3,
+                c.loop_delay_s / d.drive.sample_period_s,
                 td * 1e3,
                 tq * 1e3,
                 if c.compensate_delay {

@@ -2,7 +2,7 @@
 //! [`ControllerConfig::process`] with [`motor_control::SoftTrig`]) configured from the
 //! design, in closed loop with a discrete-time PMSM (thesis A (2.26), optionally with
 //! thesis B's harmonics (2.14)–(2.16) and L_q saturation (2.25)), same sample period,
-//! 1.5·T_s delay.
+//! the design's loop delay (1.5·T_s, or the board's: `motor_sim::plant::Plant::loop_delay_periods`).
 //!
 //! [`SCENARIOS`] is the standard scenario set; each runs on a [`Setup`] and returns
 //! measured vs designed figures with a pass/fail criterion. A new design rule adds its

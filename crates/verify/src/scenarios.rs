@@ -182,13 +182,16 @@ pub fn current_step_checks(d: &Design, k: usize, y: &[f64], target: f64) -> Vec<
         );
     }
     // The same gains in the design's sampled-loop model (`current_loop::analysis`, T_s,
-    // 1.5·T_s delay): tells a sampling effect (both measured and predicted off the
+    // the design's loop delay): tells a sampling effect (both measured and predicted off the
     // design) from an implementation fault (measured off the prediction).
     let g = if k == 0 { &cl.d } else { &cl.q };
     let predicted = g.sampled.rise_time_s.unwrap_or(f64::NAN);
     checks.push(
         check(
-            format!("{axis}-axis rise time vs the sampled loop (T_s, 1.5·T_s delay)"),
+            format!(
+                "{axis}-axis rise time vs the sampled loop (T_s, {:.4}·T_s delay)",
+                g.sampled.loop_delay_periods
+            ),
             rise,
             Some(predicted * 1e3),
             "ms",

@@ -191,8 +191,9 @@ pub fn group(d: &Design) -> Group {
     let axes = [("D_", "d", &cl.d, &ld), ("Q_", "q", &cl.q, &lq)].map(|(prefix, axis, g, l)| {
         let alpha = if cl.compensate_delay {
             format!(
-                "α = {} (delay-compensated from {alpha}: the sampled loop with 1.5·T_s delay rises in ln 9/α_spec)",
-                phys(g.bandwidth_rad_s, "rad/s")
+                "α = {} (delay-compensated from {alpha}: the sampled loop with {:.4}·T_s delay rises in ln 9/α_spec)",
+                phys(g.bandwidth_rad_s, "rad/s"),
+                g.sampled.loop_delay_periods
             )
         } else {
             alpha.clone()

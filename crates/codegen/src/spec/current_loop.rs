@@ -18,7 +18,7 @@ pub struct CurrentLoopSpec {
     pub bandwidth: Param,
     /// ζ for pole placement.
     pub damping: Option<Param>,
-    /// Design each axis so that the sampled loop with its 1.5·T_s delay delivers α (the
+    /// Design each axis so that the sampled loop with its loop delay (1.5·T_s, or the board's) delivers α (the
     /// rise time ln 9/α of the first-order methods, the dominant pole pair of pole
     /// placement; see `design::current_loop::discrete`). On unless `compensate_delay = false`.
     pub compensate_delay: bool,

@@ -252,7 +252,7 @@ pub struct RawCurrentLoop {
     pub bandwidth: Val,
     #[serde(default)]
     pub damping: Option<Val>,
-    /// Lower α per axis so the sampled loop with its 1.5·T_s delay rises in ln 9/α.
+    /// Lower α per axis so the sampled loop with its loop delay (1.5·T_s, or the board's) rises in ln 9/α.
     #[serde(default)]
     pub compensate_delay: Option<Spanned<bool>>,
 }

@@ -422,7 +422,8 @@ pub fn html(d: &Design, v: &Verification, plots: &[Plot]) -> String {
             let c = &d.current_loop;
             let _ = writeln!(
                 s,
-                "<p>Sampled loop (T_s, 1.5·T_s delay; floors: phase margin ≥ {}°, gain margin ≥ {} dB, overshoot ≤ {:.1} %; delay compensation {}):</p>\n<ul>\n<li>d axis: {}</li>\n<li>q axis: {}</li>\n</ul>",
+                "<p>Sampled loop (T_s, {:.4}·T_s delay; floors: phase margin ≥ {}°, gain margin ≥ {} dB, overshoot ≤ {:.1} %; delay compensation {}):</p>\n<ul>\n<li>d axis: {}</li>\n<li>q axis: {}</li>\n</ul>",
+                c.loop_delay_s / d.drive.sample_period_s,
                 c.floors.min_phase_margin_deg,
                 c.floors.min_gain_margin_db,
                 c.floors.max_overshoot_pct,

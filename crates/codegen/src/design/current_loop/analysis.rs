@@ -388,7 +388,7 @@ pub struct AxisGains {
     /// The bandwidth α these gains were designed for [rad/s]: the spec's, or the lower
     /// delay-compensated one of the first-order methods ([`super::discrete`]).
     pub bandwidth_rad_s: f64,
-    /// The sampled loop with these gains: poles, margins, overshoot ([`analyse`], 1.5·T_s
+    /// The sampled loop with these gains: poles, margins, overshoot ([`analyse`], the request's
     /// delay).
     #[serde(flatten)]
     pub sampled: SampledLoop,
