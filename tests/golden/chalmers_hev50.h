@@ -16,59 +16,59 @@
 /* Current loop: PI gains per axis, feed-forward, torque → i_q. */
 
 /** 0.275619 V/A: k_p = α_c·L, thesis B (2.38), (2.39).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_KP = 0.2756192f;
 
 /** 330.287 V/(A·s): k_i = α_c·(R + R_a), thesis B (2.38), (2.39).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_KI = 330.2867f;
 
 /** 0.0330287 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_KI_TS = 0.033028673f;
 
 /** 1198.34 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_KB = 1198.3444f;
 
 /** 0.267719 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_ACTIVE_DAMPING = 0.2677192f;
 
 /** 3.62819 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_ANTI_WINDUP = 3.628194f;
 
 /** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
- *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+ *  Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_D_PREFILTER = 1.0f;
 
 /** 0.671673 V/A: k_p = α_c·L, thesis B (2.38), (2.39).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908. */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KP = 0.6716734f;
 
 /** 805.616 V/(A·s): k_i = α_c·(R + R_a), thesis B (2.38), (2.39).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KI = 805.61646f;
 
 /** 0.0805616 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KI_TS = 0.080561645f;
 
 /** 1199.42 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_KB = 1199.4169f;
 
 /** 0.663773 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.6637734f;
 
 /** 1.48882 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec). */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_ANTI_WINDUP = 1.4888188f;
 
 /** 1: y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel, thesis A (5.16).
- *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
+ *  Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec). */
 static const float CHALMERS_HEV50_CURRENT_LOOP_Q_PREFILTER = 1.0f;
 
 /** 0.00023 H: L_d in u_q,ff = ω_e(L_d·i_d + ψ_M), thesis A (5.3).

@@ -10,59 +10,59 @@
 pub mod current_loop {
     /// 0.275619 V/A: `k_p = α_c·L`, thesis B (2.38), (2.39).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.7°, gain margin 12.5 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
     pub const D_KP: f32 = 0.2756192;
     /// 330.287 V/(A·s): `k_i = α_c·(R + R_a)`, thesis B (2.38), (2.39).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_KI: f32 = 330.2867;
     /// 0.0330287 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
     pub const D_KI_TS: f32 = 0.033028673;
     /// 1198.34 rad/s: `K_b = K_i/K_p (series-form zero)`, thesis A (5.7).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_KB: f32 = 1198.3444;
     /// 0.267719 Ω: `R_a = α_c·L − R (0 unless imc_active_damping)`, thesis B (2.43).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_ACTIVE_DAMPING: f32 = 0.2677192;
     /// 3.62819 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_ANTI_WINDUP: f32 = 3.628194;
     /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
     ///
-    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    /// Inputs: L_d = 0.00023 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1198.34 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
     pub const D_PREFILTER: f32 = 1.0;
     /// 0.671673 V/A: `k_p = α_c·L`, thesis B (2.38), (2.39).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 55.3°, gain margin 12.4 dB, step overshoot 0.0 %, poles |z| ≤ 0.908.
     pub const Q_KP: f32 = 0.6716734;
     /// 805.616 V/(A·s): `k_i = α_c·(R + R_a)`, thesis B (2.38), (2.39).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_KI: f32 = 805.61646;
     /// 0.0805616 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
     pub const Q_KI_TS: f32 = 0.080561645;
     /// 1199.42 rad/s: `K_b = K_i/K_p (series-form zero)`, thesis A (5.7).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_KB: f32 = 1199.4169;
     /// 0.663773 Ω: `R_a = α_c·L − R (0 unless imc_active_damping)`, thesis B (2.43).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_ACTIVE_DAMPING: f32 = 0.6637734;
     /// 1.48882 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_ANTI_WINDUP: f32 = 1.4888188;
     /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
     ///
-    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
+    /// Inputs: L_q = 0.00056 H (datasheet), R_s = 0.0079 Ω (datasheet), α = 1199.42 rad/s (delay-compensated from α = 1470 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 10000 Hz (spec).
     pub const Q_PREFILTER: f32 = 1.0;
     /// 0.00023 H: `L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)`, thesis A (5.3).
     ///

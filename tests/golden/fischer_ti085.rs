@@ -10,59 +10,59 @@
 pub mod current_loop {
     /// 0.0389382 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
     pub const D_KP: f32 = 0.03893817;
     /// 12.484 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_KI: f32 = 12.483993;
     /// 0.0006242 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
     pub const D_KI_TS: f32 = 0.00062419963;
     /// 320.611 rad/s: `K_b = K_i/K_p (series-form zero)`, thesis A (5.7).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_KB: f32 = 320.6107;
     /// 0 Ω: `R_a = α_c·L − R (0 unless imc_active_damping)`, thesis B (2.43).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_ACTIVE_DAMPING: f32 = 0.0;
     /// 25.6817 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const D_ANTI_WINDUP: f32 = 25.681744;
     /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
     ///
-    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    /// Inputs: L_d = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
     pub const D_PREFILTER: f32 = 1.0;
     /// 0.0389382 V/A: `K_p = K_a = L·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec); sampled loop (1.5000·T_s delay): phase margin 89.4°, gain margin 46.2 dB, step overshoot 0.0 %, poles |z| ≤ 0.995.
     pub const Q_KP: f32 = 0.03893817;
     /// 12.484 V/(A·s): `K_i = K_a·K_b = R·α`, thesis A (5.9), (5.7).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_KI: f32 = 12.483993;
     /// 0.0006242 V/A: `K_i·T_s (forward-difference integrator)`, thesis A (4.17b).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
     pub const Q_KI_TS: f32 = 0.00062419963;
     /// 320.611 rad/s: `K_b = K_i/K_p (series-form zero)`, thesis A (5.7).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_KB: f32 = 320.6107;
     /// 0 Ω: `R_a = α_c·L − R (0 unless imc_active_damping)`, thesis B (2.43).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_ACTIVE_DAMPING: f32 = 0.0;
     /// 25.6817 A/V: `1/k_p in dI/dt = e + (ū − u)/k_p`, thesis B (2.49).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec).
     pub const Q_ANTI_WINDUP: f32 = 25.681744;
     /// 1: `y += a·(x − y) with a = 1, no prefilter: this method's closed loop has no zero to cancel`, thesis A (5.16).
     ///
-    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
+    /// Inputs: L_q = 0.000393 H (datasheet), R_s = 0.126 Ω (datasheet), α = 99.0793 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), f_s = 20000 Hz (spec).
     pub const Q_PREFILTER: f32 = 1.0;
     /// 0.000393 H: `L_d in u_q,ff = ω_e(L_d·i_d + ψ_M)`, thesis A (5.3).
     ///

@@ -16,59 +16,59 @@
 /* Current loop: PI gains per axis, feed-forward, torque → i_q. */
 
 /** 0.117836 V/A: K_p = 2ζω_n·L − R, thesis A (5.14), (5.15).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 67.6°, gain margin 59.3 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 67.6°, gain margin 59.3 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_KP = 0.1178365f;
 
 /** 53.9127 V/(A·s): K_i = L·ω_n², thesis A (5.14), (5.15).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_KI = 53.9127f;
 
 /** 0.00269564 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_KI_TS = 0.0026956352f;
 
 /** 457.521 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_KB = 457.52127f;
 
 /** 0 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_ACTIVE_DAMPING = 0.0f;
 
 /** 8.48634 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_ANTI_WINDUP = 8.486335f;
 
 /** 0.0228761: a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y), thesis A (5.16).
- *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
+ *  Inputs: L_d = 0.0054 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_D_PREFILTER = 0.022876063f;
 
 /** 0.427852 V/A: K_p = 2ζω_n·L − R, thesis A (5.14), (5.15).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 70.0°, gain margin 51.0 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec); sampled loop (1.5000·T_s delay): phase margin 70.0°, gain margin 51.0 dB, step overshoot 4.3 %, poles |z| ≤ 0.996. */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_KP = 0.42785177f;
 
 /** 75.6796 V/(A·s): K_i = L·ω_n², thesis A (5.14), (5.15).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_KI = 75.67958f;
 
 /** 0.00378398 V/A: K_i·T_s (forward-difference integrator), thesis A (4.17b).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_KI_TS = 0.0037839792f;
 
 /** 176.883 rad/s: K_b = K_i/K_p (series-form zero), thesis A (5.7).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_KB = 176.88272f;
 
 /** 0 Ω: R_a = α_c·L − R (0 unless imc_active_damping), thesis B (2.43).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_ACTIVE_DAMPING = 0.0f;
 
 /** 2.33726 A/V: 1/k_p in dI/dt = e + (ū − u)/k_p, thesis B (2.49).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_ANTI_WINDUP = 2.337258f;
 
 /** 0.00884414: a = 1 − exp(−T_s·K_i/K_p): y += a·(x − y), thesis A (5.16).
- *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
+ *  Inputs: L_q = 0.0076 H (identified), R_s = 0.65 Ω (identified), α = 100 rad/s (delay-compensated from α = 100 rad/s (spec): the sampled loop with 1.5000·T_s delay rises in ln 9/α_spec), ζ = 0.7071 (spec), f_s = 20000 Hz (spec). */
 static const float UNIMOTOR_142UMD300_CURRENT_LOOP_Q_PREFILTER = 0.008844136f;
 
 /** 0.0054 H: L_d in u_q,ff = ω_e(L_d·i_d + ψ_M), thesis A (5.3).

@@ -323,6 +323,12 @@ impl Board {
     }
 }
 
+/// Longest injected trigger latency \[ADC cycles\] (DS12288 Table 66, t_LATRINJ with
+/// CKMODE = 0b11).
+pub const TRIGGER_LATENCY_CYCLES: f64 = 3.125;
+/// Successive-approximation cycles of a 12-bit conversion (RM0440 §21.4.12).
+pub const CONVERSION_CYCLES: f64 = 12.5;
+
 /// Worst trigger-to-end time of a converter's sequence: latency 3 ADC cycles (DS12288
 /// Table 66, t_LATRINJ ≤ 3.125 cycles with CKMODE = 0b11) plus, per rank, sampling +
 /// 12.5 conversion cycles (RM0440 §21.4.12: T_CONV = sampling + 12.5 cycles at 12 bits).
@@ -330,7 +336,9 @@ pub fn sequence_time(board: &Board, adc_hz: f64) -> f64 {
     board
         .adc
         .iter()
-        .map(|q| (3.125 + q.iter().map(|s| s.sampling.cycles + 12.5).sum::<f64>()) / adc_hz)
+        .map(|q| {
+            (TRIGGER_LATENCY_CYCLES + q.iter().map(|s| s.sampling.cycles + CONVERSION_CYCLES).sum::<f64>()) / adc_hz
+        })
         .fold(0.0, f64::max)
 }
 
@@ -350,8 +358,8 @@ pub fn current_sample_instant(board: &Board, adc_hz: f64) -> f64 {
     let instant = |signal: Signal| {
         board.adc.iter().find_map(|q| {
             let rank = q.iter().position(|s| s.signal == signal && !s.padding)?;
-            let before: f64 = q[..rank].iter().map(|s| s.sampling.cycles + 12.5).sum();
-            Some((3.125 + before + q[rank].sampling.cycles) / adc_hz)
+            let before: f64 = q[..rank].iter().map(|s| s.sampling.cycles + CONVERSION_CYCLES).sum();
+            Some((TRIGGER_LATENCY_CYCLES + before + q[rank].sampling.cycles) / adc_hz)
         })
     };
     let held: Vec<f64> = phases.iter().filter_map(|&s| instant(s)).collect();

@@ -154,11 +154,7 @@ pub fn current_ranks(board: &crate::board::Board, adc_hz: f64) -> Vec<CurrentRan
     out
 }
 
-/// Longest injected trigger latency \[ADC cycles\] (DS12288 Table 66, t_LATRINJ with
-/// CKMODE = 0b11, as `board::sequence_time`).
-pub const TRIGGER_LATENCY_CYCLES: f64 = 3.125;
-/// Successive-approximation cycles of a 12-bit conversion (RM0440 §21.4.12).
-pub const CONVERSION_CYCLES: f64 = 12.5;
+pub use crate::board::{CONVERSION_CYCLES, TRIGGER_LATENCY_CYCLES};
 
 /// h of the module documentation \[s\]: the larger of the two conditions over `ranks`,
 /// with `tick_s` the trigger's lead before the carrier maximum; and which one set it.

@@ -165,7 +165,15 @@ fn frequency_response_on_the_simulated_drive() {
     let o = motorgen(&[&base[..], &["--sim-scale", "Lq=0.7"]].concat());
     assert_eq!(o.status.code(), Some(0), "{}", text_of(&o));
     let stdout = String::from_utf8_lossy(&o.stdout);
-    assert!(stdout.contains("L_q is -30.0 % off the spec"), "{stdout}");
+    // The simulated L_q is 0.7 of the spec's: the fit names −30 % (within the 5 % the
+    // frequency-response tests hold the fit to; measured −29.9 %).
+    let off: f64 = stdout
+        .split("L_q is ")
+        .nth(1)
+        .and_then(|s| s.split(" % off the spec").next())
+        .and_then(|s| s.trim().parse().ok())
+        .unwrap_or_else(|| panic!("no `L_q is … % off the spec` in {stdout}"));
+    assert!((off + 30.0).abs() <= 0.5, "{off} % in {stdout}");
     let json = std::fs::read_to_string(dir.join("out/frequency-response-q.json")).unwrap();
     for key in [
         "\"axis\": \"q\"",

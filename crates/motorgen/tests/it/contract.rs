@@ -141,8 +141,18 @@ fn every_command_prints_each_warning_once_on_stderr_located() {
         let got = warnings(&stderr);
         let unique: BTreeSet<&String> = got.iter().collect();
         assert_eq!(unique.len(), got.len(), "{args:?}: a warning printed twice:\n{stderr}");
-        // The board's own warnings come on top with --board; the motor's are all there.
-        assert!(want.is_subset(&unique), "{args:?}: {want:?} not all in\n{stderr}");
+        // The board's own warnings come on top with --board; the motor's are all there —
+        // the current loop's delay warning at its key with the board's loop delay
+        // (`design::timing_of`) and the rise time it makes, so it is compared up to there.
+        let upto_delay = |w: &&String| w.split(" with the ").next().unwrap_or(w).to_string();
+        let (want_cut, unique_cut): (BTreeSet<String>, BTreeSet<String>) = (
+            want.iter().map(upto_delay).collect(),
+            unique.iter().map(upto_delay).collect(),
+        );
+        assert!(
+            want_cut.is_subset(&unique_cut),
+            "{args:?}: {want:?} not all in\n{stderr}"
+        );
         if !args.contains(&"--board") {
             assert_eq!(unique, want, "{args:?}");
         }
