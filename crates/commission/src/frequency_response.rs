@@ -679,7 +679,7 @@ fn solve3(mut a: [[f64; 3]; 3], mut b: [f64; 3]) -> Option<[f64; 3]> {
 }
 
 /// R, L and the loop delay fitted to `points` with the loop's gains `g` at `ts`:
-/// Levenberg–Marquardt on (ln R, ln L, D) ([`fit_from`]) from `start` and from its
+/// Levenberg–Marquardt on (ln R, ln L, D) (`fit_from`) from `start` and from its
 /// delay half a period and one period longer, the fit with the least rms error kept. The
 /// delay enters L(e^{jωT_s}) as a phase that grows with ω, so a start on the wrong side
 /// of the true delay can settle where a longer inductance trades against a shorter delay

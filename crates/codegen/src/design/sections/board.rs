@@ -622,7 +622,7 @@ pub fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64, sample_instan
     }
 }
 
-/// [`control_timing`] of `board` at switching frequency `fs_hz` (T_s = 1/f_s, TIM1's
+/// `control_timing` of `board` at switching frequency `fs_hz` (T_s = 1/f_s, TIM1's
 /// period for it, the board's sampling instant and ADC sequences); `None` where TIM1
 /// cannot make f_s (`firmware::pwm_period`, refused at `drive.switching_frequency`).
 pub fn timing_of(board: &Board, fs_hz: f64) -> Option<ControlTiming> {
