@@ -106,7 +106,7 @@ static const float UNIMOTOR_142UMD300_CURRENT_LOOP_IQ_PER_NM = 0.0f;
 #define UNIMOTOR_142UMD300_OBSERVER_RESOLVER_POLE_PAIRS UINT32_C(1)
 
 /** 1.5 samples: k in Q16.16: θ_e,lead = θ_e + (ω_e^i·LEAD) >> 16, thesis A (4.19), (4.23).
- *  Inputs: k = 1.5 samples (default: 1.5·T_s delay, thesis A §4.6). */
+ *  Inputs: k = 1.5 samples (default: the delay from the resolver's sample to the voltage's mean — the board's timing, 1.5·T_s without a board, thesis A §4.6). */
 #define UNIMOTOR_142UMD300_OBSERVER_LEAD_Q16 INT32_C(98304)
 
 /** 0 rad = 0°: θ_off/π wrapped into ±π, Q1.31 (0 until identified at commissioning, (6.9)), thesis A (4.5), (6.9).

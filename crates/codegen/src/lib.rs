@@ -73,15 +73,15 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
         return Err(Diagnostics(vec![e]));
     }
     let max_duty = limit.as_ref().map_or(1.0, |l| l.max_duty);
-    // The current loop is designed for the delay the board's timing makes; where TIM1
-    // cannot make f_s the drive section refuses it, with the nominal delay meanwhile.
-    let loop_delay_periods = design::timing_of(&board, fs)
-        .map_or(design::current_loop::NOMINAL_LOOP_DELAY_PERIODS, |t| {
-            t.loop_delay_s * fs
-        });
+    // The current loop is designed for the delay the board's timing makes, the angle
+    // lead for its resolver's; where TIM1 cannot make f_s the drive section refuses it,
+    // with the nominal delay meanwhile.
+    let timing = design::timing_of(&board, fs);
+    let nominal = design::current_loop::NOMINAL_LOOP_DELAY_PERIODS;
     let terms = design::BoardTerms {
         max_duty,
-        loop_delay_periods,
+        loop_delay_periods: timing.map_or(nominal, |t| t.loop_delay_s * fs),
+        angle_lead_periods: timing.map_or(nominal, |t| t.angle_lead_periods),
     };
     match design::design_on(&spec, source, terms) {
         Ok(d) => design::on_board(d, &board, board_src),

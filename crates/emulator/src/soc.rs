@@ -220,14 +220,17 @@ pub struct Soc {
     pub sleeping: bool,
     /// Address of a WFI the code hook stopped at (it then resumes after it, asleep).
     pub wfi_at: Option<u32>,
-    /// The phase currents held since the last ADC trigger: (that trigger \[bus units\],
-    /// Σ held instant − trigger \[s\], phases seen as bits, count).
-    current_held: (u64, f64, u8, u32),
+    /// The phase currents ([0]) and the resolver's SIN and COS ([1]) held since the last
+    /// ADC trigger: (that trigger \[bus units\], Σ held instant − trigger \[s\], inputs
+    /// seen as bits, count).
+    held: [(u64, f64, u8, u32); 2],
     /// Measured: per ADC trigger, the mean instant after it at which its conversions
     /// held the phase currents \[s\] (min, max, triggers) — each phase's first
     /// conversion, a later one of the same phase being a repeat the image discards
     /// (ES0430 lock-step padding).
     pub current_sample_instant: Option<(f64, f64, u64)>,
+    /// The same for the resolver's SIN and COS.
+    pub resolver_sample_instant: Option<(f64, f64, u64)>,
 }
 
 /// Which block an address belongs to.
@@ -348,8 +351,9 @@ impl Soc {
             switches_enabled: false,
             sleeping: false,
             wfi_at: None,
-            current_held: (0, 0.0, 0, 0),
+            held: [(0, 0.0, 0, 0); 2],
             current_sample_instant: None,
+            resolver_sample_instant: None,
         };
         soc.clocks.hse_crystal_hz = soc.wiring.hw.hse_crystal_hz;
         soc.update_clock();
@@ -1085,6 +1089,7 @@ impl Soc {
             let smp: [f64; ADC_CHANNELS] = std::array::from_fn(|ch| self.adc[k].smp_cycles(ch as u8));
             let name = self.adc[k].name;
             let mut currents = Vec::new();
+            let mut resolver = Vec::new();
             self.adc[k].complete(ts, |ch, at| {
                 let pin = pins.get(usize::from(ch)).copied().flatten();
                 let Some(input) = pin.and_then(|p| hw.analog_at(p)) else {
@@ -1122,8 +1127,11 @@ impl Soc {
                 // The rank ends at `at`; its input was held SAR_CYCLES earlier, at the end
                 // of its sampling phase (§21.4.12).
                 let held = at - SAR_CYCLES * clk;
-                if let crate::hardware::Analog::Current(phase) = input.signal {
-                    currents.push((ch, phase, (held - sampled, held)));
+                match input.signal {
+                    crate::hardware::Analog::Current(phase) => currents.push((ch, phase, (held - sampled, held))),
+                    crate::hardware::Analog::Sin => resolver.push((0, held)),
+                    crate::hardware::Analog::Cos => resolver.push((1, held)),
+                    crate::hardware::Analog::DcLink => {}
                 }
                 let v = analog.volts(input.signal, held, tim3.output((held * UNITS_PER_S) as u64));
                 // Ideal 12-bit conversion: code = V/V_REF·4096, clamped (RM0440 §21.4.1).
@@ -1132,8 +1140,11 @@ impl Soc {
             if let Some(b) = problem {
                 self.fail(b);
             }
+            for (input, held) in resolver {
+                self.held_input(1, input, held);
+            }
             for (ch, phase, sampling) in currents {
-                self.held_current(phase, sampling.1);
+                self.held_input(0, phase, sampling.1);
                 if let Some(b) = self.sampling_window(name, ch, phase, sampling) {
                     self.fail(b);
                 }
@@ -1141,28 +1152,34 @@ impl Soc {
         }
     }
 
-    /// Records phase `phase`'s current held at `held` \[s\] for
-    /// [`Soc::current_sample_instant`]: the held instants after the same trigger are
+    /// Records input `input` of kind `kind` (0: a phase current, 1: the resolver's SIN
+    /// or COS) held at `held` \[s\] for [`Soc::current_sample_instant`] and
+    /// [`Soc::resolver_sample_instant`]: the held instants after the same trigger are
     /// averaged, and a new trigger closes the last one's mean.
-    fn held_current(&mut self, phase: usize, held: f64) {
+    fn held_input(&mut self, kind: usize, input: usize, held: f64) {
         let Some(trigger) = self.tim1.last_trigger_at else {
             return;
         };
-        if self.current_held.0 != trigger {
-            let (_, sum, _, n) = self.current_held;
+        if self.held[kind].0 != trigger {
+            let (_, sum, _, n) = self.held[kind];
             if n > 0 {
                 let mean = sum / f64::from(n);
-                self.current_sample_instant = Some(match self.current_sample_instant {
+                let stat = if kind == 0 {
+                    &mut self.current_sample_instant
+                } else {
+                    &mut self.resolver_sample_instant
+                };
+                *stat = Some(match *stat {
                     None => (mean, mean, 1),
                     Some((lo, hi, k)) => (lo.min(mean), hi.max(mean), k + 1),
                 });
             }
-            self.current_held = (trigger, 0.0, 0, 0);
+            self.held[kind] = (trigger, 0.0, 0, 0);
         }
-        let bit = 1u8 << phase.min(7);
-        let (at, sum, seen, n) = self.current_held;
+        let bit = 1u8 << input.min(7);
+        let (at, sum, seen, n) = self.held[kind];
         if seen & bit == 0 {
-            self.current_held = (at, sum + held - at as f64 / UNITS_PER_S, seen | bit, n + 1);
+            self.held[kind] = (at, sum + held - at as f64 / UNITS_PER_S, seen | bit, n + 1);
         }
     }
 

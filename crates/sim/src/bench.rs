@@ -48,7 +48,7 @@ pub struct Sample {
     pub i: [f64; 2],
     /// The controller's output at t_n.
     pub out: StepOutput,
-    /// True resolver angle θ_r(t_n) \[rad\].
+    /// True resolver angle at its sampling instant (t_n + `Plant::resolver_lag_s`) \[rad\].
     pub theta_r: f64,
     /// True electrical angle θ_e(t_n) = n_p·θ_m \[rad\].
     pub theta_e: f64,
@@ -63,7 +63,7 @@ impl Bench {
         let mut state = ControllerState::new();
         let w_r = plant.resolver_ratio() * plant.omega_m() * plant.ts; // rad per sample
         state.observer = AtoState::locked(
-            angle::from_radians_f64(plant.theta_r() - w_r),
+            angle::from_radians_f64(plant.measure().theta_r - w_r),
             (w_r / PI * Q31).round() as i32,
         );
         Self {
@@ -110,7 +110,7 @@ impl Bench {
             t: self.plant.t,
             i: self.plant.i,
             out: StepOutput::default(),
-            theta_r: self.plant.theta_r(),
+            theta_r: self.plant.measure().theta_r,
             theta_e: self.plant.theta_e(),
             omega_m: self.plant.omega_m(),
         };

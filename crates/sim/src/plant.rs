@@ -206,6 +206,10 @@ pub struct Plant {
     /// `verify` sets the design's (a board samples a little after its trigger), `motorgen
     /// commission --sim-scale delay=…` a perturbed one; within [`SIMULATED_LOOP_DELAY`].
     pub loop_delay_periods: f64,
+    /// The resolver is held this long after the currents \[s\] (a board converts it later
+    /// in its ADC sequences; `verify` sets the design's, 0 default): [`Plant::measure`]
+    /// reports θ_r then, θ_r + dθ_r/dt·lag (exact at a constant speed).
+    pub resolver_lag_s: f64,
     /// The duties of the previous period (for [`Plant::extra_delay`]).
     pub previous: Option<[f32; 3]>,
     /// A winding open (0 = u, 1 = v, 2 = w; a broken lead or connector): its current is
@@ -234,6 +238,7 @@ impl Plant {
             pending: None,
             extra_delay: 0.0,
             loop_delay_periods: 1.5,
+            resolver_lag_s: 0.0,
             previous: None,
             open_phase: None,
         }
@@ -279,7 +284,7 @@ impl Plant {
         let k = 3f64.sqrt() / 2.0;
         Measured {
             phase_currents: [alpha, -0.5 * alpha + k * beta, -0.5 * alpha - k * beta],
-            theta_r: self.theta_r(),
+            theta_r: self.theta_r() + self.resolver_ratio() * self.omega_m() * self.resolver_lag_s,
             dc_link: self.dc_link,
         }
     }

@@ -356,6 +356,12 @@ impl<'a> Setup<'a> {
         // The loop delay the current loop is designed for: the board's timing
         // (`codegen` `sections::board::control_timing`), 1.5·T_s without a board.
         p.loop_delay_periods = d.current_loop.loop_delay_s / d.drive.sample_period_s;
+        // The resolver held later in the ADC sequences than the currents (the angle
+        // lead is designed from its instant, `sections::board::control_timing`).
+        p.resolver_lag_s = d
+            .board
+            .as_ref()
+            .map_or(0.0, |b| b.resolver_sample_instant_s - b.current_sample_instant_s);
         p
     }
 

@@ -59,7 +59,7 @@ pub fn ato_lock(s: &Setup<'_>) -> ScenarioResult {
     let o = &s.design.angle_observer;
     let ts = s.design.drive.sample_period_s;
     let mut b = s.bench(0.0);
-    b.state.observer = AtoState::locked(from_radians_f64(b.plant.theta_r() - LOCK_INITIAL_ERROR), 0);
+    b.state.observer = AtoState::locked(from_radians_f64(b.plant.measure().theta_r - LOCK_INITIAL_ERROR), 0);
     let wn = o.natural_frequency_rad_s;
     let n = samples(s, 25.0 / (o.damping.min(1.0) * wn));
     let mut e = Vec::with_capacity(n);

@@ -355,6 +355,18 @@ pub fn current_sample_instant(board: &Board, adc_hz: f64) -> f64 {
     } else {
         &[Signal::CurrentU, Signal::CurrentV]
     };
+    sample_instant(board, phases, adc_hz)
+}
+
+/// The mean instant after the ADC trigger at which the resolver's SIN and COS are held
+/// \[s\] ([`current_sample_instant`]'s rule): the angle observer's input, which the
+/// angle lead (thesis A (4.23)) carries to the voltage's mean.
+pub fn resolver_sample_instant(board: &Board, adc_hz: f64) -> f64 {
+    sample_instant(board, &[Signal::ResolverSin, Signal::ResolverCos], adc_hz)
+}
+
+/// The mean hold instant of `signals` after the trigger \[s\] (each signal's first rank).
+fn sample_instant(board: &Board, signals: &[Signal], adc_hz: f64) -> f64 {
     let instant = |signal: Signal| {
         board.adc.iter().find_map(|q| {
             let rank = q.iter().position(|s| s.signal == signal && !s.padding)?;
@@ -362,7 +374,7 @@ pub fn current_sample_instant(board: &Board, adc_hz: f64) -> f64 {
             Some((TRIGGER_LATENCY_CYCLES + before + q[rank].sampling.cycles) / adc_hz)
         })
     };
-    let held: Vec<f64> = phases.iter().filter_map(|&s| instant(s)).collect();
+    let held: Vec<f64> = signals.iter().filter_map(|&s| instant(s)).collect();
     held.iter().sum::<f64>() / held.len().max(1) as f64
 }
 

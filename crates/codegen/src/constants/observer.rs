@@ -68,7 +68,7 @@ impl<'a> Observer<'a> {
             inputs: Of(|c| match c.o.lead_samples_source {
                 Provenance::Default => {
                     format!(
-                        "k = {} samples (default: 1.5·T_s delay, thesis A §4.6)",
+                        "k = {} samples (default: the delay from the resolver's sample to the voltage's mean — the board's timing, 1.5·T_s without a board, thesis A §4.6)",
                         c.o.lead_samples
                     )
                 }

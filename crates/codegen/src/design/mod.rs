@@ -106,6 +106,10 @@ pub struct BoardTerms {
     /// ([`timing_of`]): the current loop is designed for it
     /// ([`current_loop::discrete`]).
     pub loop_delay_periods: f64,
+    /// The delay from its resolver sample to the voltage's mean, in periods of T_s
+    /// ([`timing_of`]): the angle lead k (thesis A (4.23)) unless the spec sets
+    /// `angle_observer.lead_samples`.
+    pub angle_lead_periods: f64,
 }
 
 impl BoardTerms {
@@ -114,6 +118,7 @@ impl BoardTerms {
     pub const NONE: BoardTerms = BoardTerms {
         max_duty: 1.0,
         loop_delay_periods: current_loop::NOMINAL_LOOP_DELAY_PERIODS,
+        angle_lead_periods: current_loop::NOMINAL_LOOP_DELAY_PERIODS,
     };
 }
 
@@ -128,6 +133,7 @@ pub fn design_on(spec: &Spec, src: Source<'_>, terms: BoardTerms) -> Result<Desi
         warnings: Vec::new(),
         usable_voltage_fraction: usable,
         loop_delay_periods: terms.loop_delay_periods,
+        board_angle_lead_periods: terms.angle_lead_periods,
     };
     // The motor values against each other and the drive first: a value off by a unit
     // prefix is refused at its key before it makes the sections below fail confusingly.

@@ -237,6 +237,31 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
                 tick_s * 1e9
             );
         }
+        // The angle lead the same way from the resolver's hold instants (the image's
+        // `LEAD_Q16`, designed from them by default: `control_timing`), within one tick.
+        let lead = rig.design.angle_observer.lead_samples;
+        let (res_lo, res_hi, _) = rig
+            .machine
+            .soc()
+            .resolver_sample_instant
+            .unwrap_or_else(|| panic!("{motor}: no resolver conversion after a trigger"));
+        let led = [
+            (lo as f64 / units_per_s - res_hi) / ts + 0.5,
+            (hi as f64 / units_per_s - res_lo) / ts + 0.5,
+        ];
+        for k in led {
+            assert!(
+                (k - lead).abs() * ts <= tick_s,
+                "{motor}: resolver sample → voltage mean measured {k:.5} periods, the angle lead is {lead:.5}"
+            );
+        }
+        println!(
+            "{motor}: angle lead designed {lead:.5} periods, measured {:.5}–{:.5} (resolver held {:.4}–{:.4} µs after the trigger)",
+            led[0],
+            led[1],
+            res_lo * 1e6,
+            res_hi * 1e6
+        );
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
              {:.1} % of the {cycles:.0} cycles of a period; trigger → compare values active {}–{} ticks over {n} periods (design {design_ticks}); currents held {:.4}–{:.4} µs after the trigger over {held_n} triggers; loop delay measured {:.4}–{:.4} µs, designed {:.4} µs = {:.4}·T_s",

@@ -26,8 +26,8 @@
 //! speed, integrated with RK4 on four sub-steps per segment; the duties computed from the
 //! samples at t_n act from the update λ·T_s later for one period (λ = D − 1/2 of the loop
 //! delay D, [`Drive::loop_delay_periods`]; λ = 1 at thesis A §4.6's 1.5·T_s) with the
-//! angle lead of 1.5 periods (4.23), so the applied dq voltage turns by ω_e·(1.5·T_s − age)
-//! with the time since its sample, scaled by the DC link it meets over the one it was
+//! angle lead k of the firmware (4.23; 1.5 periods without a board), so the applied dq
+//! voltage turns by ω_e·(k·T_s − age) with the time since its sample, scaled by the DC link it meets over the one it was
 //! computed for; the gates are off in the first period. The scenarios' start, settling, length and criteria are `verify`'s (it uses the
 //! constants and functions here). What the model leaves out against the simulation
 //! `verify` runs — ADC quantisation, the angle observer, L_q saturation and flux
@@ -71,9 +71,6 @@ pub const SETTLE_PERIODS: usize = 20;
 pub const STEP_SPANS: f64 = 10.0;
 /// RK4 sub-steps per period (as `motor-sim`'s plant).
 const SUBSTEPS: usize = 4;
-/// Periods from a sample to the middle of the period its duties act in (thesis A §4.6),
-/// which the firmware's angle lead (4.23) aims at.
-const LEAD_PERIODS: f64 = 1.5;
 
 /// Current step height \[A\]: [`STEP_FRACTION`] of the current-circle radius √2·I_peak
 /// (`peak_current_a`), kept so that the larger proportional gain's kick `kp_max·Δi` stays
@@ -143,6 +140,12 @@ pub struct Drive {
     /// periods (the current loop's, `current_loop::discrete`): the duties act from
     /// (D − 1/2)·T_s after their sample.
     pub loop_delay_periods: f64,
+    /// The angle the firmware turns the voltage by, counted from the currents' sample
+    /// [periods]: its angle lead k (thesis A (4.23), `design::sections::angle_observer`)
+    /// from the resolver's sample, plus the resolver's lag behind the currents in the
+    /// ADC sequences (a board's, `sections::board::control_timing`; k + D − k_board, which
+    /// is D with the default lead).
+    pub angle_lead_periods: f64,
 }
 
 /// The decoupling scenario's figures.
@@ -270,8 +273,8 @@ impl<'a> Loop<'a> {
 
     /// One period of the plant from this sample: the pending command (computed one
     /// period before) until the update λ·T_s into the period, then `now` (computed from
-    /// this sample), each applied with the 1.5-period angle lead — in the rotor frame it
-    /// turns by ω_e·(1.5·T_s − age), its age the time since its sample — and scaled by
+    /// this sample), each applied with the angle lead k — in the rotor frame it turns by
+    /// ω_e·(k·T_s − age), its age the time since its sample — and scaled by
     /// the DC link it meets over the one its duties were computed with, (5.1).
     fn advance(&self, now: ([f64; 2], f64)) -> [f64; 2] {
         let Some(before) = self.pending else {
@@ -289,7 +292,7 @@ impl<'a> Loop<'a> {
             }
             let scale = self.dc_link / computed_for;
             let v = |tau: f64| {
-                let a = w * (LEAD_PERIODS * ts - (age0 + tau));
+                let a = w * (dr.angle_lead_periods * ts - (age0 + tau));
                 let (s, c) = a.sin_cos();
                 [scale * (c * u[0] - s * u[1]), scale * (s * u[0] + c * u[1])]
             };

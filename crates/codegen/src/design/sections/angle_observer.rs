@@ -35,7 +35,8 @@ pub struct ObserverOut {
     pub resolver_offset_q31: Option<i32>,
     /// Delay k in samples compensated by the angle lead (4.23).
     pub lead_samples: f64,
-    /// Where k came from: `angle_observer.lead_samples`, or the default 1.5 (thesis A §4.6).
+    /// Where k came from: `angle_observer.lead_samples`, or by default the board's timing
+    /// (from the resolver's sample to the voltage's mean; 1.5 without a board, thesis A §4.6).
     pub lead_samples_source: Provenance,
     /// k in Q16.16: θ_e,lead^i = θ_e^i + (ω_e^i·LEAD) >> 16, ω_e^i the per-sample electrical angle step (4.19), (4.23).
     pub lead_q16: i32,
@@ -117,7 +118,7 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
         ));
     }
     let offset = spec.resolver.offset.as_ref().map(|p| p.value);
-    let lead = o.lead_samples.value;
+    let lead = cx.angle_lead_periods();
     Some(ObserverOut {
         error: o.error,
         natural_frequency_rad_s: o.natural_frequency.value,

@@ -21,7 +21,8 @@ use serde::Serialize;
 
 use crate::board::{
     ADC_CLOCK_HZ, Board, PinUse, Signal, break_active_high, break_pull, checks_option_bytes, current_sample_instant,
-    gates, samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle, warning_at,
+    gates, resolver_sample_instant, samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle,
+    warning_at,
 };
 use crate::design::Design;
 use crate::design::duty_limit::{self, DutyBound, DutyLimit};
@@ -105,6 +106,12 @@ pub struct BoardOut {
     /// From the ADC trigger to the mean end of the phase currents' sampling phases \[s\]
     /// (`board::current_sample_instant`).
     pub current_sample_instant_s: f64,
+    /// From the ADC trigger to the mean end of the resolver SIN and COS sampling phases
+    /// \[s\] (`board::resolver_sample_instant`).
+    pub resolver_sample_instant_s: f64,
+    /// The delay from the resolver's sample to the mean of the voltage computed from it
+    /// [periods of T_s], the default angle lead k (thesis A (4.23)).
+    pub angle_lead_periods: f64,
     /// The loop delay this timing makes, which the current loop is designed for \[s\]:
     /// from the currents' sample to the update, plus half a period, the mean delay of the
     /// voltage held over the period after the update (thesis A §4.6).
@@ -410,6 +417,17 @@ pub(in crate::design) fn board(
                 ),
                 "the motor designed on this board (`codegen::design_with_board`)".into(),
             );
+        } else if d.angle_observer.lead_samples_source == crate::spec::Provenance::Default
+            && (d.angle_observer.lead_samples - t.angle_lead_periods).abs() > 1e-9
+        {
+            refuse(
+                "sensing.sample_instant",
+                format!(
+                    "the resolver's sampling instant and TIM1's update scheme make an angle lead of {:.4} periods, but the angle observer of {} ({spec}) was designed with {:.4}",
+                    t.angle_lead_periods, d.name, d.angle_observer.lead_samples
+                ),
+                "the motor designed on this board (`codegen::design_with_board`)".into(),
+            );
         }
     }
     let dead_s = d
@@ -491,6 +509,8 @@ pub(in crate::design) fn board(
         trips,
         trigger_to_update_ticks: timing.trigger_to_update_ticks,
         current_sample_instant_s: timing.current_sample_instant_s,
+        resolver_sample_instant_s: timing.resolver_sample_instant_s,
+        angle_lead_periods: timing.angle_lead_periods,
         loop_delay_s: timing.loop_delay_s,
         duty_limit,
         can_bit_rate: can_timing.bit_rate,
@@ -610,15 +630,25 @@ pub fn offset_bound_code(board: &Board) -> i32 {
 /// sampling phases, `board::current_sample_instant`), so the loop delay is the time from
 /// there to the update plus half a period: the voltage is held for the period after the
 /// update, its mean half a period later (thesis A §4.6, which samples at the update:
-/// 1.5·T_s). The current loop is designed for it (`current_loop::discrete`).
-pub fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64, sample_instant_s: f64) -> ControlTiming {
+/// 1.5·T_s). The current loop is designed for it (`current_loop::discrete`). In the
+/// same way the resolver, held `resolver_instant_s` after the trigger, sets the angle
+/// lead k (thesis A (4.23)): from its sample to the voltage's mean, in periods.
+pub fn control_timing(
+    at_carrier_maximum: bool,
+    arr: u16,
+    ts: f64,
+    sample_instant_s: f64,
+    resolver_instant_s: f64,
+) -> ControlTiming {
     let ticks = 2 * u32::from(arr) + u32::from(at_carrier_maximum);
     let s = f64::from(ticks) / f64::from(firmware::TIMER_CLOCK_HZ);
     ControlTiming {
         trigger_to_update_ticks: ticks,
         trigger_to_update_s: s,
         current_sample_instant_s: sample_instant_s,
+        resolver_sample_instant_s: resolver_instant_s,
         loop_delay_s: s - sample_instant_s + 0.5 * ts,
+        angle_lead_periods: (s - resolver_instant_s) / ts + 0.5,
     }
 }
 
@@ -632,6 +662,7 @@ pub fn timing_of(board: &Board, fs_hz: f64) -> Option<ControlTiming> {
         arr,
         1.0 / fs_hz,
         current_sample_instant(board, ADC_CLOCK_HZ),
+        resolver_sample_instant(board, ADC_CLOCK_HZ),
     ))
 }
 
@@ -644,8 +675,12 @@ pub struct ControlTiming {
     pub trigger_to_update_s: f64,
     /// Trigger → the currents' mean sample instant \[s\].
     pub current_sample_instant_s: f64,
+    /// Trigger → the resolver's mean sample instant \[s\].
+    pub resolver_sample_instant_s: f64,
     /// Sample → update plus T_s/2 \[s\].
     pub loop_delay_s: f64,
+    /// Resolver sample → update plus T_s/2 [periods of T_s]: the angle lead k.
+    pub angle_lead_periods: f64,
 }
 
 fn pin_code(board: &Board, s: Signal) -> u8 {
@@ -697,6 +732,23 @@ mod tests {
             (nucleo.loop_delay_s - 36.565_686e-6).abs() < 1e-12,
             "{}",
             nucleo.loop_delay_s
+        );
+        // The resolver: SIN rank 2 (3.125 + 37 + 24.5 = 64.625 cycles) on both boards;
+        // COS rank 3 after two 24.5-cycle ranks on the reference board (101.625 cycles,
+        // mean 83.125 = 1.955 882 µs: k = (50 − 1.955 882)/50 + ½ = 1.460 882), rank 3 with
+        // 247.5 cycles on the NUCLEO (324.625, mean 194.625 = 4.579 412 µs: k =
+        // (25.005 882 − 4.579 412)/25 + ½ = 1.317 059).
+        assert!((reference.resolver_sample_instant_s - 1.955_882e-6).abs() < 1e-12);
+        assert!(
+            (reference.angle_lead_periods - 1.460_882).abs() < 1e-6,
+            "{}",
+            reference.angle_lead_periods
+        );
+        assert!((nucleo.resolver_sample_instant_s - 4.579_412e-6).abs() < 1e-12);
+        assert!(
+            (nucleo.angle_lead_periods - 1.317_059).abs() < 1e-6,
+            "{}",
+            nucleo.angle_lead_periods
         );
     }
 

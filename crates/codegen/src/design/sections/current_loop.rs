@@ -241,6 +241,9 @@ fn drive(cx: &Context<'_>, r: f64, ts: f64) -> at_speed::Drive {
         method: c.method,
         damping: zeta,
         loop_delay_periods: cx.loop_delay_periods,
+        // The lead from the resolver's sample, plus its lag behind the currents'
+        // (D − k_board: the two samples' distance in periods).
+        angle_lead_periods: cx.angle_lead_periods() + cx.loop_delay_periods - cx.board_angle_lead_periods,
     }
 }
 

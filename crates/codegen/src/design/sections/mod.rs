@@ -40,9 +40,23 @@ pub(super) struct Context<'a> {
     /// The loop delay the current loop is designed for, in periods of T_s (the board's,
     /// `design::BoardTerms`).
     pub loop_delay_periods: f64,
+    /// The angle lead the board's timing makes, in periods of T_s (`design::BoardTerms`).
+    pub board_angle_lead_periods: f64,
 }
 
 impl Context<'_> {
+    /// The angle lead k (thesis A (4.23)) [periods of T_s]: the spec's
+    /// `angle_observer.lead_samples`, or by default the board's (from its resolver's
+    /// sample to the voltage's mean; 1.5 without a board, thesis A §4.6).
+    pub fn angle_lead_periods(&self) -> f64 {
+        let lead = &self.spec.angle_observer.lead_samples;
+        if lead.source == crate::spec::Provenance::Default {
+            self.board_angle_lead_periods
+        } else {
+            lead.value
+        }
+    }
+
     /// f_s [Hz].
     pub fn switching_frequency(&self) -> f64 {
         self.spec.drive.switching_frequency.value
