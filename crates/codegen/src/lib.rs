@@ -74,9 +74,15 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
     }
     let max_duty = limit.as_ref().map_or(1.0, |l| l.max_duty);
     // The current loop is designed for the delay the board's timing makes, the angle
-    // lead for its resolver's; where TIM1 cannot make f_s the drive section refuses it,
-    // with the nominal delay meanwhile.
-    let timing = design::timing_of(&board, fs);
+    // lead for its resolver's. Where TIM1 cannot make f_s (the drive section refuses
+    // it), or the conversions end after the update (a delay the sampled model does not
+    // carry: the board section refuses it at `sensing.source_resistance.current`), the
+    // motor is designed with the nominal delay meanwhile.
+    let (lo, hi) = design::current_loop::discrete::MODELLED_DELAY_PERIODS;
+    let timing = design::timing_of(&board, fs).filter(|t| {
+        let d = t.loop_delay_s * fs;
+        d > lo && d <= hi && t.angle_lead_periods > lo
+    });
     let nominal = design::current_loop::NOMINAL_LOOP_DELAY_PERIODS;
     let terms = design::BoardTerms {
         max_duty,

@@ -609,9 +609,9 @@ pub fn model_point(g: &discrete::LoopGains, plant: &PlantModel, ts: f64, omega: 
     let tau = (plant.delay_periods - 0.5).max(0.0);
     let q = tau.floor();
     let x = tau - q;
-    let a = (-r * ts / l).exp();
-    let e = (-r * (1.0 - x) * ts / l).exp();
-    let (c2, c1) = ((1.0 - e) / r, (e - a) / r);
+    // c₁, c₂ are the design's b, b₀ at the lag x (`SampledPlant::with_lag`).
+    let p = discrete::SampledPlant::with_lag(r, l, ts, x);
+    let (a, c1, c2) = (p.a, p.b, p.b0);
     let th = omega * ts;
     let z = (th.cos(), th.sin());
     let zq1 = ((q + 1.0) * th).cos();

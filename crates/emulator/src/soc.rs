@@ -220,10 +220,10 @@ pub struct Soc {
     pub sleeping: bool,
     /// Address of a WFI the code hook stopped at (it then resumes after it, asleep).
     pub wfi_at: Option<u32>,
-    /// The phase currents ([0]) and the resolver's SIN and COS ([1]) held since the last
-    /// ADC trigger: (that trigger \[bus units\], Σ held instant − trigger \[s\], inputs
-    /// seen as bits, count).
-    held: [(u64, f64, u8, u32); 2],
+    /// The phase currents held since the last ADC trigger.
+    currents_held: Holds,
+    /// The resolver's SIN and COS held since the last ADC trigger.
+    resolver_held: Holds,
     /// Measured: per ADC trigger, the mean instant after it at which its conversions
     /// held the phase currents \[s\] (min, max, triggers) — each phase's first
     /// conversion, a later one of the same phase being a repeat the image discards
@@ -231,6 +231,51 @@ pub struct Soc {
     pub current_sample_instant: Option<(f64, f64, u64)>,
     /// The same for the resolver's SIN and COS.
     pub resolver_sample_instant: Option<(f64, f64, u64)>,
+}
+
+/// The inputs of one kind held after one ADC trigger, for [`Soc::current_sample_instant`]
+/// and [`Soc::resolver_sample_instant`].
+#[derive(Clone, Copy, Debug, Default)]
+struct Holds {
+    /// The trigger \[bus units\].
+    trigger: u64,
+    /// Σ (held instant − trigger) \[s\].
+    sum_s: f64,
+    /// The inputs seen, as bits.
+    seen: u8,
+    /// How many.
+    n: u32,
+}
+
+impl Holds {
+    /// Input `input` held at `held` \[s\] after the trigger at `trigger` (bus units;
+    /// none yet: ignored): a new trigger first closes the last one's mean into `stat`
+    /// (min, max, triggers); a second hold of the same input after one trigger (a
+    /// padding repeat) is not counted.
+    fn add(&mut self, trigger: Option<u64>, input: usize, held: f64, stat: &mut Option<(f64, f64, u64)>) {
+        let Some(trigger) = trigger else {
+            return;
+        };
+        if self.trigger != trigger {
+            if self.n > 0 {
+                let mean = self.sum_s / f64::from(self.n);
+                *stat = Some(match *stat {
+                    None => (mean, mean, 1),
+                    Some((lo, hi, k)) => (lo.min(mean), hi.max(mean), k + 1),
+                });
+            }
+            *self = Holds {
+                trigger,
+                ..Holds::default()
+            };
+        }
+        let bit = 1u8 << input.min(7);
+        if self.seen & bit == 0 {
+            self.sum_s += held - trigger as f64 / UNITS_PER_S;
+            self.seen |= bit;
+            self.n += 1;
+        }
+    }
 }
 
 /// Which block an address belongs to.
@@ -351,7 +396,8 @@ impl Soc {
             switches_enabled: false,
             sleeping: false,
             wfi_at: None,
-            held: [(0, 0.0, 0, 0); 2],
+            currents_held: Holds::default(),
+            resolver_held: Holds::default(),
             current_sample_instant: None,
             resolver_sample_instant: None,
         };
@@ -1140,46 +1186,18 @@ impl Soc {
             if let Some(b) = problem {
                 self.fail(b);
             }
+            let trigger = self.tim1.last_trigger_at;
             for (input, held) in resolver {
-                self.held_input(1, input, held);
+                self.resolver_held
+                    .add(trigger, input, held, &mut self.resolver_sample_instant);
             }
             for (ch, phase, sampling) in currents {
-                self.held_input(0, phase, sampling.1);
+                self.currents_held
+                    .add(trigger, phase, sampling.1, &mut self.current_sample_instant);
                 if let Some(b) = self.sampling_window(name, ch, phase, sampling) {
                     self.fail(b);
                 }
             }
-        }
-    }
-
-    /// Records input `input` of kind `kind` (0: a phase current, 1: the resolver's SIN
-    /// or COS) held at `held` \[s\] for [`Soc::current_sample_instant`] and
-    /// [`Soc::resolver_sample_instant`]: the held instants after the same trigger are
-    /// averaged, and a new trigger closes the last one's mean.
-    fn held_input(&mut self, kind: usize, input: usize, held: f64) {
-        let Some(trigger) = self.tim1.last_trigger_at else {
-            return;
-        };
-        if self.held[kind].0 != trigger {
-            let (_, sum, _, n) = self.held[kind];
-            if n > 0 {
-                let mean = sum / f64::from(n);
-                let stat = if kind == 0 {
-                    &mut self.current_sample_instant
-                } else {
-                    &mut self.resolver_sample_instant
-                };
-                *stat = Some(match *stat {
-                    None => (mean, mean, 1),
-                    Some((lo, hi, k)) => (lo.min(mean), hi.max(mean), k + 1),
-                });
-            }
-            self.held[kind] = (trigger, 0.0, 0, 0);
-        }
-        let bit = 1u8 << input.min(7);
-        let (at, sum, seen, n) = self.held[kind];
-        if seen & bit == 0 {
-            self.held[kind] = (at, sum + held - at as f64 / UNITS_PER_S, seen | bit, n + 1);
         }
     }
 

@@ -281,7 +281,7 @@ pub fn ato_gains(input: TokenStream) -> syn::Result<TokenStream> {
 /// `pi_gains!(method = imc|pole_placement|imc_active_damping, resistance = "…", inductance = "…", bandwidth = "…", fs = "…"[, damping = …][, compensate_delay = false])`:
 /// one axis through the design core's current-loop pipeline and its rules
 /// (`codegen::design::current_loop::rules::verdict`, what `motorgen check` applies to a
-/// spec's `[current_loop]`), with the firmware's 1.5·T_s loop delay and, unless
+/// spec's `[current_loop]`), with thesis A §4.6's 1.5·T_s loop delay (no board) and, unless
 /// `compensate_delay = false`, the delay compensation a spec gets by default. A request
 /// the rules refuse is a compile error at `bandwidth` with the refusal's words.
 pub fn pi_gains(input: TokenStream) -> syn::Result<TokenStream> {

@@ -61,7 +61,7 @@ pub fn ato_gains(input: TokenStream) -> TokenStream {
 /// `pi_gains!(method = imc, resistance = "0.126 Ω", inductance = "0.393 mH", bandwidth = "100 rad/s", fs = "20 kHz")`
 /// (`damping = 0.7071` for `pole_placement`; `compensate_delay = false` to opt out of
 /// the delay compensation, as in a spec). The gains are the design core's current-loop
-/// pipeline (thesis A 5.9, 5.14; thesis B 2.38, with the firmware's 1.5·T_s delay), and
+/// pipeline (thesis A 5.9, 5.14; thesis B 2.38, with thesis A §4.6's 1.5·T_s delay: a macro has no board), and
 /// a bandwidth `motorgen check` refuses — a sampled loop below the phase/gain-margin,
 /// overshoot or rise-time floors, a right-half-plane zero, negative active damping — is a
 /// compile error at `bandwidth` naming the rule, the figure and the bandwidth that works.

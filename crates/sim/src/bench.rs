@@ -1,5 +1,6 @@
 //! The firmware's control step and the simulated drive, stepped together with the
-//! timing of thesis A §4.6: at t_n the ADCs sample currents, DC link and resolver; the
+//! timing of thesis A §4.6: at t_n the ADCs sample currents and DC link, the resolver
+//! [`Plant::resolver_lag_s`] later (0 without a board); the
 //! step computes duties which the timer loads at the next update, so that they act for
 //! the period after it — with the update one period after the sample, one period of
 //! computation plus the PWM's half-period averaging, the 1.5·T_s the angle lead (4.23)

@@ -194,7 +194,9 @@ pub struct Plant {
     pub theta_m: f64,
     /// Actual DC-link voltage \[V\] (a scenario may change it between periods).
     pub dc_link: f64,
-    /// Duties loaded for the next period (computed at the previous sample); `None` = gates off.
+    /// The duties [`Plant::advance`] switches to after [`Plant::extra_delay`] of the period
+    /// (with [`Plant::step_with`]: computed at this sample when the update falls inside
+    /// the period, at the previous one otherwise); `None` = gates off.
     pub pending: Option<[f32; 3]>,
     /// The part of the period in [0, 1) during which the previous period's duties still
     /// act before the pending ones ([`Plant::advance`]; set by [`Plant::step_with`] from

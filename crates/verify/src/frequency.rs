@@ -1,12 +1,13 @@
 //! Frequency responses of the discrete designs, as the firmware realises them (for the
 //! report's Bode plots), and of the continuous designs they approximate.
 //!
-//! Current loop per axis, sample period T_s (thesis A §4.6 timing):
+//! Current loop per axis, sample period T_s, the design's loop delay D = λ + ½
+//! (`codegen::design::current_loop::discrete`; λ = 1 is thesis A §4.6's 1.5·T_s):
 //!
 //! ```text
 //! C(z) = k_p + k_i·T_s·z⁻¹/(1 − z⁻¹)          forward-difference PI (4.17b), (2.49) linear
-//! P(z) = b·z⁻²/(1 − a·z⁻¹),  a = e^(−R·T_s/L), b = (1 − a)/R
-//!        ZOH of 1/(Ls + R) (thesis A (5.5)) plus one period of computation delay
+//! P(z) = (b₀·z + b)/(z·(z − a)),  a = e^(−R·T_s/L), b, b₀ of the voltage switching λ·T_s
+//!        after the sample: ZOH of 1/(Ls + R) (thesis A (5.5)) and the computation delay
 //! P_a = P/(1 + R_a·P)                            active damping (thesis B (2.31))
 //! F(z) = c/(1 − (1 − c)·z⁻¹)                      prefilter (5.16), c = 1 − e^(−T_s·k_i/k_p)
 //! L = C·P_a,   T = F·L/(1 + L)
@@ -25,6 +26,7 @@ use nalgebra::Complex;
 use codegen::design::Design;
 use codegen::design::angle_observer::Q31_ONE;
 use codegen::design::current_loop::AxisGains;
+use codegen::design::current_loop::discrete::SampledPlant;
 use codegen::spec::{Method, ObserverError};
 
 /// A frequency response on a grid.
@@ -71,18 +73,18 @@ fn z_inv(omega: f64, ts: f64) -> Complex<f64> {
     Complex::from_polar(1.0, -omega * ts)
 }
 
-/// Open-loop L and closed-loop T of one current-loop axis with resistance `r`,
-/// inductance `l`, at each frequency of `omega`.
-pub fn current_loop(g: &AxisGains, r: f64, l: f64, ts: f64, omega: &[f64]) -> (Response, Response) {
-    let a = (-r * ts / l).exp();
-    let b = (1.0 - a) / r;
+/// Open-loop L and closed-loop T of one current-loop axis with gains `g` on the sampled
+/// `plant` (its R, L, T_s and loop delay: `discrete::plant` of the design's request), at
+/// each frequency of `omega`.
+pub fn current_loop(g: &AxisGains, plant: &SampledPlant, omega: &[f64]) -> (Response, Response) {
+    let ts = plant.ts;
     let c = g.prefilter.as_ref().map_or(1.0, |p| p.discrete_coefficient);
     let one = Complex::new(1.0, 0.0);
     let (mut open, mut closed) = (Vec::new(), Vec::new());
     for &w in omega {
         let zi = z_inv(w, ts);
         let ctrl = g.kp + g.ki * ts * zi / (one - zi);
-        let p = b * zi * zi / (one - a * zi);
+        let p = plant.transfer(one / zi);
         let pa = p / (one + g.active_damping_ohm * p);
         let lo = ctrl * pa;
         let f = c / (one - (1.0 - c) * zi);
@@ -183,6 +185,10 @@ pub fn fir(d: &Design, n: usize) -> Response {
 mod tests {
     use super::*;
 
+    fn q_plant(d: &Design) -> SampledPlant {
+        codegen::design::current_loop::discrete::plant(&d.current_loop_request(codegen::design::current_loop::Axis::Q))
+    }
+
     fn fischer() -> Design {
         let text =
             std::fs::read_to_string(concat!(env!("CARGO_MANIFEST_DIR"), "/../../motors/fischer-ti085.toml")).unwrap();
@@ -195,13 +201,7 @@ mod tests {
     fn closed_loops_have_unit_dc_gain() {
         let d = fischer();
         let w = [1e-6];
-        let (_, t) = current_loop(
-            &d.current_loop.q,
-            d.motor.phase_resistance_ohm,
-            d.motor.q_inductance_h,
-            d.drive.sample_period_s,
-            &w,
-        );
+        let (_, t) = current_loop(&d.current_loop.q, &q_plant(&d), &w);
         assert!(
             (t.values[0] - Complex::new(1.0, 0.0)).norm() < 1e-6,
             "{:?}",
@@ -223,13 +223,7 @@ mod tests {
     fn imc_closed_loop_is_3_db_down_at_alpha() {
         let d = fischer();
         let alpha = d.current_loop.bandwidth_rad_s;
-        let (_, t) = current_loop(
-            &d.current_loop.q,
-            d.motor.phase_resistance_ohm,
-            d.motor.q_inductance_h,
-            d.drive.sample_period_s,
-            &[alpha],
-        );
+        let (_, t) = current_loop(&d.current_loop.q, &q_plant(&d), &[alpha]);
         let db = t.magnitude_db()[0];
         assert!((db + 3.0103).abs() < 0.1, "{db}");
     }

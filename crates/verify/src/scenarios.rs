@@ -415,7 +415,7 @@ pub const DC_LINK_RISE: f64 = decoupling::DC_LINK_RISE;
 /// [`DC_LINK_RISE`] (regenerative braking).
 ///
 /// Criterion. The 1/U_dc feed-forward (5.1) scales the duties with the U_dc sampled at
-/// t_n, and they act during [t_{n+1}, t_{n+2}) (thesis A §4.6). A step between two
+/// t_n, and they act for the period after the next update (thesis A §4.6). A step between two
 /// samples therefore goes uncompensated for exactly one period: the applied voltage is
 /// off by ρ·u_dq (ρ = ΔU_dc/U_dc), which moves the current by the one-period kick
 /// `Δi_1 = |ρ|·T_s·|(u_d/L_d, u_q/L_q)|` with the steady-state `u_d = −ω_e·L_q·i_q`,

@@ -322,8 +322,9 @@ mod tests {
         assert_eq!(c.pwm_period, 4250);
         // Thesis A (5.9): K_p = L·α = 0.0393 V/A, K_i = R·α = 12.6 V/(A·s) for the
         // continuous design. The default delay compensation designs α so that the sampled
-        // loop (1.5·T_s delay) rises in ln 9/α: at α·T_s = 0.005 that lowers α by under 1 %
-        // (first-order estimate: a delay τ = 1.5·T_s moves the pole by e^(−α·τ) = 0.9925).
+        // loop (1.48·T_s delay on the reference board at 20 kHz) rises in ln 9/α: at
+        // α·T_s = 0.005 that lowers α by under 1 % (first-order estimate: a delay
+        // τ = 1.5·T_s moves the pole by e^(−α·τ) = 0.9925).
         // IMC cancels the plant pole either way: K_i/K_p = R/L = 0.126/0.393e-3 = 320.61 1/s.
         let kp = c.current_loop.d.kp;
         assert!(kp < 0.0393 && kp > 0.99 * 0.0393, "{kp}");

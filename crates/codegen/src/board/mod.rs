@@ -365,7 +365,8 @@ pub fn resolver_sample_instant(board: &Board, adc_hz: f64) -> f64 {
     sample_instant(board, &[Signal::ResolverSin, Signal::ResolverCos], adc_hz)
 }
 
-/// The mean hold instant of `signals` after the trigger \[s\] (each signal's first rank).
+/// The mean hold instant of `signals` after the trigger \[s\] (each signal's first rank;
+/// 0 for none of them on the board, which its parser refuses for the currents and resolver).
 fn sample_instant(board: &Board, signals: &[Signal], adc_hz: f64) -> f64 {
     let instant = |signal: Signal| {
         board.adc.iter().find_map(|q| {

@@ -49,7 +49,9 @@ impl ResolveContext<'_> {
                 source: Provenance::Default,
                 key: "angle_observer.lead_samples".into(),
                 span: raw.angle_observer.span(),
-                note: Some("T_delay = 1.5·T_s (thesis A §4.6)".into()),
+                note: Some(
+                    "the board's delay from the resolver's sample to the voltage's mean; T_delay = 1.5·T_s without a board (thesis A §4.6)".into(),
+                ),
             }),
         };
         Some(ObserverSpec {

@@ -18,6 +18,7 @@ use std::fmt::Write as _;
 use crate::{Verification, format_value, frequency};
 use codegen::constants::constants;
 use codegen::design::Design;
+use codegen::design::current_loop::{Axis, discrete};
 use nalgebra::Complex;
 use plots::Line;
 
@@ -228,19 +229,17 @@ pub fn plots_with_measured(d: &Design, v: &Verification, measured: &[MeasuredLoo
     let alpha = d.current_loop.bandwidth_rad_s;
     let grid = frequency::log_grid(alpha / 100.0, PI / ts, 400);
     let designed = frequency::current_loop_designed(d, &grid);
-    let m = &d.motor;
-    for (axis, g, l) in [
-        ("d", &d.current_loop.d, m.d_inductance_h),
-        ("q", &d.current_loop.q, m.q_inductance_h),
-    ] {
-        let (open, closed) = frequency::current_loop(g, m.phase_resistance_ohm, l, ts, &grid);
+    for (axis, g, which) in [("d", &d.current_loop.d, Axis::D), ("q", &d.current_loop.q, Axis::Q)] {
+        let plant = discrete::plant(&d.current_loop_request(which));
+        let (open, closed) = frequency::current_loop(g, &plant, &grid);
         let mut responses = vec![
             ("open loop L (discrete)".to_string(), open),
             ("closed loop T (discrete)".to_string(), closed),
             ("closed loop (continuous design)".to_string(), designed.clone()),
         ];
         let mut caption = format!(
-            "{axis}-axis current loop: discrete open loop L = C·P and closed loop T (forward-difference PI, ZOH plant, one period of delay) against the continuous design, up to the Nyquist frequency π·f_s"
+            "{axis}-axis current loop: discrete open loop L = C·P and closed loop T (forward-difference PI, ZOH plant, the design's {:.4}·T_s loop delay) against the continuous design, up to the Nyquist frequency π·f_s",
+            plant.lag + 0.5
         );
         for meas in measured.iter().filter(|x| x.axis == axis) {
             let values = meas
@@ -391,8 +390,9 @@ pub fn html(d: &Design, v: &Verification, plots: &[Plot]) -> String {
     let passed = v.scenarios.iter().filter(|x| x.passed()).count();
     let _ = writeln!(
         s,
-        "<h2 id=\"verification\">Verification</h2>\n<p>{passed} of {} scenarios passed. The firmware's control step (<code>motor-control</code>) runs with this design's constants against the simulated motor (1.5·T_s delay).</p>",
-        v.scenarios.len()
+        "<h2 id=\"verification\">Verification</h2>\n<p>{passed} of {} scenarios passed. The firmware's control step (<code>motor-control</code>) runs with this design's constants against the simulated motor (the design's {:.4}·T_s loop delay).</p>",
+        v.scenarios.len(),
+        d.current_loop.loop_delay_s / d.drive.sample_period_s
     );
     s.push_str("<table id=\"verification-table\">\n<tr><th>scenario</th><th>check</th><th>measured</th><th>designed</th><th>criterion</th><th>result</th></tr>\n");
     for sc in &v.scenarios {

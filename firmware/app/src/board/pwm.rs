@@ -12,8 +12,9 @@
 //!   the counter starts; the *overflow* (carrier maximum) for low-side shunts, RCR = 0 at
 //!   the UG and RCR = 1 written right after the start (RM0440 §29.3.5;
 //!   [`crate::config::REPETITION`]). The preloaded compare values from a control step
-//!   take effect there, one period after the sample they came from (the 1.5·T_s loop
-//!   delay the current loop is designed for).
+//!   take effect there, one period after the trigger they came from (with the
+//!   currents' hold instants after the trigger and the half period, the loop delay the
+//!   current loop is designed for: codegen `sections::board::control_timing`).
 //! * The ADC trigger is not the update event: channel 4 (no pin) makes OC4REF rise at
 //!   the board's `sensing.sample_instant` ([`crate::config::TRIGGER`]: one tick before
 //!   the carrier maximum for low-side shunts, at the minimum otherwise), routed as TRGO2

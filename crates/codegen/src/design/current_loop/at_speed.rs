@@ -8,7 +8,7 @@
 //!   the peak |i_d| it causes must be at least [`MIN_DECOUPLING_RATIO`] times smaller with
 //!   the feed-forward. Without it the d-axis PI alone rejects the coupling −ω_e·L_q·i_q,
 //!   so the excursion shrinks as α grows; with it the residual is the coupling of the
-//!   current that changed since the sample (the 1.5·T_s of thesis A §4.6), which grows
+//!   current that changed since the sample (the loop delay, 1.5·T_s in thesis A §4.6), which grows
 //!   with the step's speed: the ratio falls with α, and a wide loop fails it while
 //!   meeting every margin.
 //! * [`dc_link_step`] (thesis A (5.1), §4.6): at the same point with i_q at the step
@@ -69,7 +69,8 @@ pub const COUPLING_SHARE: f64 = 0.3;
 pub const SETTLE_PERIODS: usize = 20;
 /// The step is followed for this many 1/α.
 pub const STEP_SPANS: f64 = 10.0;
-/// RK4 sub-steps per period (as `motor-sim`'s plant).
+/// RK4 sub-steps per segment of constant command (two per period when the update falls
+/// inside it; as `motor-sim`'s plant).
 const SUBSTEPS: usize = 4;
 
 /// Current step height \[A\]: [`STEP_FRACTION`] of the current-circle radius √2·I_peak

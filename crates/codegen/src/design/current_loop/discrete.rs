@@ -45,9 +45,10 @@ use super::Request;
 use super::continuous::{self, CurrentLoopError, Pi, Prefilter, natural_frequency, rise_time};
 use crate::spec::Method;
 
-/// The loop delays this model carries, in sample periods: from the ZOH's half period
-/// plus a sample-to-update lag λ just above 0 (exclusive) to λ = 1 (thesis A §4.6: 1.5).
-pub const MODELLED_DELAY_PERIODS: std::ops::RangeInclusive<f64> = 0.5..=1.5;
+/// The loop delays this model carries, in sample periods, (exclusive, inclusive): from
+/// the ZOH's half period plus a sample-to-update lag λ just above 0 to λ = 1 (thesis A
+/// §4.6: 1.5).
+pub const MODELLED_DELAY_PERIODS: (f64, f64) = (0.5, 1.5);
 
 /// The gains of one axis as the sampled loop sees them.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -132,7 +133,7 @@ impl LoopGains {
 pub fn plant(req: &Request) -> SampledPlant {
     let ts = req.sample_period_s;
     let periods = req.loop_delay_s / ts;
-    let (lo, hi) = (*MODELLED_DELAY_PERIODS.start(), *MODELLED_DELAY_PERIODS.end());
+    let (lo, hi) = MODELLED_DELAY_PERIODS;
     assert!(
         periods > lo && periods < hi + 1e-9,
         "the sampled current-loop model carries a loop delay from above {lo}·T_s to {hi}·T_s, not {periods}·T_s"

@@ -626,30 +626,33 @@ pub fn offset_bound_code(board: &Board) -> i32 {
 ///   trigger, loads them — for the low-side trigger one tick later, as the trigger
 ///   precedes its extreme by one tick.
 ///
-/// The currents are sampled `sample_instant_s` after the trigger (the end of their
-/// sampling phases, `board::current_sample_instant`), so the loop delay is the time from
-/// there to the update plus half a period: the voltage is held for the period after the
-/// update, its mean half a period later (thesis A §4.6, which samples at the update:
-/// 1.5·T_s). The current loop is designed for it (`current_loop::discrete`). In the
-/// same way the resolver, held `resolver_instant_s` after the trigger, sets the angle
-/// lead k (thesis A (4.23)): from its sample to the voltage's mean, in periods.
-pub fn control_timing(
-    at_carrier_maximum: bool,
-    arr: u16,
-    ts: f64,
-    sample_instant_s: f64,
-    resolver_instant_s: f64,
-) -> ControlTiming {
+/// The currents are held `held.currents_s` after the trigger (the end of their sampling
+/// phases, `board::current_sample_instant`), so the loop delay is the time from there to
+/// the update plus half a period: the voltage is held for the period after the update,
+/// its mean half a period later (thesis A §4.6, which samples at the update: 1.5·T_s).
+/// The current loop is designed for it (`current_loop::discrete`). In the same way the
+/// resolver, held `held.resolver_s` after the trigger, sets the angle lead k (thesis A
+/// (4.23)): from its sample to the voltage's mean, in periods.
+fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64, held: HoldInstants) -> ControlTiming {
     let ticks = 2 * u32::from(arr) + u32::from(at_carrier_maximum);
     let s = f64::from(ticks) / f64::from(firmware::TIMER_CLOCK_HZ);
     ControlTiming {
         trigger_to_update_ticks: ticks,
         trigger_to_update_s: s,
-        current_sample_instant_s: sample_instant_s,
-        resolver_sample_instant_s: resolver_instant_s,
-        loop_delay_s: s - sample_instant_s + 0.5 * ts,
-        angle_lead_periods: (s - resolver_instant_s) / ts + 0.5,
+        current_sample_instant_s: held.currents_s,
+        resolver_sample_instant_s: held.resolver_s,
+        loop_delay_s: s - held.currents_s + 0.5 * ts,
+        angle_lead_periods: (s - held.resolver_s) / ts + 0.5,
     }
+}
+
+/// When the ADCs hold what the control step reads, after the trigger \[s\].
+#[derive(Debug, Clone, Copy)]
+struct HoldInstants {
+    /// The phase currents' mean (`board::current_sample_instant`).
+    currents_s: f64,
+    /// The resolver SIN's and COS's mean (`board::resolver_sample_instant`).
+    resolver_s: f64,
 }
 
 /// `control_timing` of `board` at switching frequency `fs_hz` (T_s = 1/f_s, TIM1's
@@ -661,8 +664,10 @@ pub fn timing_of(board: &Board, fs_hz: f64) -> Option<ControlTiming> {
         samples_at_carrier_maximum(board),
         arr,
         1.0 / fs_hz,
-        current_sample_instant(board, ADC_CLOCK_HZ),
-        resolver_sample_instant(board, ADC_CLOCK_HZ),
+        HoldInstants {
+            currents_s: current_sample_instant(board, ADC_CLOCK_HZ),
+            resolver_s: resolver_sample_instant(board, ADC_CLOCK_HZ),
+        },
     ))
 }
 

@@ -173,7 +173,7 @@ pub(in crate::design) fn current_loop(cx: &mut Context<'_>) -> Option<CurrentLoo
             cx.warn_at(&c.bandwidth, text);
         }
     }
-    let hot = hot_variant(cx, r, ts, delay);
+    let hot = hot_variant(cx, r, ts);
     let (d, q) = gains?;
     let ramp_lag = [(&d, &requests[0]), (&q, &requests[1])]
         .iter()
@@ -291,10 +291,10 @@ impl Design {
 
 /// The same gains for R_s at the maximum winding temperature (2.24), if `[thermal]` is given;
 /// a warning (not an error) when that design is infeasible.
-fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64, delay: f64) -> Option<HotVariant> {
+fn hot_variant(cx: &mut Context<'_>, r: f64, ts: f64) -> Option<HotVariant> {
     let t = cx.spec.thermal.as_ref()?;
     let r_hot = thermal::resistance_at(r, t.reference_temperature.value, t.max_winding_temperature.value);
-    let requests = requests(cx.spec, r_hot, ts, delay);
+    let requests = requests(cx.spec, r_hot, ts, cx.loop_delay_periods);
     match axes(&requests) {
         Ok((d, q)) => {
             let promise = Promise::of(&requests[0]);
