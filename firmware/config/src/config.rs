@@ -347,7 +347,11 @@ mod tests {
             (c.angle.motor_pole_pairs, c.angle.resolver_pole_pairs, c.angle.offset),
             (4, 1, 0)
         );
-        assert_eq!(c.angle_lead, 98_304);
+        // The angle lead from the resolver's hold instants on the reference board
+        // (SIN and COS at 64.625 and 101.625 ADC cycles of 42.5 MHz after the trigger,
+        // mean 1.955 882 µs; codegen `sections::board::control_timing`):
+        // k = (50 − 1.955 882)/50 + ½ = 1.460 882 → round(k·65 536) = 95 740 (Q16.16).
+        assert_eq!(c.angle_lead, 95_740);
         assert!(close(c.current_sense.amps_per_lsb[0], 3.3 / (0.015 * 65536.0), 1e-6));
         assert_eq!(c.current_sense.offset, [32768; 3]);
         assert!(close(c.dc_link_sense.volts_per_lsb, 750.0 / 32768.0, 1e-6));
