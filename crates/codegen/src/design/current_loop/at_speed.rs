@@ -142,7 +142,7 @@ pub struct Drive {
     /// (D − 1/2)·T_s after their sample.
     pub loop_delay_periods: f64,
     /// The angle the firmware turns the voltage by, counted from the currents' sample
-    /// [periods]: its angle lead k (thesis A (4.23), `design::sections::angle_observer`)
+    /// \[periods\]: its angle lead k (thesis A (4.23), `design::sections::angle_observer`)
     /// from the resolver's sample, plus the resolver's lag behind the currents in the
     /// ADC sequences (a board's, `sections::board::control_timing`; k + D − k_board, which
     /// is D with the default lead).
