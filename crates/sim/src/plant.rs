@@ -194,14 +194,14 @@ pub struct Plant {
     pub theta_m: f64,
     /// Actual DC-link voltage \[V\] (a scenario may change it between periods).
     pub dc_link: f64,
-    /// The duties [`Plant::advance`] switches to after [`Plant::extra_delay`] of the period
+    /// The duties [`Plant::advance`] switches to after a part of the period (`extra_delay`)
     /// (with [`Plant::step_with`]: computed at this sample when the update falls inside
     /// the period, at the previous one otherwise); `None` = gates off.
     pub pending: Option<[f32; 3]>,
     /// The part of the period in [0, 1) during which the previous period's duties still
     /// act before the pending ones ([`Plant::advance`]; set by [`Plant::step_with`] from
     /// [`Plant::loop_delay_periods`]); 0: the pending duties for the whole period.
-    pub extra_delay: f64,
+    extra_delay: f64,
     /// The loop delay D [periods of T_s] [`Plant::step_with`] simulates: the duties
     /// computed from a sample act from (D − 1/2)·T_s after it for one period, so their
     /// mean is D·T_s after the sample. Default 1.5 (thesis A §4.6: sampled at the update);
@@ -213,7 +213,7 @@ pub struct Plant {
     /// reports θ_r then, θ_r + dθ_r/dt·lag (exact at a constant speed).
     pub resolver_lag_s: f64,
     /// The duties of the previous period (for [`Plant::extra_delay`]).
-    pub previous: Option<[f32; 3]>,
+    previous: Option<[f32; 3]>,
     /// A winding open (0 = u, 1 = v, 2 = w; a broken lead or connector): its current is
     /// zero and the star point floats, so the αβ current stays on the line
     /// perpendicular to that phase's axis (2π·k/3). Modelled by projecting the current
