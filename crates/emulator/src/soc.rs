@@ -258,11 +258,7 @@ impl Holds {
         };
         if self.trigger != trigger {
             if self.n > 0 {
-                let mean = self.sum_s / f64::from(self.n);
-                *stat = Some(match *stat {
-                    None => (mean, mean, 1),
-                    Some((lo, hi, k)) => (lo.min(mean), hi.max(mean), k + 1),
-                });
+                *stat = crate::periph::spread(*stat, self.sum_s / f64::from(self.n));
             }
             *self = Holds {
                 trigger,

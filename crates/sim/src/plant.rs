@@ -298,7 +298,8 @@ impl Plant {
     /// sample's, these pending for the next period. A D outside [`SIMULATED_LOOP_DELAY`]
     /// is taken at its nearest end.
     pub fn step_with(&mut self, computed: Option<[f32; 3]>) {
-        let lag = (self.loop_delay_periods - 0.5).clamp(1e-9, 2.0 - 1e-9);
+        let (lo, hi) = SIMULATED_LOOP_DELAY;
+        let lag = self.loop_delay_periods.clamp(lo + 1e-9, hi - 1e-9) - 0.5;
         if lag < 1.0 {
             self.pending = computed;
             self.extra_delay = lag;

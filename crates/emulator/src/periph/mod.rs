@@ -7,6 +7,14 @@
 /// ([`crate::soc`]) advances it.
 pub const UNITS_PER_S: f64 = 1.36e9;
 
+/// A measurement's (min, max, count) with `x` added.
+pub fn spread<T: PartialOrd + Copy>(stat: Option<(T, T, u64)>, x: T) -> Option<(T, T, u64)> {
+    Some(match stat {
+        None => (x, x, 1),
+        Some((lo, hi, n)) => (if x < lo { x } else { lo }, if x > hi { x } else { hi }, n + 1),
+    })
+}
+
 pub mod adc;
 pub mod clock;
 pub mod fdcan;

@@ -260,11 +260,7 @@ impl Tim1 {
             return;
         }
         if let Some(tr) = self.written_after_trigger.take() {
-            let d = t.saturating_sub(tr);
-            self.trigger_to_update = Some(match self.trigger_to_update {
-                None => (d, d, 1),
-                Some((lo, hi, n)) => (lo.min(d), hi.max(d), n + 1),
-            });
+            self.trigger_to_update = super::spread(self.trigger_to_update, t.saturating_sub(tr));
         }
         self.update();
     }

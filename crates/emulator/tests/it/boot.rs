@@ -224,10 +224,15 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
             .unwrap_or_else(|| panic!("{motor}: no phase current converted after a trigger"));
         let units_per_s = motor_emulator::UNITS_PER_S;
         let tick_s = units_per_tick / units_per_s;
-        let delay = [
-            lo as f64 / units_per_s - held_hi + 0.5 * ts,
-            hi as f64 / units_per_s - held_lo + 0.5 * ts,
-        ];
+        // From inputs held (min, max) after the trigger to the mean of the voltage:
+        // the extremes over the measured periods \[s\].
+        let to_voltage_mean = |held_lo: f64, held_hi: f64| {
+            [
+                lo as f64 / units_per_s - held_hi + 0.5 * ts,
+                hi as f64 / units_per_s - held_lo + 0.5 * ts,
+            ]
+        };
+        let delay = to_voltage_mean(held_lo, held_hi);
         for m in delay {
             assert!(
                 (m - loop_delay).abs() <= tick_s,
@@ -245,10 +250,7 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
             .soc()
             .resolver_sample_instant
             .unwrap_or_else(|| panic!("{motor}: no resolver conversion after a trigger"));
-        let led = [
-            (lo as f64 / units_per_s - res_hi) / ts + 0.5,
-            (hi as f64 / units_per_s - res_lo) / ts + 0.5,
-        ];
+        let led = to_voltage_mean(res_lo, res_hi).map(|s| s / ts);
         for k in led {
             assert!(
                 (k - lead).abs() * ts <= tick_s,
