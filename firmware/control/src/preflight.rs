@@ -28,7 +28,12 @@
 //! 1. **Rotation**: the αβ voltage [`Preflight::rotation_voltage`] held at the
 //!    resolver's θ_e for [`Preflight::settle_samples`] (the rotor aligns), turned by one
 //!    electrical turn at [`Preflight::rotation_step`] per period, held again for
-//!    `settle_samples`. Judged:
+//!    `settle_samples`. Judged at the end of the first hold (the rotor at rest, the
+//!    current settled): the current along the held voltage, averaged over the last
+//!    [`Preflight::average_samples`], not below −[`Preflight::open_fraction`] of the
+//!    least current the rotation draws, else [`PreflightFault::InvertedSensing`] — a
+//!    passive load's current has a component along its voltage whatever the lead order,
+//!    so inverted sensing is refused before the turn. Judged after the turn:
 //!    * every phase's largest |i| during the turn ≥ [`Preflight::open_fraction`] of the
 //!      least current the rotation draws (V_rot·ρ_R⁻¹/R), else
 //!      [`PreflightFault::OpenPhase`];
@@ -48,7 +53,8 @@
 //!    currents, (2.7)); at the end of each level the last `average_samples` periods are
 //!    averaged. Judged in this order:
 //!    * sign: the current has the commanded sign, else
-//!      [`PreflightFault::InvertedSensing`];
+//!      [`PreflightFault::InvertedSensing`] (what the first hold let pass with an open
+//!      phase at 90° to its voltage);
 //!    * sum: |i_u + i_v + i_w| ≤ [`Preflight::sum_bound`] (three measured phases only),
 //!      else [`PreflightFault::CurrentSum`];
 //!    * open phase: every phase whose axis lies within 60° of the pulse (|cos| ≥ 1/2)
@@ -249,6 +255,15 @@ fn signed(pulse: u8, x: f32) -> f32 {
     if pulse == 0 { x } else { -x }
 }
 
+/// The current `i` along the angle `angle`: i_α cos θ + i_β sin θ of the phase
+/// currents, (2.7).
+fn along<T: Trig>(trig: &mut T, angle: i32, i: Uvw) -> f32 {
+    let sc = trig.sin_cos(angle).to_f32();
+    let alpha = TWO_THIRDS * (i.u - 0.5 * (i.v + i.w));
+    let beta = INV_SQRT_3 * (i.v - i.w);
+    alpha * sc.cos + beta * sc.sin
+}
+
 /// The open-loop αβ voltage of magnitude `v` at angle `angle`.
 fn at_angle<T: Trig>(trig: &mut T, angle: i32, v: f32) -> Progress<Result<PulseFigures, PreflightFault>> {
     let sc = trig.sin_cos(angle).to_f32();
@@ -318,7 +333,16 @@ impl Preflight {
         st.n = st.n.saturating_add(1);
         match st.stage {
             Stage::Hold => {
+                let average = self.averaged(self.settle_samples);
+                if st.n > self.settle_samples.saturating_sub(average) {
+                    for (s, i) in st.sum_uvw.iter_mut().zip([m.i_uvw.u, m.i_uvw.v, m.i_uvw.w]) {
+                        *s += i;
+                    }
+                }
                 if st.n >= self.settle_samples {
+                    if let Err(f) = self.hold_verdict(st, trig, average) {
+                        return Progress::Finished(Err(f));
+                    }
                     st.stage = Stage::Turn;
                     st.n = 0;
                 }
@@ -360,9 +384,31 @@ impl Preflight {
         at_angle(trig, st.start.wrapping_add(st.generated as i32), self.rotation_voltage)
     }
 
+    /// The least current the rotation's voltage draws: V_rot at the highest accepted R.
+    fn least_rotation_current(&self) -> f32 {
+        self.rotation_voltage / (self.resistance * self.resistance_ratio)
+    }
+
+    /// The first hold's end: the current along the held voltage, averaged over its last
+    /// periods, must not be opposite to it. A star-connected R-L load at rest draws its
+    /// current along the voltage (v·i = R·|i|² ≥ 0 once the rise is over, whatever the
+    /// lead order), at least [`Self::least_rotation_current`] with every phase connected
+    /// and down to 0 with one open at 90° to the voltage; measured at less than
+    /// −`open_fraction` of that least current, the sensing is inverted. Judged here,
+    /// before the turn, rather than only at the pulses 1–3 s later.
+    fn hold_verdict<T: Trig>(&self, st: &mut PreflightState, trig: &mut T, average: u32) -> Result<(), PreflightFault> {
+        let n = average.max(1) as f32;
+        let [u, v, w] = st.sum_uvw.map(|s| s / n);
+        st.sum_uvw = [0.0; 3];
+        let i = along(trig, st.start, Uvw { u, v, w });
+        if !at_least(i, -self.open_fraction * self.least_rotation_current()) {
+            return Err(PreflightFault::InvertedSensing);
+        }
+        Ok(())
+    }
+
     fn rotation_verdict(&self, st: &PreflightState, average: u32) -> Result<(), PreflightFault> {
-        // The least current the rotation draws: V_rot at the highest accepted R.
-        let least = self.rotation_voltage / (self.resistance * self.resistance_ratio);
+        let least = self.least_rotation_current();
         if st.peak.iter().any(|&p| !at_least(p, self.open_fraction * least)) {
             return Err(PreflightFault::OpenPhase);
         }
@@ -397,18 +443,15 @@ impl Preflight {
         if st.level < 2 {
             // Sample n of this level: taken in the period that computed the level's
             // n-th demand (index 0: before the level's voltage acts). The current along
-            // the pulse: i_α cos θ + i_β sin θ, (2.7).
-            let sc = trig.sin_cos(st.angle).to_f32();
+            // the pulse ([`along`]).
             let i = m.i_uvw;
-            let alpha = TWO_THIRDS * (i.u - 0.5 * (i.v + i.w));
-            let beta = INV_SQRT_3 * (i.v - i.w);
-            let along = alpha * sc.cos + beta * sc.sin;
+            let on_pulse = along(trig, st.angle, i);
             let average = self.averaged(levels);
             if st.level == 1 {
-                st.area += along;
+                st.area += on_pulse;
             }
             if st.n >= levels.saturating_sub(average) {
-                st.sum_i += along;
+                st.sum_i += on_pulse;
                 for (s, i) in st.sum_uvw.iter_mut().zip([i.u, i.v, i.w]) {
                     *s += i;
                 }

@@ -447,7 +447,9 @@ impl<'a> Commissioning<'a> {
         Decl {
             name: "PREFLIGHT_AVERAGE_SAMPLES",
             value: Custom(|c| c.samples((c.level_periods() / 10.0).ceil().max(1.0))),
-            formula: Lit("⌈levels/10⌉: the last tenth of a level (and of the rotation's end hold) averaged"),
+            formula: Lit(
+                "⌈levels/10⌉: the last tenth of a level (and as many periods at the end of each of the rotation's holds) averaged",
+            ),
             equation: Lit("—"),
             inputs: Of(|c| c.tau_in.clone()),
             json: Json::None,

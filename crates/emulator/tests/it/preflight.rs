@@ -176,17 +176,6 @@ fn aligning_pairs() -> Vec<(String, String)> {
     out
 }
 
-/// The first (sorted) of [`aligning_pairs`] on each board in `boards/`.
-fn one_pair_per_board() -> Vec<(String, String)> {
-    let mut out: Vec<(String, String)> = Vec::new();
-    for (motor, board) in aligning_pairs() {
-        if !out.iter().any(|(_, b)| *b == board) {
-            out.push((motor, board));
-        }
-    }
-    out
-}
-
 /// Correct wiring passes on every motor a free rotor aligns, on its board: no fault
 /// record, the drive back in torque mode (enabled at zero torque), the check's current
 /// reached (≥ ½·I_p: it ran) and never beyond its trip.
@@ -219,29 +208,35 @@ fn correct_wiring_passes() {
     }
 }
 
-/// `defect` refused with `cause` on one motor per board ([`one_pair_per_board`]), the
-/// gates off from the verdict on (20 ms watched), the current never beyond the check's
-/// trip. One pair per board, not every motor (CI time: the check runs 2.0–4.5 s of
-/// emulated time, the turn and its two holds, then the pulses — 4.8–11.8 s of wall time
-/// per run). Run on all seven of [`aligning_pairs`] (commit f9651f1), every one of the
-/// 28 runs was refused with its cause, but the emulator binary grew from 228 to 350 s
-/// in CI and CI to 1 223 s, over issue 29's 20 minutes; after the emulator's speed-ups
-/// every pair still costs 76 s more wall time (162 s against 86 s for the five tests,
-/// crates/emulator/README.md), with CI at 1 066 s. Each defect is its own test so that
-/// they run in parallel.
-fn refused(defect: Defect, cause: &str) {
-    let pairs = one_pair_per_board();
+/// `defect` refused with `cause` on every pair a free rotor aligns ([`aligning_pairs`]:
+/// every motor with a flux linkage on every board it fits), the gates off from the
+/// verdict on (20 ms watched), the current never beyond the check's trip. Each defect is
+/// its own test so that they run in parallel.
+fn refused(defect: Defect, cause: &str) -> Vec<Refusal> {
+    let pairs = aligning_pairs();
     let filtered = std::env::var_os("EMULATOR_MOTORS").is_some();
-    assert!(
-        filtered || pairs.len() == motor_test_support::board_stems().len(),
-        "not every board has a pair: {pairs:?}"
-    );
-    for (motor, board) in pairs {
-        refused_on(&motor, &board, defect, cause);
+    for board in motor_test_support::board_stems() {
+        assert!(
+            filtered || pairs.iter().any(|(_, b)| *b == board),
+            "no pair on {board}: {pairs:?}"
+        );
     }
+    pairs
+        .iter()
+        .map(|(motor, board)| refused_on(motor, board, defect, cause))
+        .collect()
 }
 
-fn refused_on(motor: &str, board: &str, defect: Defect, cause: &str) {
+/// When a refusal came.
+struct Refusal {
+    name: String,
+    /// Emulated time from the command to the end of the run (20 ms after the verdict) \[s\].
+    ran_s: f64,
+    /// The rotation's first hold, `ROTATION_SETTLE_SAMPLES`·T_s \[s\].
+    hold_s: f64,
+}
+
+fn refused_on(motor: &str, board: &str, defect: Defect, cause: &str) -> Refusal {
     let mut rig = rig(motor, board, defect);
     let name = rig.bench.name();
     let trip = constant(&rig.design, "PREFLIGHT_CURRENT_TRIP");
@@ -265,12 +260,28 @@ fn refused_on(motor: &str, board: &str, defect: Defect, cause: &str) {
         "{name}: {defect:?}: {:.2} A beyond the check's trip {trip:.2} A",
         o.peak_a
     );
+    Refusal {
+        hold_s: constant(&rig.design, "ROTATION_SETTLE_SAMPLES") * rig.design.drive.sample_period_s,
+        name,
+        ran_s: o.ran_s,
+    }
 }
 
-/// The sensing inverted on every phase: refused at the first pulse level, cause 11.
+/// The sensing inverted on every phase: refused at the end of the first hold, before the
+/// turn, cause 11.
 #[test]
 fn inverted_sensing_is_refused() {
-    refused(Defect::InvertedSensing, "11 (inverted current sensing)");
+    for r in refused(Defect::InvertedSensing, "11 (inverted current sensing)") {
+        // The hold, the 20 ms watched after the verdict, and a few periods' slack for the
+        // command's frame and the verdict's fault record.
+        assert!(
+            r.ran_s <= r.hold_s + 0.021,
+            "{}: refused {:.4} s after the command, the first hold ends at {:.4} s",
+            r.name,
+            r.ran_s,
+            r.hold_s
+        );
+    }
 }
 
 /// Winding v open: refused by the rotation (every phase's peak), cause 15.

@@ -95,7 +95,7 @@ fn healthy_drive_passes() {
 }
 
 /// The board's sensing inverted (the plant's currents read with the opposite sign):
-/// refused at the first level.
+/// refused at the end of the first hold, before the turn: after its 10 000 periods.
 #[test]
 fn inverted_sensing_is_refused() {
     let mut b = bench();
@@ -103,9 +103,23 @@ fn inverted_sensing_is_refused() {
     let c = check();
     let (r, periods, _) = run(b, &c);
     assert_eq!(r, Err(PreflightFault::InvertedSensing));
-    // At the end of the first level, after the rotation.
-    let rotation = c.periods() - 4 * 500 - 2 * 500;
-    assert!(periods <= rotation + 500, "{periods}");
+    assert_eq!(periods, u64::from(c.settle_samples), "{periods}");
+}
+
+/// Inverted sensing on a drive whose hold cannot see it — phase u open with the hold's
+/// voltage along u (θ_e = 0: legs v and w at one potential, no current during the
+/// hold): the hold passes it and the turn refuses the open phase.
+#[test]
+fn inverted_sensing_with_no_hold_current_is_left_to_the_turn() {
+    let mut b = bench();
+    b.current_gain = [-1.0; 3];
+    b.plant.open_phase = Some(0);
+    // The resolver's θ_e at rest is the hold's angle: 0, phase u's axis.
+    assert_eq!(b.plant.theta_e(), 0.0);
+    let c = check();
+    let (r, periods, _) = run(b, &c);
+    assert_eq!(r, Err(PreflightFault::OpenPhase));
+    assert!(periods > u64::from(c.settle_samples), "{periods}");
 }
 
 /// One phase's gain 20 % high: the currents no longer sum to zero.
