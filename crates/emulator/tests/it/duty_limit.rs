@@ -13,14 +13,16 @@
 //! top speed (its acceleration rule), [`HOLD_S`] there, then the MTPA torque on the
 //! board's current circle for [`AFTER_S`].
 //!
-//! Boards: the NUCLEO + X-NUCLEO-IHM08M1 (low-side shunts, d_max < 1) and the reference
-//! board (in-line Hall sensors: d_max = 1, the duty reaches the THPWM linear range's
-//! 100 %), each with its first motor (`rig::benches`; maxon-ec45-flat-70w on both). The
-//! 400 A variant of the reference board is the same hardware with another sensing gain
-//! and takes only the traction motors, whose ramps take seconds of simulated time
-//! (`at_speed`'s module documentation): it is left out here, as its sensing reads the
-//! currents whatever the switches do. The defect: the compare values one timer tick
-//! beyond `MAX_COMPARE` (`Patches::compare_beyond`) and the rule fires.
+//! Boards: every board in `boards/`, each with one motor ([`BENCHES`]): the NUCLEO +
+//! X-NUCLEO-IHM08M1 (low-side shunts, d_max < 1) and the reference board (in-line Hall
+//! sensors: d_max = 1, the duty reaches the THPWM linear range's 100 %) with
+//! maxon-ec45-flat-70w, the 400 A variant of the reference board (the same hardware with
+//! another sensing gain, d_max = 1) with emrax-228-hv. The 400 A board takes only the
+//! traction motors; of them emrax-228-hv's angle observer (ω_n = 1000 rad/s) follows a
+//! zero-torque ramp to its 6500 rpm in 0.33 s, where amk-dd5-ipm's (200 rad/s) and
+//! chalmers-hev50's (70 rad/s) would need seconds of emulated time. The defect: the
+//! compare values one timer tick beyond `MAX_COMPARE` (`Patches::compare_beyond`) and the
+//! rule fires.
 
 use std::f64::consts::PI;
 
@@ -55,15 +57,18 @@ struct Outcome {
     cpu_s: f64,
 }
 
-/// The motor of the scenario: the one `rig::benches` puts on the NUCLEO, which fits the
-/// reference board too (checked), with the shortest ramp to its top speed.
-const MOTOR: &str = "maxon-ec45-flat-70w";
+/// The scenario's (board, motor) pairs (module documentation): every board in `boards/`.
+const BENCHES: [(&str, &str); 3] = [
+    ("nucleo-g474re-ihm08m1", "maxon-ec45-flat-70w"),
+    ("motorgen-reference", "maxon-ec45-flat-70w"),
+    ("motorgen-reference-400a", "emrax-228-hv"),
+];
 
-/// Panics unless `rig::benches` runs `MOTOR` on `board`.
-fn check_fits(board: &str) {
+/// Panics unless `rig::benches` runs `motor` on `board`.
+fn check_fits(motor: &str, board: &str) {
     assert!(
-        benches().iter().any(|(m, b)| m == MOTOR && b == board),
-        "{MOTOR} does not fit {board}"
+        benches().iter().any(|(m, b)| m == motor && b == board),
+        "{motor} does not fit {board}"
     );
 }
 
@@ -167,14 +172,18 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     })
 }
 
-/// On every board but the 400 A variant (module documentation): the duty reaches its
-/// limit and never passes it, no conversion samples inside a switching edge (the strict
+/// On every board in `boards/` ([`BENCHES`]): the duty reaches its limit and never passes it, no conversion samples inside a switching edge (the strict
 /// rule would have stopped the run), and the image's torque and currents are verify's.
 #[test]
 fn torque_step_at_top_speed_reaches_the_duty_limit() {
-    for board in ["nucleo-g474re-ihm08m1", "motorgen-reference"] {
-        let motor = MOTOR;
-        check_fits(board);
+    for board in motor_test_support::board_stems() {
+        assert!(
+            BENCHES.iter().any(|(b, _)| *b == board),
+            "{board} has no duty-limit scenario"
+        );
+    }
+    for (board, motor) in BENCHES {
+        check_fits(motor, board);
         let o =
             step_at_top_speed(motor, board, Patches::default()).unwrap_or_else(|e| panic!("{motor} on {board}: {e}"));
         let tick = 1.0 / f64::from(o.arr);
@@ -210,9 +219,8 @@ fn torque_step_at_top_speed_reaches_the_duty_limit() {
 /// after its low side switched off, and the rule stops the run.
 #[test]
 fn a_duty_one_tick_beyond_the_limit_samples_inside_an_edge() {
-    let board = "nucleo-g474re-ihm08m1";
-    let motor = MOTOR;
-    check_fits(board);
+    let (board, motor) = BENCHES[0];
+    check_fits(motor, board);
     let (file, text) = wiring::read(&format!("boards/{board}.toml")).unwrap();
     let limit = wiring::design(motor, &file, &text)
         .unwrap_or_else(|e| panic!("{motor} on {board}: {e}"))
