@@ -300,6 +300,13 @@ pub fn board(b: &crate::design::BoardOut, d: &Design) -> String {
             b.dead_time_ns,
             b.conversion_time_s * 1e6
         )?;
+        writeln!(
+            s,
+            "  resolver COS held {:.2} µs after SIN: the angle is their mean instant's, with a ripple of ±{:.2}° electrical at twice the resolver angle at the over-speed trip ({:.0} rpm)",
+            b.resolver_skew_s * 1e6,
+            b.resolver_skew_ripple_rad.to_degrees(),
+            b.trips.over_speed_rad_s.value * 30.0 / std::f64::consts::PI
+        )?;
         let l = &b.duty_limit;
         let why = match l.bound {
             crate::design::duty_limit::DutyBound::None => {

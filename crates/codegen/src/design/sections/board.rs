@@ -21,8 +21,8 @@ use serde::Serialize;
 
 use crate::board::{
     ADC_CLOCK_HZ, Board, PinUse, Signal, break_active_high, break_pull, checks_option_bytes, current_sample_instant,
-    gates, resolver_sample_instant, samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity, tim1_cr2_idle,
-    warning_at,
+    gates, resolver_sample_instant, resolver_skew, samples_at_carrier_maximum, sequence_time, tim1_ccer_polarity,
+    tim1_cr2_idle, warning_at,
 };
 use crate::design::Design;
 use crate::design::duty_limit::{self, DutyBound, DutyLimit};
@@ -109,6 +109,14 @@ pub struct BoardOut {
     /// From the ADC trigger to the mean end of the resolver SIN and COS sampling phases
     /// \[s\] (`board::resolver_sample_instant`).
     pub resolver_sample_instant_s: f64,
+    /// How long after the resolver's SIN its COS is held \[s\] (`board::resolver_skew`):
+    /// the design takes their mean instant, which leaves a ripple of the angle at twice
+    /// the resolver angle.
+    pub resolver_skew_s: f64,
+    /// That ripple's amplitude in electrical angle at the over-speed trip \[rad\]:
+    /// ω_e·|Δt|/2 (first order in ε = ω_r·Δt/2, times n_p/n_r), the most the drive can
+    /// see of it.
+    pub resolver_skew_ripple_rad: f64,
     /// The delay from the resolver's sample to the mean of the voltage computed from it
     /// [periods of T_s], the default angle lead k (thesis A (4.23)).
     pub angle_lead_periods: f64,
@@ -471,6 +479,8 @@ pub(in crate::design) fn board(
         return Err(errors);
     };
     let trips = trips(board, d);
+    let over_speed_electrical_rad_s = trips.over_speed_rad_s.value * f64::from(d.motor.pole_pairs);
+    let resolver_skew_s = resolver_skew(board, ADC_CLOCK_HZ);
     let out = BoardOut {
         board: board.clone(),
         current_offset_code: (board.current.offset_v / board.adc_reference_v * CODES_16).round() as i32,
@@ -505,8 +515,10 @@ pub(in crate::design) fn board(
         hse_hz: board.hse_hz.map_or(0, |f| f.round() as u32),
         sample_at_carrier_maximum: u8::from(samples_at_carrier_maximum(board)),
         boot0_option_bytes: u8::from(checks_option_bytes(board)),
-        over_speed_electrical_rad_s: trips.over_speed_rad_s.value * f64::from(d.motor.pole_pairs),
+        over_speed_electrical_rad_s,
         trips,
+        resolver_skew_s,
+        resolver_skew_ripple_rad: 0.5 * over_speed_electrical_rad_s * resolver_skew_s.abs(),
         trigger_to_update_ticks: timing.trigger_to_update_ticks,
         current_sample_instant_s: timing.current_sample_instant_s,
         resolver_sample_instant_s: timing.resolver_sample_instant_s,
@@ -750,6 +762,11 @@ mod tests {
             reference.angle_lead_periods
         );
         assert!((nucleo.resolver_sample_instant_s - 4.579_412e-6).abs() < 1e-12);
+        // COS after SIN: 37 cycles = 0.870 588 µs on the reference board, 260 cycles =
+        // 6.117 647 µs on the NUCLEO.
+        let skew = |stem: &str| resolver_skew(&board_of(stem), ADC_CLOCK_HZ);
+        assert!((skew("motorgen-reference") - 0.870_588e-6).abs() < 1e-12);
+        assert!((skew("nucleo-g474re-ihm08m1") - 6.117_647e-6).abs() < 1e-12);
         assert!(
             (nucleo.angle_lead_periods - 1.317_059).abs() < 1e-6,
             "{}",
