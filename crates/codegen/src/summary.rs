@@ -300,13 +300,24 @@ pub fn board(b: &crate::design::BoardOut, d: &Design) -> String {
             b.dead_time_ns,
             b.conversion_time_s * 1e6
         )?;
-        writeln!(
-            s,
-            "  resolver COS held {:.2} µs after SIN: the angle is their mean instant's, with a ripple of ±{:.2}° electrical at twice the resolver angle at the over-speed trip ({:.0} rpm)",
-            b.resolver_skew_s * 1e6,
-            b.resolver_skew_ripple_rad.to_degrees(),
-            b.trips.over_speed_rad_s.value * 30.0 / std::f64::consts::PI
-        )?;
+        if b.resolver_skew_s == 0.0 {
+            writeln!(
+                s,
+                "  resolver SIN and COS held together {:.2} µs after the trigger, where the excitation peaks (TIM3 shift {} ticks)",
+                b.resolver_sample_instant_s * 1e6,
+                b.excitation_shift_ticks
+            )?;
+        } else {
+            writeln!(
+                s,
+                "  resolver COS held {:.2} µs after SIN, the excitation peaking at their mean {:.2} µs (TIM3 shift {} ticks): the angle ripples by ±{:.2}° electrical at twice the resolver angle at the over-speed trip ({:.0} rpm)",
+                b.resolver_skew_s * 1e6,
+                b.resolver_sample_instant_s * 1e6,
+                b.excitation_shift_ticks,
+                b.resolver_skew_ripple_rad.to_degrees(),
+                b.trips.over_speed_rad_s.value * 30.0 / std::f64::consts::PI
+            )?;
+        }
         let l = &b.duty_limit;
         let why = match l.bound {
             crate::design::duty_limit::DutyBound::None => {

@@ -183,6 +183,15 @@ pub const BDTR: u32 = registers::bdtr(
 /// OC4M and CCR4 of the ADC trigger at the board's sampling instant (defect 8).
 pub const TRIGGER: (u8, u16) = registers::trigger_channel(board::SAMPLE_AT_CARRIER_MAXIMUM == 1, PWM_PERIOD);
 
+/// TIM3_CCR1 of the resolver excitation: the toggle `board::EXCITATION_SHIFT_TICKS` after
+/// half a carrier period from the ADC trigger that resets TIM3, so the excitation's
+/// fundamental peaks at the resolver's mean hold instant (codegen
+/// `sections::board::excitation_shift_ticks`). Modulo TIM3's period 2·ARR1: a resolver
+/// held more than half a carrier period after the trigger gets its edge the half period
+/// before the hold instead of after it — the fundamental's extremum still at the hold,
+/// the pin's level unchanged from the hold to the control step's read.
+pub const EXCITATION_CCR1: u32 = (PWM_PERIOD as u32 + board::EXCITATION_SHIFT_TICKS as u32) % (2 * PWM_PERIOD as u32);
+
 /// TIM1_RCR before the start and after it (`registers::repetition`): the update event
 /// at the board's sampling instant, one carrier period before the compare values computed
 /// from that sample take effect.
@@ -348,10 +357,13 @@ mod tests {
             (4, 1, 0)
         );
         // The angle lead from the resolver's hold instants on the reference board
-        // (SIN and COS at 64.625 and 101.625 ADC cycles of 42.5 MHz after the trigger,
-        // mean 1.955 882 µs; codegen `sections::board::control_timing`):
-        // k = (50 − 1.955 882)/50 + ½ = 1.460 882 → round(k·65 536) = 95 740 (Q16.16).
-        assert_eq!(c.angle_lead, 95_740);
+        // (SIN and COS both at rank 3, 101.625 ADC cycles of 42.5 MHz after the trigger =
+        // 2.391 176 µs; codegen `sections::board::control_timing`):
+        // k = (50 − 2.391 176)/50 + ½ = 1.452 176 → round(k·65 536) = 95 170 (Q16.16).
+        assert_eq!(c.angle_lead, 95_170);
+        // The excitation's peak at that instant: 101.625·4 = 406.5 → 407 ticks after the
+        // trigger, TIM3 toggling at ARR + 407 = 4250 + 407.
+        assert_eq!(EXCITATION_CCR1, 4657);
         assert!(close(c.current_sense.amps_per_lsb[0], 3.3 / (0.015 * 65536.0), 1e-6));
         assert_eq!(c.current_sense.offset, [32768; 3]);
         assert!(close(c.dc_link_sense.volts_per_lsb, 750.0 / 32768.0, 1e-6));

@@ -3,8 +3,11 @@
 //! The firmware triggers ADC1 and ADC2 together from TIM1 and converts up to four
 //! injected ranks each (ADC_JSQR.JL = 0…3, RM0440 §21.4.21). The plan puts every input
 //! on a converter that has it as a channel and prefers, in this order: the resolver's
-//! SIN and COS on different converters (sampled at the same instant); the phase
-//! currents in the first ranks (a rank-k conversion samples k−1 conversions after the
+//! SIN and COS on different converters, at the same rank where that delays no current's
+//! sample (`align_resolver`; with the lock-step below they are then held at the same
+//! instant — held Δt apart, the observer reads the angle of (sin(θ − ε), cos(θ + ε)),
+//! ε = ω_r·Δt/2, and the excitation's envelope at two phases: `board::resolver_skew`);
+//! the phase currents in the first ranks (a rank-k conversion samples k−1 conversions after the
 //! trigger, and low-side shunts carry the current only inside the low-side pulse); equal
 //! sequence lengths, ADC1 the longer one (the control interrupt runs on ADC1's end of
 //! sequence and then waits for ADC2).
@@ -90,6 +93,56 @@ pub fn lock_step(mut seqs: [Vec<AdcSlot>; 2]) -> [Vec<AdcSlot>; 2] {
         }
     }
     seqs
+}
+
+/// Cycles from the first rank's start to the end of `signal`'s sampling phase (its hold
+/// instant less the trigger latency, RM0440 §21.4.12), if a rank converts it.
+fn held_cycles(seqs: &[Vec<AdcSlot>; 2], signal: Signal) -> Option<f64> {
+    seqs.iter().find_map(|q| {
+        let rank = q.iter().position(|s| s.signal == signal && !s.padding)?;
+        let before: f64 = q[..rank]
+            .iter()
+            .map(|s| s.sampling.cycles + super::CONVERSION_CYCLES)
+            .sum();
+        Some(before + q[rank].sampling.cycles)
+    })
+}
+
+/// The lock-stepped sequences with SIN and COS at the same rank where the plan put them
+/// on different converters at different ranks: the inputs after the resolver on the
+/// converter where it comes first (never a current: they come before it) are moved
+/// ahead of it, one at a time, until the ranks match — kept only if no phase current is
+/// then held later (a slow input moved into a current's rank would lengthen that rank's
+/// sampling through the lock-step, and a low-side shunt's window with it).
+fn align_resolver(seqs: [Vec<AdcSlot>; 2]) -> [Vec<AdcSlot>; 2] {
+    let locked = lock_step(seqs.clone());
+    let rank = |q: &[AdcSlot]| {
+        q.iter()
+            .position(|s| matches!(s.signal, Signal::ResolverSin | Signal::ResolverCos))
+    };
+    let (Some(a), Some(b)) = (rank(&seqs[0]), rank(&seqs[1])) else {
+        return locked;
+    };
+    let (early, mut at, target) = if a < b { (0, a, b) } else { (1, b, a) };
+    let mut moved = seqs;
+    let q = &mut moved[early];
+    while at < target && at + 1 < q.len() {
+        let next = q.remove(at + 1);
+        q.insert(at, next);
+        at += 1;
+    }
+    if at != target {
+        return locked;
+    }
+    let aligned = lock_step(moved);
+    let currents = [Signal::CurrentU, Signal::CurrentV, Signal::CurrentW];
+    let later = currents
+        .iter()
+        .any(|&c| match (held_cycles(&aligned, c), held_cycles(&locked, c)) {
+            (Some(x), Some(y)) => x > y,
+            _ => false,
+        });
+    if later { locked } else { aligned }
 }
 
 /// Rank order within one converter: currents, resolver, DC link.
@@ -236,7 +289,7 @@ pub(super) fn plan(
         );
         ok = false;
     }
-    ok.then(|| lock_step(out))
+    ok.then(|| align_resolver(out))
 }
 
 #[cfg(test)]
@@ -280,5 +333,52 @@ mod tests {
         assert_eq!(cycles(&a), [24.5, 24.5, 247.5]);
         assert_eq!(cycles(&b), [24.5, 24.5, 247.5]);
         assert_eq!(b[2].sampling.smp_code, 6);
+    }
+
+    /// The reference board's plan, ADC1 [u, SIN, DC link], ADC2 [v, w, COS], all 24.5
+    /// cycles: the DC link moves ahead of SIN, both resolver ranks third; the currents'
+    /// ranks unchanged.
+    #[test]
+    fn resolver_aligned_where_no_current_waits() {
+        let [a, b] = align_resolver([
+            vec![
+                slot(Signal::CurrentU, 1, 3, 24.5),
+                slot(Signal::ResolverSin, 2, 3, 24.5),
+                slot(Signal::DcLink, 3, 3, 24.5),
+            ],
+            vec![
+                slot(Signal::CurrentV, 3, 3, 24.5),
+                slot(Signal::CurrentW, 17, 3, 24.5),
+                slot(Signal::ResolverCos, 4, 3, 24.5),
+            ],
+        ]);
+        let signals = |q: &[AdcSlot]| q.iter().map(|s| s.signal).collect::<Vec<_>>();
+        assert_eq!(signals(&a), [Signal::CurrentU, Signal::DcLink, Signal::ResolverSin]);
+        assert_eq!(signals(&b), [Signal::CurrentV, Signal::CurrentW, Signal::ResolverCos]);
+    }
+
+    /// The NUCLEO's plan, ADC1 [w, SIN, DC link at 247.5 cycles], ADC2 [u, v, COS]: moving
+    /// the DC link into rank 2 would sample current v for 247.5 cycles (the lock-step), so
+    /// the plan stays as it was.
+    #[test]
+    fn resolver_left_apart_where_a_current_would_wait() {
+        let plan = [
+            vec![
+                slot(Signal::CurrentW, 6, 3, 24.5),
+                slot(Signal::ResolverSin, 11, 3, 24.5),
+                slot(Signal::DcLink, 2, 6, 247.5),
+            ],
+            vec![
+                slot(Signal::CurrentU, 1, 3, 24.5),
+                slot(Signal::CurrentV, 7, 3, 24.5),
+                slot(Signal::ResolverCos, 17, 6, 247.5),
+            ],
+        ];
+        let [a, _] = align_resolver(plan.clone());
+        assert_eq!(
+            a.iter().map(|s| s.signal).collect::<Vec<_>>(),
+            [Signal::CurrentW, Signal::ResolverSin, Signal::DcLink]
+        );
+        assert_eq!(align_resolver(plan.clone()), lock_step(plan));
     }
 }

@@ -235,6 +235,23 @@ impl<'a> OnBoard<'a> {
             json: Json::At("/board/sample_at_carrier_maximum"),
         },
         Decl {
+            name: "EXCITATION_SHIFT_TICKS",
+            value: Custom(|c| {
+                let ticks = c.o.excitation_shift_ticks;
+                let ns = f64::from(ticks) / f64::from(crate::firmware::TIMER_CLOCK_HZ) * 1e9;
+                (
+                    intv(ticks.into(), "u16", "uint16_t"),
+                    format!("{ticks} ticks = {ns:.1} ns"),
+                )
+            }),
+            formula: Lit(
+                "round(t_res·170 MHz), t_res the resolver's mean hold instant after the ADC trigger: TIM3 toggles the f_s/2 excitation ARR + shift ticks after each trigger, so its fundamental peaks when SIN and COS are held",
+            ),
+            equation: Lit("thesis A §4.3, §4.4.1; RM0440 §21.4.12"),
+            inputs: Of(|c| c.key("sensing.source_resistance.resolver")),
+            json: Json::At("/board/excitation_shift_ticks"),
+        },
+        Decl {
             name: "BREAK_ACTIVE_HIGH",
             value: Custom(|c| {
                 let physical = format!("{:?}", c.b.break_polarity);

@@ -264,6 +264,31 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
             res_lo * 1e6,
             res_hi * 1e6
         );
+        // The resolver excitation's fundamental peaks where SIN and COS are held: the
+        // emulated TIM3's output (the image's CCR1, reset by the trigger) toggles once per
+        // carrier period; the peak lies a half period (ARR ticks) before the edge that
+        // follows the trigger. Within one tick of the resolver's mean hold instant.
+        let soc = rig.machine.soc();
+        let trigger = soc.tim1.last_trigger_at.expect("a trigger");
+        let arr = u64::from(rig.design.drive.pwm_period);
+        let tick = soc.tim1.tick;
+        let level = soc.tim3.output(trigger);
+        let edge = (1..2 * arr)
+            .find(|k| soc.tim3.output(trigger + k * tick) != level)
+            .unwrap_or_else(|| panic!("{motor}: the excitation did not toggle within a carrier period"));
+        let peak_s = (edge as f64 - arr as f64) * tick_s;
+        let held_mean = 0.5 * (res_lo + res_hi);
+        assert!(
+            (peak_s - held_mean).abs() <= tick_s,
+            "{motor}: the excitation peaks {:.4} µs after the trigger, the resolver is held at {:.4} µs",
+            peak_s * 1e6,
+            held_mean * 1e6
+        );
+        println!(
+            "{motor}: resolver excitation peaks {:.4} µs after the trigger (edge {edge} ticks), SIN/COS held at {:.4} µs on average",
+            peak_s * 1e6,
+            held_mean * 1e6
+        );
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
              {:.1} % of the {cycles:.0} cycles of a period; trigger → compare values active {}–{} ticks over {n} periods (design {design_ticks}); currents held {:.4}–{:.4} µs after the trigger over {held_n} triggers; loop delay measured {:.4}–{:.4} µs, designed {:.4} µs = {:.4}·T_s",

@@ -109,6 +109,10 @@ pub struct BoardOut {
     /// From the ADC trigger to the mean end of the resolver SIN and COS sampling phases
     /// \[s\] (`board::resolver_sample_instant`).
     pub resolver_sample_instant_s: f64,
+    /// TIM3's resolver-excitation edges this many timer ticks later than half a carrier
+    /// period after the ADC trigger, so that the excitation's fundamental peaks at the
+    /// resolver's mean hold instant (`excitation_shift_ticks`).
+    pub excitation_shift_ticks: u16,
     /// How long after the resolver's SIN its COS is held \[s\] (`board::resolver_skew`):
     /// the design takes their mean instant, which leaves a ripple of the angle at twice
     /// the resolver angle.
@@ -518,6 +522,7 @@ pub(in crate::design) fn board(
         over_speed_electrical_rad_s,
         trips,
         resolver_skew_s,
+        excitation_shift_ticks: excitation_shift_ticks(timing.resolver_sample_instant_s),
         resolver_skew_ripple_rad: 0.5 * over_speed_electrical_rad_s * resolver_skew_s.abs(),
         trigger_to_update_ticks: timing.trigger_to_update_ticks,
         current_sample_instant_s: timing.current_sample_instant_s,
@@ -658,6 +663,21 @@ fn control_timing(at_carrier_maximum: bool, arr: u16, ts: f64, held: HoldInstant
     }
 }
 
+/// TIM3's shift of the resolver excitation \[timer ticks\]: the resolver's mean hold
+/// instant `resolver_s` after the trigger, rounded. The excitation is a square wave at
+/// f_s/2 that TIM3 toggles once per carrier period, `ARR + shift` ticks after each ADC
+/// trigger resets it (firmware `board::resolver`); its fundamental, which the board's
+/// excitation filter passes (thesis A §4.4), peaks midway between two edges, `shift`
+/// ticks after the trigger — at the instant the ADCs hold SIN and COS. There the
+/// envelope cos(π·f_s·(t − t_peak)) is at its extremum for both: an excitation peaking
+/// at the trigger would read the two windings at the gains cos(π·f_s·t_SIN) and
+/// cos(π·f_s·t_COS) — unequal where they are held apart (the NUCLEO's 1.52 and 7.64 µs
+/// at 40 kHz: 0.982 and 0.574, an angle error up to 15° of the resolver), and less than
+/// one everywhere (thesis A §4.4.1: a shift only lowers the apparent amplitude).
+pub fn excitation_shift_ticks(resolver_s: f64) -> u16 {
+    (resolver_s * f64::from(firmware::TIMER_CLOCK_HZ)).round() as u16
+}
+
 /// When the ADCs hold what the control step reads, after the trigger \[s\].
 #[derive(Debug, Clone, Copy)]
 struct HoldInstants {
@@ -750,23 +770,29 @@ mod tests {
             "{}",
             nucleo.loop_delay_s
         );
-        // The resolver: SIN rank 2 (3.125 + 37 + 24.5 = 64.625 cycles) on both boards;
-        // COS rank 3 after two 24.5-cycle ranks on the reference board (101.625 cycles,
-        // mean 83.125 = 1.955 882 µs: k = (50 − 1.955 882)/50 + ½ = 1.460 882), rank 3 with
-        // 247.5 cycles on the NUCLEO (324.625, mean 194.625 = 4.579 412 µs: k =
-        // (25.005 882 − 4.579 412)/25 + ½ = 1.317 059).
-        assert!((reference.resolver_sample_instant_s - 1.955_882e-6).abs() < 1e-12);
+        // The resolver: on the reference board SIN and COS both rank 3, after two 24.5-cycle
+        // ranks (the DC link moved ahead of SIN, `sequence::align_resolver`): 3.125 + 2·37
+        // + 24.5 = 101.625 cycles = 2.391 176 µs, k = (50 − 2.391 176)/50 + ½ = 1.452 176.
+        // On the NUCLEO SIN rank 2 (3.125 + 37 + 24.5 = 64.625 cycles), COS rank 3 with
+        // 247.5 cycles (324.625), mean 194.625 = 4.579 412 µs: k = (25.005 882 −
+        // 4.579 412)/25 + ½ = 1.317 059.
+        assert!((reference.resolver_sample_instant_s - 2.391_176e-6).abs() < 1e-12);
         assert!(
-            (reference.angle_lead_periods - 1.460_882).abs() < 1e-6,
+            (reference.angle_lead_periods - 1.452_176).abs() < 1e-6,
             "{}",
             reference.angle_lead_periods
         );
         assert!((nucleo.resolver_sample_instant_s - 4.579_412e-6).abs() < 1e-12);
-        // COS after SIN: 37 cycles = 0.870 588 µs on the reference board, 260 cycles =
-        // 6.117 647 µs on the NUCLEO.
+        // SIN and COS both at rank 3 on the reference board (101.625 cycles: no skew); SIN
+        // rank 2, COS rank 3 on the NUCLEO (260 cycles = 6.117 647 µs apart: aligning them
+        // would move its DC link's 247.5-cycle rank ahead of current v).
         let skew = |stem: &str| resolver_skew(&board_of(stem), ADC_CLOCK_HZ);
-        assert!((skew("motorgen-reference") - 0.870_588e-6).abs() < 1e-12);
+        assert_eq!(skew("motorgen-reference"), 0.0);
         assert!((skew("nucleo-g474re-ihm08m1") - 6.117_647e-6).abs() < 1e-12);
+        // The excitation's peak at the mean hold instant, in 170 MHz ticks (4 per ADC
+        // cycle): 101.625·4 = 406.5 → 407; 194.625·4 = 778.5 → 779.
+        assert_eq!(excitation_shift_ticks(reference.resolver_sample_instant_s), 407);
+        assert_eq!(excitation_shift_ticks(nucleo.resolver_sample_instant_s), 779);
         assert!(
             (nucleo.angle_lead_periods - 1.317_059).abs() < 1e-6,
             "{}",
