@@ -53,8 +53,9 @@
 //!    currents, (2.7)); at the end of each level the last `average_samples` periods are
 //!    averaged. Judged in this order:
 //!    * sign: the current has the commanded sign, else
-//!      [`PreflightFault::InvertedSensing`] (what the first hold let pass with an open
-//!      phase at 90° to its voltage);
+//!      [`PreflightFault::InvertedSensing`] (what the first hold's margin lets pass:
+//!      one phase's sensing inverted, the current along the voltage then between −⅓
+//!      and 1 of its true size with the angle, or a hold current below the margin);
 //!    * sum: |i_u + i_v + i_w| ≤ [`Preflight::sum_bound`] (three measured phases only),
 //!      else [`PreflightFault::CurrentSum`];
 //!    * open phase: every phase whose axis lies within 60° of the pulse (|cos| ≥ 1/2)

@@ -172,8 +172,9 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     })
 }
 
-/// On every board in `boards/` ([`BENCHES`]): the duty reaches its limit and never passes it, no conversion samples inside a switching edge (the strict
-/// rule would have stopped the run), and the image's torque and currents are verify's.
+/// On every board in `boards/` ([`BENCHES`]): the duty reaches its limit and never
+/// passes it, no conversion samples inside a switching edge (the strict rule would have
+/// stopped the run), and the image's torque and currents are verify's.
 #[test]
 fn torque_step_at_top_speed_reaches_the_duty_limit() {
     for board in motor_test_support::board_stems() {
