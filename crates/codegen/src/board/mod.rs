@@ -372,8 +372,8 @@ pub fn resolver_sample_instant(board: &Board, adc_hz: f64) -> f64 {
 /// ripple at twice the resolver angle whose amplitude grows with the speed.
 pub fn resolver_skew(board: &Board, adc_hz: f64) -> f64 {
     match (
-        hold_instant(board, Signal::ResolverSin, adc_hz),
-        hold_instant(board, Signal::ResolverCos, adc_hz),
+        hold_instant(&board.adc, Signal::ResolverSin, adc_hz),
+        hold_instant(&board.adc, Signal::ResolverCos, adc_hz),
     ) {
         (Some(sin), Some(cos)) => cos - sin,
         _ => 0.0,
@@ -383,8 +383,8 @@ pub fn resolver_skew(board: &Board, adc_hz: f64) -> f64 {
 /// When `signal`'s first rank is held after the trigger \[s\]: the trigger latency, the
 /// ranks before it (sampling + 12.5 cycles each) and its own sampling; `None` where no
 /// sequence converts it.
-fn hold_instant(board: &Board, signal: Signal, adc_hz: f64) -> Option<f64> {
-    board.adc.iter().find_map(|q| {
+pub(crate) fn hold_instant(adc: &[Vec<AdcSlot>; 2], signal: Signal, adc_hz: f64) -> Option<f64> {
+    adc.iter().find_map(|q| {
         let rank = q.iter().position(|s| s.signal == signal && !s.padding)?;
         let before: f64 = q[..rank].iter().map(|s| s.sampling.cycles + CONVERSION_CYCLES).sum();
         Some((TRIGGER_LATENCY_CYCLES + before + q[rank].sampling.cycles) / adc_hz)
@@ -394,7 +394,10 @@ fn hold_instant(board: &Board, signal: Signal, adc_hz: f64) -> Option<f64> {
 /// The mean hold instant of `signals` after the trigger \[s\] (each signal's first rank;
 /// 0 for none of them on the board, which its parser refuses for the currents and resolver).
 fn sample_instant(board: &Board, signals: &[Signal], adc_hz: f64) -> f64 {
-    let held: Vec<f64> = signals.iter().filter_map(|&s| hold_instant(board, s, adc_hz)).collect();
+    let held: Vec<f64> = signals
+        .iter()
+        .filter_map(|&s| hold_instant(&board.adc, s, adc_hz))
+        .collect();
     held.iter().sum::<f64>() / held.len().max(1) as f64
 }
 

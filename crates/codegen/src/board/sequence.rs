@@ -95,19 +95,6 @@ pub fn lock_step(mut seqs: [Vec<AdcSlot>; 2]) -> [Vec<AdcSlot>; 2] {
     seqs
 }
 
-/// Cycles from the first rank's start to the end of `signal`'s sampling phase (its hold
-/// instant less the trigger latency, RM0440 §21.4.12), if a rank converts it.
-fn held_cycles(seqs: &[Vec<AdcSlot>; 2], signal: Signal) -> Option<f64> {
-    seqs.iter().find_map(|q| {
-        let rank = q.iter().position(|s| s.signal == signal && !s.padding)?;
-        let before: f64 = q[..rank]
-            .iter()
-            .map(|s| s.sampling.cycles + super::CONVERSION_CYCLES)
-            .sum();
-        Some(before + q[rank].sampling.cycles)
-    })
-}
-
 /// The lock-stepped sequences with SIN and COS at the same rank where the plan put them
 /// on different converters at different ranks: the inputs after the resolver on the
 /// converter where it comes first (never a current: they come before it) are moved
@@ -136,12 +123,15 @@ fn align_resolver(seqs: [Vec<AdcSlot>; 2]) -> [Vec<AdcSlot>; 2] {
     }
     let aligned = lock_step(moved);
     let currents = [Signal::CurrentU, Signal::CurrentV, Signal::CurrentW];
-    let later = currents
-        .iter()
-        .any(|&c| match (held_cycles(&aligned, c), held_cycles(&locked, c)) {
+    let later = currents.iter().any(|&c| {
+        match (
+            super::hold_instant(&aligned, c, ADC_CLOCK_HZ),
+            super::hold_instant(&locked, c, ADC_CLOCK_HZ),
+        ) {
             (Some(x), Some(y)) => x > y,
             _ => false,
-        });
+        }
+    });
     if later { locked } else { aligned }
 }
 
