@@ -92,11 +92,10 @@ impl Drive {
 impl Analog for Drive {
     /// The board's [`Sensing`] of the plant at `t`: its phase currents, DC link and
     /// resolver angle θ_r.
-    fn volts(&mut self, signal: Signal, t: f64, excitation_high: bool) -> f64 {
+    fn volts(&mut self, signal: Signal, t: f64, excitation: f64) -> f64 {
         let m = self.measure_at(t);
         let by_leg = self.leads.map(|w| m.phase_currents[w]);
-        self.sensing
-            .volts(signal, by_leg, m.dc_link, m.theta_r, excitation_high)
+        self.sensing.volts(signal, by_leg, m.dc_link, m.theta_r, excitation)
     }
 
     fn bridge(&mut self, t: f64, duties: Option<[f64; 3]>) {

@@ -64,9 +64,10 @@ impl Wiring {
 
 /// The analog inputs, as the test drives them.
 pub trait Analog: std::any::Any {
-    /// Voltage at the pin of `signal` at `t` \[s\]; `excitation_high` is the resolver
-    /// excitation's sign at that instant (the level of its square wave).
-    fn volts(&mut self, signal: Signal, t: f64, excitation_high: bool) -> f64;
+    /// Voltage at the pin of `signal` at `t` \[s\]; `excitation` is the resolver
+    /// excitation at that instant, normalised to ±1 at its peaks
+    /// ([`crate::periph::tim3::Tim3::excitation`]).
+    fn volts(&mut self, signal: Signal, t: f64, excitation: f64) -> f64;
 
     /// From `t` \[s\] on the bridge applies `duties` (each leg's high-side share of the
     /// carrier period, from the switches the gate driver turns on; `None`: not
@@ -123,6 +124,10 @@ pub struct Patches {
     /// a duty one timer tick beyond the sampling window's limit (`board::MAX_COMPARE`),
     /// as a modulator without the duty limit would exceed it (issue 26 item 3).
     pub compare_beyond: Option<u16>,
+    /// TIM3_CCR1 writes are replaced by half TIM3's period, (ARR + 1)/2: the excitation
+    /// toggles half a carrier period after TIM1's reset, so its fundamental peaks at the
+    /// ADC trigger, not where SIN and COS are held (the image before stop 40).
+    pub excitation_peak_at_trigger: bool,
 }
 
 /// A break pulse the test schedules on the comparator.
@@ -231,6 +236,10 @@ pub struct Soc {
     pub current_sample_instant: Option<(f64, f64, u64)>,
     /// The same for the resolver's SIN and COS.
     pub resolver_sample_instant: Option<(f64, f64, u64)>,
+    /// Measured: the instant \[s\] SIN and the instant COS was last held, and the resolver
+    /// excitation ([`Tim3::excitation`]) there — the envelope gain each winding was read
+    /// at (equal gains: the angle is undistorted, thesis A §4.3).
+    pub resolver_excitation: [Option<(f64, f64)>; 2],
 }
 
 /// The inputs of one kind held after one ADC trigger, for [`Soc::current_sample_instant`]
@@ -396,6 +405,7 @@ impl Soc {
             resolver_held: Holds::default(),
             current_sample_instant: None,
             resolver_sample_instant: None,
+            resolver_excitation: [None; 2],
         };
         soc.clocks.hse_crystal_hz = soc.wiring.hw.hse_crystal_hz;
         soc.update_clock();
@@ -799,7 +809,14 @@ impl Soc {
         let ts = self.time_s();
         self.service();
         match block {
-            Block::Tim3 => self.tim3.write(off, value, t)?,
+            Block::Tim3 => {
+                let value = if off == 0x34 && self.patches.excitation_peak_at_trigger {
+                    self.tim3.period_ticks() / 2
+                } else {
+                    value
+                };
+                self.tim3.write(off, value, t)?
+            }
             Block::Iwdg => self.iwdg.write(off, value, ts)?,
             Block::Fdcan => {
                 let kernel = self.clocks.fdcan_kernel_hz();
@@ -1132,6 +1149,7 @@ impl Soc {
             let name = self.adc[k].name;
             let mut currents = Vec::new();
             let mut resolver = Vec::new();
+            let mut envelope = [None; 2];
             self.adc[k].complete(ts, |ch, at| {
                 let pin = pins.get(usize::from(ch)).copied().flatten();
                 let Some(input) = pin.and_then(|p| hw.analog_at(p)) else {
@@ -1175,12 +1193,23 @@ impl Soc {
                     crate::hardware::Analog::Cos => resolver.push((1, held)),
                     crate::hardware::Analog::DcLink => {}
                 }
-                let v = analog.volts(input.signal, held, tim3.output((held * UNITS_PER_S) as u64));
+                let excitation = tim3.excitation((held * UNITS_PER_S) as u64);
+                match input.signal {
+                    crate::hardware::Analog::Sin => envelope[0] = Some((held, excitation)),
+                    crate::hardware::Analog::Cos => envelope[1] = Some((held, excitation)),
+                    _ => {}
+                }
+                let v = analog.volts(input.signal, held, excitation);
                 // Ideal 12-bit conversion: code = V/V_REF·4096, clamped (RM0440 §21.4.1).
                 (v / vref * 4096.0).floor().clamp(0.0, 4095.0) as u16
             });
             if let Some(b) = problem {
                 self.fail(b);
+            }
+            for (k, e) in envelope.into_iter().enumerate() {
+                if e.is_some() {
+                    self.resolver_excitation[k] = e;
+                }
             }
             let trigger = self.tim1.last_trigger_at;
             for (input, held) in resolver {
@@ -1283,7 +1312,7 @@ pub(crate) mod tests {
     /// Every analog input at 0 V (the unit tests' source).
     pub(crate) struct Quiet;
     impl Analog for Quiet {
-        fn volts(&mut self, _: Signal, _: f64, _: bool) -> f64 {
+        fn volts(&mut self, _: Signal, _: f64, _: f64) -> f64 {
             0.0
         }
     }

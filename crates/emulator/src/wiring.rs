@@ -66,8 +66,9 @@ pub const RESOLVER_AMPLITUDE: f64 = 0.4;
 /// The board's analog front end as the hardware has it: what the pins of the sensed
 /// signals carry for a given drive state — phase current i → the board's zero level +
 /// its signed gain·i, the DC link through its divider, the resolver SIN/COS at mid-scale
-/// ± [`RESOLVER_AMPLITUDE`] of half the range times sin/cos θ_r and the excitation's sign
-/// (synchronous demodulation, thesis A §4.3).
+/// ± [`RESOLVER_AMPLITUDE`] of half the range times sin/cos θ_r and the excitation at the
+/// instant the ADC holds them (the envelope the synchronous demodulation samples, thesis A
+/// §4.3).
 #[derive(Clone, Debug, PartialEq)]
 pub struct Sensing {
     hw: Hardware,
@@ -92,30 +93,22 @@ impl Sensing {
     }
 
     /// Voltage at the pin of `signal` with phase currents `currents` \[A\], DC link
-    /// `dc_link_v` \[V\], resolver angle `theta_r` \[rad\] and the excitation's level.
-    pub fn volts(
-        &self,
-        signal: Signal,
-        currents: [f64; 3],
-        dc_link_v: f64,
-        theta_r: f64,
-        excitation_high: bool,
-    ) -> f64 {
+    /// `dc_link_v` \[V\], resolver angle `theta_r` \[rad\] and the excitation (±1 at its
+    /// peaks).
+    pub fn volts(&self, signal: Signal, currents: [f64; 3], dc_link_v: f64, theta_r: f64, excitation: f64) -> f64 {
         let half = self.hw.vref / 2.0;
-        let sign = if excitation_high { 1.0 } else { -1.0 };
         match signal {
             Signal::Current(k) => self.hw.current_volts(self.gain_error[k] * currents[k]) + self.zero_error_v[k],
             Signal::DcLink => dc_link_v * self.hw.dc_link_ratio,
-            Signal::Sin => half + RESOLVER_AMPLITUDE * half * sign * theta_r.sin(),
-            Signal::Cos => half + RESOLVER_AMPLITUDE * half * sign * theta_r.cos(),
+            Signal::Sin => half + RESOLVER_AMPLITUDE * half * excitation * theta_r.sin(),
+            Signal::Cos => half + RESOLVER_AMPLITUDE * half * excitation * theta_r.cos(),
         }
     }
 }
 
 /// The inverter at standstill: phase currents `currents` \[A\] and the DC link at
 /// `dc_link_v` through the board's [`Sensing`], the resolver at rotor angle 0 (SIN at
-/// mid-scale, COS at [`RESOLVER_AMPLITUDE`] of half the range times the excitation's
-/// sign).
+/// mid-scale, COS at [`RESOLVER_AMPLITUDE`] of half the range times the excitation).
 #[derive(Clone, Debug)]
 pub struct Standstill {
     /// Phase currents u, v, w \[A\].
@@ -138,8 +131,8 @@ impl Standstill {
 }
 
 impl Analog for Standstill {
-    fn volts(&mut self, signal: Signal, _t: f64, excitation_high: bool) -> f64 {
+    fn volts(&mut self, signal: Signal, _t: f64, excitation: f64) -> f64 {
         self.sensing
-            .volts(signal, self.currents, self.dc_link_v, 0.0, excitation_high)
+            .volts(signal, self.currents, self.dc_link_v, 0.0, excitation)
     }
 }

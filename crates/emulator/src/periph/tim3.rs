@@ -19,6 +19,8 @@ pub struct Tim3 {
     reset_at: Option<u64>,
     /// OC1REF at that reset.
     level_at_reset: bool,
+    /// The last two OC1REF toggles before that reset, latest first (bus sub-ticks).
+    edges_at_reset: [Option<u64>; 2],
     /// Bus sub-ticks per timer tick.
     pub tick: u64,
     /// Resets by TIM1's TRGO.
@@ -31,6 +33,7 @@ impl Default for Tim3 {
             regs: [0; 0x68 / 4],
             reset_at: None,
             level_at_reset: false,
+            edges_at_reset: [None; 2],
             tick: 8,
             slave_resets: 0,
         }
@@ -49,13 +52,75 @@ impl Tim3 {
             return self.level_at_reset;
         };
         let ticks = t.saturating_sub(r) / self.tick;
-        let (ccr, arr) = (u64::from(self.reg(0x34)), u64::from(self.reg(0x2C)));
+        let (ccr, arr) = (u64::from(self.reg(0x34)), self.arr());
         let toggles = if (self.reg(0x18) >> 4) & 7 == 0b011 && ticks >= ccr && ccr <= arr {
             1 + (ticks - ccr) / (arr + 1)
         } else {
             0
         };
         self.level_at_reset ^ (toggles % 2 == 1)
+    }
+
+    /// The auto-reload value: TIM3 is a 16-bit timer (RM0440 §29.2, ARR[15:0] of
+    /// TIMx_ARR without dithering; the PAC's `write` keeps the register's other reset bits).
+    fn arr(&self) -> u64 {
+        u64::from(self.reg(0x2C) & 0xFFFF)
+    }
+
+    /// The counter's period in ticks, ARR + 1.
+    pub fn period_ticks(&self) -> u32 {
+        self.arr() as u32 + 1
+    }
+
+    /// The last two OC1REF toggles at or before `t`, latest first (bus sub-ticks): the
+    /// counter matches CCR1 at CCR1 ticks after the reset and every ARR + 1 after.
+    fn last_edges(&self, t: u64) -> [Option<u64>; 2] {
+        let Some(r) = self.reset_at else {
+            return self.edges_at_reset;
+        };
+        let ticks = t.saturating_sub(r) / self.tick;
+        let (ccr, arr) = (u64::from(self.reg(0x34)), self.arr());
+        let n = if (self.reg(0x18) >> 4) & 7 == 0b011 && ticks >= ccr && ccr <= arr {
+            1 + (ticks - ccr) / (arr + 1)
+        } else {
+            0
+        };
+        let at = |k: u64| Some(r + (ccr + k * (arr + 1)) * self.tick);
+        match n {
+            0 => self.edges_at_reset,
+            1 => [at(0), self.edges_at_reset[0]],
+            _ => [at(n - 1), at(n - 2)],
+        }
+    }
+
+    /// Restarts the counter at `t` (enable, UG, TIM1's TRGO), keeping OC1REF and its
+    /// last edges.
+    fn restart(&mut self, t: u64, running: bool) {
+        self.level_at_reset = self.oc1(t);
+        self.edges_at_reset = self.last_edges(t);
+        self.reset_at = running.then_some(t);
+    }
+
+    /// The resolver excitation at `t` as the board's excitation filter passes it to the
+    /// resolver: the fundamental of the pin's square wave, normalised to ±1 — the pin's
+    /// level × sin(π·τ/H), τ the time since its last edge and H the time between its last
+    /// two (a square wave's fundamental peaks midway between its edges; the filter is
+    /// centred on the toggling frequency, so it adds no phase there, thesis A §4.3: the
+    /// excitation is filtered to a sinusoid at f_s/2). 0 with the output disabled, before
+    /// two edges, or once no edge has come for H: a transformer passes no DC.
+    pub fn excitation(&self, t: u64) -> f64 {
+        if self.reg(0x20) & 1 == 0 {
+            return 0.0;
+        }
+        let [Some(last), Some(prev)] = self.last_edges(t) else {
+            return 0.0;
+        };
+        let (h, tau) = ((last - prev) as f64, t.saturating_sub(last) as f64);
+        if h <= 0.0 || tau >= h {
+            return 0.0;
+        }
+        let level = if self.output(t) { 1.0 } else { -1.0 };
+        level * (std::f64::consts::PI * tau / h).sin()
     }
 
     /// The pin output: OC1REF with CC1E (polarity CC1P).
@@ -70,8 +135,7 @@ impl Tim3 {
         let sms = (smcr & 7) | ((smcr >> 13) & 8);
         let ts = ((smcr >> 4) & 7) | ((smcr >> 17) & 0x18);
         if self.reset_at.is_some() && sms == 0b0100 && ts == 0 {
-            self.level_at_reset = self.oc1(t);
-            self.reset_at = Some(t);
+            self.restart(t, true);
             self.slave_resets += 1;
         }
     }
@@ -82,7 +146,7 @@ impl Tim3 {
             return Err(unknown("TIM3", off));
         }
         Ok(match (off, self.reset_at) {
-            (0x24, Some(r)) => ((t.saturating_sub(r) / self.tick) % (u64::from(self.reg(0x2C)) + 1)) as u32,
+            (0x24, Some(r)) => ((t.saturating_sub(r) / self.tick) % (self.arr() + 1)) as u32,
             _ => self.reg(off),
         })
     }
@@ -102,17 +166,15 @@ impl Tim3 {
                             "only up-counting with PSC = 0 is modelled (RM0440 §29.5.1)",
                         ));
                     }
-                    self.reset_at = Some(t);
+                    self.restart(t, true);
                 } else if value & 1 == 0 && was {
-                    self.level_at_reset = self.oc1(t);
-                    self.reset_at = None;
+                    self.restart(t, false);
                 }
                 self.regs[0] = value;
             }
             0x14 => {
                 if value & 1 != 0 && self.reset_at.is_some() {
-                    self.level_at_reset = self.oc1(t);
-                    self.reset_at = Some(t);
+                    self.restart(t, true);
                 }
             }
             0x10 => self.regs[4] &= value,

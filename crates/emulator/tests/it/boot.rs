@@ -2,6 +2,8 @@
 //! first enabled PWM period, on every board in `boards/` with every motor that fits it,
 //! in strict mode; and reintroduced bring-up defects fail with the rule they break.
 
+use std::f64::consts::PI;
+
 use crate::BOOT_LIMIT_S;
 use motor_emulator::periph::system::IRQ_ADC1_2;
 use motor_emulator::rig::{Bench, Rig, benches};
@@ -288,6 +290,24 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
             "{motor}: resolver excitation peaks {:.4} µs after the trigger (edge {edge} ticks), SIN/COS held at {:.4} µs on average",
             peak_s * 1e6,
             held_mean * 1e6
+        );
+        // The envelope gain each winding was read at (the excitation filtered to a
+        // sinusoid at f_s/2, the emulated TIM3's `excitation`): the same for SIN and COS,
+        // sign included, and by hand cos(π·f_s·Δ/2) for windings held Δ apart about the peak — 1 where
+        // they are held together, cos(π·40 kHz·3.06 µs) = 0.927 on the NUCLEO.
+        let [Some((t_sin, e_sin)), Some((t_cos, e_cos))] = soc.resolver_excitation else {
+            panic!("{motor}: SIN or COS never converted");
+        };
+        let fs = 1.0 / ts;
+        let by_hand = (PI * fs * (t_cos - t_sin) / 2.0).cos();
+        assert!(
+            (e_sin - e_cos).abs() <= 2e-3 && (e_sin.abs() - by_hand).abs() <= 2e-3,
+            "{motor}: SIN read at envelope gain {e_sin:.4}, COS at {e_cos:.4} ({:.3} µs apart: cos(π·f_s·Δ/2) = {by_hand:.4})",
+            (t_cos - t_sin) * 1e6
+        );
+        println!(
+            "{motor}: resolver envelope gain SIN {e_sin:.4}, COS {e_cos:.4}, held {:.3} µs apart (by hand {by_hand:.4})",
+            (t_cos - t_sin) * 1e6
         );
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \

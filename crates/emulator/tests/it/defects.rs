@@ -263,3 +263,45 @@ fn a_break_pulse_inside_the_interrupt_is_not_missed() {
         }
     }
 }
+
+/// The resolver excitation's peak at the ADC trigger (the image before stop 40: TIM3_CCR1
+/// at half its period, `Patches::excitation_peak_at_trigger`) on the NUCLEO +
+/// X-NUCLEO-IHM08M1, where SIN and COS are held at different ranks: the emulated
+/// excitation (the square wave's fundamental, `Tim3::excitation`) reads them at different
+/// envelope gains — by hand cos(π·f_s·t) for a winding held t after the peak, 0.982 and
+/// 0.574 at the 1.52 µs and 7.64 µs the emulator measures at 40 kHz — which the boot test
+/// (`control_interrupt_instructions_fit_the_period_and_the_budget`) refuses on every pair.
+#[test]
+fn excitation_peak_at_the_trigger_reads_sin_and_cos_at_different_gains() {
+    let bench = Bench::new("maxon-ec45-flat-70w", "nucleo-g474re-ihm08m1").unwrap();
+    let name = bench.name();
+    let patches = Patches {
+        excitation_peak_at_trigger: true,
+        ..Patches::default()
+    };
+    let (rig, v) = run_patched(bench, patches, 5.0);
+    assert!(v.is_none(), "{name}: {v:?}");
+    let soc = rig.machine.soc();
+    let [Some((t_sin, e_sin)), Some((t_cos, e_cos))] = soc.resolver_excitation else {
+        panic!("{name}: SIN or COS never converted");
+    };
+    // The windings' hold instants after the trigger: their mean (measured per trigger)
+    // ∓ half their distance.
+    let (mean, _, _) = soc.resolver_sample_instant.expect("resolver conversions");
+    let fs = rig.design.drive.switching_frequency_hz;
+    let gain = |t: f64| (std::f64::consts::PI * fs * t).cos();
+    let (g_sin, g_cos) = (gain(mean - (t_cos - t_sin) / 2.0), gain(mean + (t_cos - t_sin) / 2.0));
+    println!(
+        "{name}: excitation peak at the trigger: SIN held {:.3} µs after it at gain {e_sin:.4} (by hand {g_sin:.4}), COS {:.3} µs at {e_cos:.4} (by hand {g_cos:.4})",
+        (mean - (t_cos - t_sin) / 2.0) * 1e6,
+        (mean + (t_cos - t_sin) / 2.0) * 1e6
+    );
+    assert!(
+        (e_sin.abs() - g_sin).abs() < 0.01 && (e_cos.abs() - g_cos).abs() < 0.01,
+        "{name}: envelope gains {e_sin:.4} / {e_cos:.4}, by hand {g_sin:.4} / {g_cos:.4}"
+    );
+    assert!(
+        (e_sin - e_cos).abs() > 0.3,
+        "{name}: SIN and COS read at gains {e_sin:.4} and {e_cos:.4}"
+    );
+}

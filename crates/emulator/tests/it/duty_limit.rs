@@ -17,12 +17,23 @@
 //! X-NUCLEO-IHM08M1 (low-side shunts, d_max < 1) and the reference board (in-line Hall
 //! sensors: d_max = 1, the duty reaches the THPWM linear range's 100 %) with
 //! maxon-ec45-flat-70w, the 400 A variant of the reference board (the same hardware with
-//! another sensing gain, d_max = 1) with emrax-228-hv. The 400 A board takes only the
-//! traction motors; of them emrax-228-hv's angle observer (ω_n = 1000 rad/s) follows a
-//! zero-torque ramp to its 6500 rpm in 0.33 s, where amk-dd5-ipm's (200 rad/s) and
-//! chalmers-hev50's (70 rad/s) would need seconds of emulated time. The defect: the
-//! compare values one timer tick beyond `MAX_COMPARE` (`Patches::compare_beyond`) and the
-//! rule fires.
+//! another sensing gain, d_max = 1) with emrax-228-hv. The defect: the compare values one
+//! timer tick beyond `MAX_COMPARE` (`Patches::compare_beyond`) and the rule fires.
+//!
+//! The other motors with a flux linkage, tried on their boards (stop 41) and not run:
+//! * fischer-ti085, amk-dd5-ipm, chalmers-hev50: the trig-identity observer's acceleration
+//!   at a lag Δ is K_i·A·sin Δ (thesis A (4.12)–(4.15)); with ω_n = 70, 200 and 70 rad/s
+//!   and the emulated resolver's A = 0.4 a zero-torque ramp to the top speed within 3° of
+//!   lag takes 81.6 s, 12.5 s and 24.5 s of emulated time. A faster ramp leaves a lag that
+//!   the ramp's end releases within a few 1/ω_n against a back EMF near V'_max: fischer-ti085
+//!   ramped at its drive's 2 000 rpm/s (24° of lag) to 12 000 rpm reached i_d = 100.6 A at
+//!   zero torque 13 ms after the ramp's end, and the over-current trip switched it off. Its
+//!   current loop (thesis A's 100 rad/s, K_p = 0.039 V/A, L = 0.39 mH) cannot reject the
+//!   tens of volts the frame's turn puts on the d axis.
+//! * mit-mini-cheetah-actuator (ω_n = 2000 rad/s, 0.11 s to 2 292 rpm): the step's peak
+//!   duty was 0.98976, not the limit — its field weakening (α_fw = 500 rad/s, V'_max =
+//!   0.8·V_max) keeps the PI output inside the circle, so the duty limit is not exercised
+//!   (the torque was within 0.24 of verify's tolerance, the currents 0.419 A of 1.761 A).
 
 use std::f64::consts::PI;
 
