@@ -88,6 +88,7 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
         max_duty,
         loop_delay_periods: timing.map_or(nominal, |t| t.loop_delay_s * fs),
         angle_lead_periods: timing.map_or(nominal, |t| t.angle_lead_periods),
+        resolver_signal_gain: board::resolver_signal_gain(&board, fs),
     };
     match design::design_on(&spec, source, terms) {
         Ok(d) => design::on_board(d, &board, board_src),

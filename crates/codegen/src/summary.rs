@@ -110,8 +110,19 @@ pub fn summary(d: &Design) -> String {
         )?;
         writeln!(
             s,
-            "  K_p = 2ζω_n = {} 1/s, K_i = ω_n² = {} 1/s² (4.15); Q1.31: K̃_p = {}, K̃_i = {} (4.22)",
-            o.gains.kp, o.gains.ki, o.gains.kp_q31, o.gains.ki_q31
+            "  K_p = 2ζω_n = {} 1/s, K_i = ω_n² = {} 1/s² (4.15); Q1.31: K̃_p = {}, K̃_i = {} (4.22){}",
+            o.gains.kp,
+            o.gains.ki,
+            o.gains.kp_q31,
+            o.gains.ki_q31,
+            if o.gains.signal_gain == 1.0 {
+                String::new()
+            } else {
+                format!(
+                    ", divided by the resolver signal's {:.4} of full scale (4.10)",
+                    o.gains.signal_gain
+                )
+            }
         )?;
         writeln!(
             s,

@@ -57,16 +57,10 @@ pub fn read(file: &str) -> Result<(String, String), String> {
     Ok((file.to_string(), text))
 }
 
-/// Amplitude of the resolver SIN/COS inputs at the excitation's extremum, as a fraction
-/// of half the ADC range around mid-scale. Neither board states the front end's swing,
-/// so this is the test's choice, inside the rails; the image's angle observer scales its
-/// trig-identity error with it (thesis A (4.10)), an atan2 error does not.
-pub const RESOLVER_AMPLITUDE: f64 = 0.4;
-
 /// The board's analog front end as the hardware has it: what the pins of the sensed
 /// signals carry for a given drive state — phase current i → the board's zero level +
 /// its signed gain·i, the DC link through its divider, the resolver SIN/COS at mid-scale
-/// ± [`RESOLVER_AMPLITUDE`] of half the range times sin/cos θ_r and the excitation at the
+/// ± the front end's amplitude (`Hardware::resolver_amplitude_v`) times sin/cos θ_r and the excitation at the
 /// instant the ADC holds them (the envelope the synchronous demodulation samples, thesis A
 /// §4.3).
 #[derive(Clone, Debug, PartialEq)]
@@ -100,15 +94,15 @@ impl Sensing {
         match signal {
             Signal::Current(k) => self.hw.current_volts(self.gain_error[k] * currents[k]) + self.zero_error_v[k],
             Signal::DcLink => dc_link_v * self.hw.dc_link_ratio,
-            Signal::Sin => half + RESOLVER_AMPLITUDE * half * excitation * theta_r.sin(),
-            Signal::Cos => half + RESOLVER_AMPLITUDE * half * excitation * theta_r.cos(),
+            Signal::Sin => half + self.hw.resolver_amplitude_v * excitation * theta_r.sin(),
+            Signal::Cos => half + self.hw.resolver_amplitude_v * excitation * theta_r.cos(),
         }
     }
 }
 
 /// The inverter at standstill: phase currents `currents` \[A\] and the DC link at
 /// `dc_link_v` through the board's [`Sensing`], the resolver at rotor angle 0 (SIN at
-/// mid-scale, COS at [`RESOLVER_AMPLITUDE`] of half the range times the excitation).
+/// mid-scale, COS at the front end's amplitude times the excitation).
 #[derive(Clone, Debug)]
 pub struct Standstill {
     /// Phase currents u, v, w \[A\].

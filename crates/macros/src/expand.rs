@@ -263,7 +263,8 @@ pub fn ato_gains(input: TokenStream) -> syn::Result<TokenStream> {
     } else {
         ObserverError::TrigIdentity
     };
-    let g = angle_observer::design(wn, zeta, fs, error).map_err(|e| {
+    // The macro knows no board: resolver signals at full scale (thesis A (4.8)).
+    let g = angle_observer::design(wn, zeta, fs, error, 1.0).map_err(|e| {
         let what = match e {
             angle_observer::ObserverGainError::Overflow { gain, scaled } => {
                 format!("K̃_{} = {scaled:.3e} does not fit Q1.31 (4.22)", &gain[1..])

@@ -24,7 +24,6 @@ use motor_control::transforms::Dq;
 use super::{Check, ScenarioResult, Setup, format_value, series};
 use codegen::design::Design;
 use motor_control::angle::from_radians_f64;
-use motor_sim::bench::Bench;
 use motor_sim::plant::{SpeedProfile, wrap};
 
 /// Initial speed error in units of ρ: Fig. 4.17's 0.5 pu drop at ρ = 0.1 pu.
@@ -103,7 +102,7 @@ fn simulate(s: &Setup<'_>, c: &EstimatorConfig, w: f64, seconds: f64) -> Run {
     let d = s.design;
     let np = f64::from(d.motor.pole_pairs);
     let ts = d.drive.sample_period_s;
-    let mut b = Bench::new(s.cfg, s.plant(SpeedProfile::constant(w / np)));
+    let mut b = s.bench_on(SpeedProfile::constant(w / np));
     let rho = f64::from(c.rho);
     let mut st = EstimatorState {
         theta: from_radians_f64(b.plant.theta_e()),

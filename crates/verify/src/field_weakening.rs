@@ -184,8 +184,9 @@ pub struct Step {
 /// Runs the firmware's control step with [`Demand::Torque`]`(torque(t))` [N·m] for `n`
 /// periods on the simulated drive, the shaft following `speed(t)` [rad/s, mechanical]
 /// (piecewise linear within each period), starting locked at `speed(0)`, the resolver
-/// signals at `resolver_amplitude` of full scale (1 in the scenario; the emulated board's
-/// front end gives less, [`motor_sim::bench::Bench::resolver_amplitude`]).
+/// signals at `resolver_amplitude` of full scale (the design's board's in the scenario,
+/// [`Setup::signal_gain`]; the emulated board passes what its own front end gives,
+/// [`motor_sim::bench::Bench::resolver_amplitude`]).
 pub fn run(
     s: &Setup<'_>,
     torque_nm: &dyn Fn(f64) -> f64,
@@ -320,7 +321,7 @@ pub fn field_weakening(s: &Setup<'_>) -> ScenarioResult {
     let hold = 20.0 * t_fw;
     let n = ((t0 + ramp.duration + hold) / ts).ceil() as usize;
     let torque_cmd = full_torque(d);
-    let steps = run(s, &|_| torque_cmd, &|t| ramp.at(t), n, 1.0);
+    let steps = run(s, &|_| torque_cmd, &|t| ramp.at(t), n, s.signal_gain());
 
     let i_max = fw.current_max_a;
     let v_max_design = d.current_loop.voltage_limit_v;

@@ -367,7 +367,24 @@ impl<'a> Setup<'a> {
 
     /// Controller + plant at a constant mechanical speed [rad/s], observer locked.
     pub fn bench(&self, omega_m: f64) -> Bench {
-        Bench::new(self.cfg, self.plant(SpeedProfile::constant(omega_m)))
+        self.bench_on(SpeedProfile::constant(omega_m))
+    }
+
+    /// Controller + plant with the shaft on `profile`, observer locked, the resolver
+    /// signals at the amplitude the design expects of its board ([`Self::signal_gain`]).
+    pub fn bench_on(&self, profile: SpeedProfile) -> Bench {
+        let mut b = Bench::new(self.cfg, self.plant(profile));
+        b.resolver_amplitude = self.signal_gain();
+        b
+    }
+
+    /// The resolver signals at the observer's input as a fraction of full scale that the
+    /// design's trig-identity gains were divided by (`codegen::board::resolver_signal_gain`:
+    /// the board's front end and the excitation's envelope at its hold instants; 1 without
+    /// a board): the simulated drive reads them at that amplitude, so the observer is
+    /// judged as the board runs it (thesis A (4.10)).
+    pub fn signal_gain(&self) -> f64 {
+        self.design.angle_observer.gains.signal_gain
     }
 
     /// Description of the plant's optional terms.

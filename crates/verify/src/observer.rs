@@ -21,7 +21,6 @@ use super::{ScenarioResult, Setup, format_value};
 use codegen::design::angle_observer::ramp_lag;
 use codegen::spec::ObserverError;
 use motor_control::angle::{from_radians_f64, to_radians_f64};
-use motor_sim::bench::Bench;
 use motor_sim::figures::settling_time;
 use motor_sim::plant::{SpeedProfile, wrap};
 
@@ -171,7 +170,7 @@ struct Run {
 
 fn observe(s: &Setup<'_>, profile: SpeedProfile, n: usize) -> Run {
     let nr = f64::from(s.design.angle_observer.resolver_pole_pairs);
-    let mut b = Bench::new(s.cfg, s.plant(profile));
+    let mut b = s.bench_on(profile);
     let speed_per_lsb = f64::from(s.cfg.speed_per_lsb);
     let mut r = Run {
         t: Vec::with_capacity(n),

@@ -349,8 +349,13 @@ mod tests {
             1e-5
         ));
         assert!(close(c.feed_forward.ld, 0.393e-3, 1e-6));
-        assert_eq!(c.observer.kp.to_bits(), 4_784_957);
-        assert_eq!(c.observer.ki.to_bits(), 8_374);
+        // Thesis A §4.4.2's observer (ω_n = 70 rad/s, ζ = 1) with its trig-identity gains
+        // divided by the reference board's resolver signal, 0.66 V of the 1.65 V half
+        // range = 0.4 of full scale, SIN and COS held together (thesis A (4.10)):
+        // K̃_p = 140/(20000·π·0.4) = 5.570423e-3 → ·2^31 = 11 962 392.3 → 11 962 392;
+        // K̃_i = 4900/(4e8·π·0.4) = 9.748240e-6 → ·2^31 = 20 934.2 → 20 934.
+        assert_eq!(c.observer.kp.to_bits(), 11_962_392);
+        assert_eq!(c.observer.ki.to_bits(), 20_934);
         assert_eq!(c.observer.error, motor_control::ato::ObserverError::TrigIdentity);
         assert_eq!(
             (c.angle.motor_pole_pairs, c.angle.resolver_pole_pairs, c.angle.offset),

@@ -41,15 +41,17 @@ mod tests {
     use super::motor;
 
     /// The default motor is the Fischer TI085: thesis A §4.4.2 observer gains in Q1.31
-    /// (4 784 957 and 8 374, hand calculation in codegen's angle_observer tests); its
-    /// current-loop gains are checked in `config::tests::fischer_numbers`.
+    /// on the default board, whose resolver signal is 0.4 of full scale (11 962 392 and
+    /// 20 934, hand calculation in `config::tests::fischer_numbers` and codegen's
+    /// angle_observer tests); its current-loop gains are checked in
+    /// `config::tests::fischer_numbers`.
     #[test]
     fn default_image_carries_the_fischer_constants() {
         if option_env!("MOTOR").is_some_and(|m| m != "fischer-ti085") {
             return;
         }
-        assert_eq!(motor::observer::KP.to_bits(), 4_784_957);
-        assert_eq!(motor::observer::KI.to_bits(), 8_374);
+        assert_eq!(motor::observer::KP.to_bits(), 11_962_392);
+        assert_eq!(motor::observer::KI.to_bits(), 20_934);
         assert_eq!(
             motor::filter::TAPS_Q15.iter().map(|&t| i32::from(t)).sum::<i32>(),
             32768

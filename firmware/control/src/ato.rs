@@ -73,6 +73,17 @@ impl AtoState {
     pub const fn locked(theta: i32, omega: i32) -> Self {
         Self { theta, omega, error: 0 }
     }
+
+    /// Acquired at rest on a sample: θ̂ = atan2(sin θ_r, cos θ_r) (π-scaled Q1.31, the
+    /// angle the atan2 error compares with, §4.4.1), ω̂ = 0. An observer that pulls in
+    /// from θ̂ = 0 instead answers an initial error Δ with a speed kick in its first
+    /// period, K_p·sin Δ with the trig identity and K_p·Δ with atan2 (K_p = 2ζω_n: up to
+    /// 4 000 and 12 566 rad/s of resolver speed for ω_n = 2000 rad/s), which an over-speed
+    /// trip takes for a runaway; seeded from the sample the rotor's angle needs no
+    /// pull-in. (0, 0) — no excitation yet — gives θ̂ = 0.
+    pub fn acquired<T: Trig>(trig: &mut T, resolver: ResolverSample) -> Self {
+        Self::locked(trig.atan2(resolver.sin, resolver.cos), 0)
+    }
 }
 
 /// One demodulated resolver sample (4.3): envelopes of the SIN and COS windings,
@@ -306,6 +317,41 @@ mod tests {
             eprintln!("ATO {error:?} re-lock from π/2: e after 0.2 s = {e:.3e} rad");
             assert!(e.abs() < 1e-3, "{error:?}: {e}");
         }
+    }
+
+    /// Acquisition at rest: seeded on a sample at any angle (here 2.5 rad, and −3 rad near
+    /// the ±π wrap) at 0.4 of full scale, the next steps on the same sample keep the angle
+    /// within 2^−20 rad and the speed at zero (no kick), where the observer pulled in
+    /// from θ̂ = 0 kicks its speed by K̃_p·sin Δ in the first period: with ω_n = 2000
+    /// rad/s at 20 kHz, by hand K_p·0.4·sin 2.5 = 4000·0.4·0.598 = 957.6 rad/s.
+    #[test]
+    fn acquired_at_rest_needs_no_pull_in() {
+        let cfg = config(ObserverError::TrigIdentity, 2000.0, 1.0);
+        for theta in [2.5, -3.0] {
+            let s = ResolverSample {
+                sin: (0.4 * f64::sin(theta) * Q31) as i32,
+                cos: (0.4 * f64::cos(theta) * Q31) as i32,
+            };
+            let mut st = AtoState::acquired(&mut SoftTrig, s);
+            assert!(
+                wrap(rad(st.theta) - theta).abs() < 2f64.powi(-20),
+                "{theta}: {}",
+                rad(st.theta)
+            );
+            for _ in 0..100 {
+                cfg.process(&mut st, &mut SoftTrig, s);
+                assert!(rad_per_s(st.omega).abs() < 1e-3, "{theta}: ω̂ = {}", rad_per_s(st.omega));
+            }
+            assert!(wrap(rad(st.theta) - theta).abs() < 2f64.powi(-20));
+        }
+        let mut cold = AtoState::new();
+        let s = ResolverSample {
+            sin: (0.4 * f64::sin(2.5) * Q31) as i32,
+            cos: (0.4 * f64::cos(2.5) * Q31) as i32,
+        };
+        cfg.process(&mut cold, &mut SoftTrig, s);
+        let kick = rad_per_s(cold.omega);
+        assert!((kick - 4000.0 * 0.4 * 2.5f64.sin()).abs() < 1.0, "{kick}");
     }
 
     /// Wrap-around across ±π: tracking continues through many turns at high speed

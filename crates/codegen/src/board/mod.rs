@@ -263,6 +263,11 @@ pub struct Board {
     pub adc_reference_v: f64,
     /// DC-link divider ratio V_pin/U_dc.
     pub dc_link_divider: f64,
+    /// The resolver's SIN and COS peak at their ADC pins about mid-scale \[V\], at the
+    /// excitation's peak and the winding's full coupling (`sensing.resolver_amplitude`;
+    /// V_REF/2, the ADC's whole range, where the board does not state it). The
+    /// trig-identity observer's loop gain scales with it (thesis A (4.10)).
+    pub resolver_amplitude_v: f64,
     /// When the currents are sampled.
     pub sample_instant: SampleInstant,
     /// The injected conversion sequences of ADC1 and ADC2, with each input's sampling.
@@ -378,6 +383,18 @@ pub fn resolver_skew(board: &Board, adc_hz: f64) -> f64 {
         (Some(sin), Some(cos)) => cos - sin,
         _ => 0.0,
     }
+}
+
+/// The resolver signals' amplitude at the observer's input as a fraction of full scale
+/// (the ADC's half range about mid-scale, to which the firmware normalises SIN and COS):
+/// the front end's peak `resolver_amplitude_v` over V_REF/2, times the excitation's
+/// envelope where SIN and COS are held — the excitation's fundamental peaks at their mean
+/// hold instant (`EXCITATION_SHIFT_TICKS`), so windings held Δt apart ([`resolver_skew`])
+/// each read cos(π·f_s·Δt/2) of it at f_s/2 excitation (thesis A §4.3). The
+/// trig-identity error is this fraction times sin(θ_r − θ̂) (thesis A (4.10)).
+pub fn resolver_signal_gain(board: &Board, fs_hz: f64) -> f64 {
+    let envelope = (std::f64::consts::PI * fs_hz * resolver_skew(board, ADC_CLOCK_HZ) / 2.0).cos();
+    board.resolver_amplitude_v / (board.adc_reference_v / 2.0) * envelope
 }
 
 /// When `signal`'s first rank is held after the trigger \[s\]: the trigger latency, the
@@ -608,6 +625,37 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         1.0,
         "the divider ratio V_pin/U_dc as a plain number between 0 and 1, e.g. 0.0522 for 9.31 kΩ/(169 kΩ + 9.31 kΩ)",
     );
+    // The resolver front end's swing: a SIN/COS beyond V_REF/2 about mid-scale clips at
+    // the rails, one below a tenth of it leaves the angle fewer than ±205 codes
+    // (12 bits, RM0440 §21.4.1): the trig-identity observer's error (4.8) is then
+    // coarser than 1/205 rad.
+    let amplitude = match (&s.resolver_amplitude, &vref) {
+        (Some(v), Some(r)) => {
+            spans.push(("sensing.resolver_amplitude".into(), v.span()));
+            cx.quantity("sensing.resolver_amplitude", v, Kind::Voltage, Provenance::Datasheet, true)
+                .and_then(|a| {
+                    let half = r.value / 2.0;
+                    if a.value > half || a.value < 0.1 * half {
+                        cx.err(
+                            a.span.clone(),
+                            "sensing.resolver_amplitude",
+                            format!(
+                                "{} V is outside {:.3} V … {half:.3} V: the SIN/COS peak about mid-scale must fit half the {} V reference and use at least a tenth of it",
+                                a.value,
+                                0.1 * half,
+                                r.value
+                            ),
+                            format!("the front end's SIN/COS peak at the pin, from its schematic (excitation amplitude × the resolver's transformation ratio × the front end's gain), between {:.3} V and {half:.3} V, e.g. \"1.3 V\"", 0.1 * half),
+                        );
+                        None
+                    } else {
+                        Some(a.value)
+                    }
+                })
+        }
+        (None, Some(r)) => Some(r.value / 2.0),
+        _ => None,
+    };
     let sr = s.source_resistance.get_ref();
     let r_current = q(
         cx,
@@ -777,6 +825,7 @@ fn resolve(cx: &mut ResolveContext<'_>, raw: &RawBoard) -> Option<Board> {
         hse_hz: hse,
         adc_reference_v: vref?.value,
         dc_link_divider: divider?.value,
+        resolver_amplitude_v: amplitude?,
         sample_instant: *s.sample_instant.get_ref(),
         adc: adc?,
         dead_time_s: dead?.value,

@@ -233,6 +233,9 @@ pub struct RawSensing {
     #[serde(default)]
     pub current_offset: Option<Val>,
     pub dc_link_divider: Val,
+    /// The resolver SIN/COS peak at their pins about mid-scale (optional: V_REF/2).
+    #[serde(default)]
+    pub resolver_amplitude: Option<Val>,
     pub sample_instant: Spanned<SampleInstant>,
     #[serde(default)]
     pub sampling_cycles: Option<Val>,

@@ -14,7 +14,8 @@ use crate::spec::{ObserverError, Provenance};
 struct Observer<'a> {
     d: &'a Design,
     o: &'a ObserverOut,
-    /// The normalisation of the error in the gains' formulas: π, or 1 for atan2.
+    /// The normalisation of the error in the gains' formulas: π·g (g the resolver
+    /// signal's fraction of full scale), or 1 for atan2.
     norm: &'static str,
     /// ω_n, ζ and f_s.
     inputs: String,
@@ -117,15 +118,29 @@ pub fn group(d: &Design) -> Group {
         d,
         o,
         norm: match o.error {
-            ObserverError::TrigIdentity => "π",
+            ObserverError::TrigIdentity => "π·g",
             ObserverError::Atan2 => "1 (atan2 error already normalised by π)",
         },
-        inputs: format!(
-            "ω_n = {} (spec), ζ = {} (spec), {}",
-            phys(o.natural_frequency_rad_s, "rad/s"),
-            o.damping,
-            fs_input(d)
-        ),
+        inputs: match o.error {
+            ObserverError::TrigIdentity => format!(
+                "ω_n = {} (spec), ζ = {} (spec), {}, g = {} (the resolver signal's fraction of full scale the error scales with, thesis A (4.10): {})",
+                phys(o.natural_frequency_rad_s, "rad/s"),
+                o.damping,
+                fs_input(d),
+                phys(o.gains.signal_gain, ""),
+                if d.board.is_some() {
+                    "the board's sensing.resolver_amplitude over V_REF/2 times the excitation's envelope where SIN and COS are held"
+                } else {
+                    "no board: signals at full scale"
+                }
+            ),
+            ObserverError::Atan2 => format!(
+                "ω_n = {} (spec), ζ = {} (spec), {}",
+                phys(o.natural_frequency_rad_s, "rad/s"),
+                o.damping,
+                fs_input(d)
+            ),
+        },
     };
     Group {
         name: "observer",

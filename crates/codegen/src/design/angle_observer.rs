@@ -5,6 +5,13 @@
 //! update (4.22) uses K̃_p = K_p/(f_s·π), K̃_i = K_i/(f_s²·π) for the trig-identity
 //! error, which is in radians. The atan2 (CORDIC) error is already normalised by
 //! π, so its gains lose the 1/π: K̃_p = K_p/f_s, K̃_i = K_i/f_s².
+//!
+//! The trig-identity error scales with the resolver signals' amplitude g at the
+//! observer's input, as a fraction of full scale: g·sin(θ_r − θ̂) (thesis A (4.10)), "this
+//! slows down the observer". On a board whose front end and sampling give g < 1
+//! (`crate::board::resolver_signal_gain`) its gains are divided by g, K̃ = K/(f_s^n·π·g),
+//! so that the loop has the designed ω_n and ζ there; the atan2 error does not depend on
+//! the amplitude.
 
 use serde::Serialize;
 
@@ -30,6 +37,9 @@ pub struct ObserverGains {
     pub ki_q31: i32,
     /// Relative error of K̃_i after rounding.
     pub ki_quantisation_error: f64,
+    /// The resolver signals' amplitude at the observer's input as a fraction of full scale
+    /// g the trig-identity gains are divided by (1 for atan2, or without a board).
+    pub signal_gain: f64,
 }
 
 /// Why the gains cannot be stored.
@@ -62,12 +72,24 @@ fn to_q31(gain: &'static str, x: f64) -> Result<i32, ObserverGainError> {
     Ok(i as i32)
 }
 
-/// Designs the observer for natural frequency `wn` [rad/s], damping `zeta`, sample rate `fs` \[Hz\].
-pub fn design(wn: f64, zeta: f64, fs: f64, error: ObserverError) -> Result<ObserverGains, ObserverGainError> {
+/// Designs the observer for natural frequency `wn` [rad/s], damping `zeta`, sample rate
+/// `fs` \[Hz\] and resolver signals at `signal_gain` of full scale (module documentation;
+/// 1 where the signals span the ADC's range).
+pub fn design(
+    wn: f64,
+    zeta: f64,
+    fs: f64,
+    error: ObserverError,
+    signal_gain: f64,
+) -> Result<ObserverGains, ObserverGainError> {
     let kp = 2.0 * zeta * wn;
     let ki = wn * wn;
+    let signal_gain = match error {
+        ObserverError::TrigIdentity => signal_gain,
+        ObserverError::Atan2 => 1.0,
+    };
     let norm = match error {
-        ObserverError::TrigIdentity => std::f64::consts::PI,
+        ObserverError::TrigIdentity => std::f64::consts::PI * signal_gain,
         ObserverError::Atan2 => 1.0,
     };
     let kp_scaled = kp / (fs * norm);
@@ -82,6 +104,7 @@ pub fn design(wn: f64, zeta: f64, fs: f64, error: ObserverError) -> Result<Obser
         kp_q31,
         ki_q31,
         ki_quantisation_error: (f64::from(ki_q31) / Q31_ONE - ki_scaled) / ki_scaled,
+        signal_gain,
     })
 }
 
@@ -128,7 +151,7 @@ mod tests {
     ///   K̃_i = 4900/(4e8·π) = 3.899296e-6 → ·2^31 = 8 373.6 → 8 374
     #[test]
     fn thesis_observer_trig_identity() {
-        let g = design(70.0, 1.0, 20e3, ObserverError::TrigIdentity).unwrap();
+        let g = design(70.0, 1.0, 20e3, ObserverError::TrigIdentity, 1.0).unwrap();
         assert_eq!((g.kp, g.ki), (140.0, 4900.0));
         assert!((g.kp_scaled - 2.228_169e-3).abs() < 1e-9);
         assert!((g.ki_scaled - 3.899_296e-6).abs() < 1e-12);
@@ -141,21 +164,35 @@ mod tests {
     /// K̃_i = 4900/4e8 = 1.225e-5 → 26 306.7 → 26 307.
     #[test]
     fn thesis_observer_atan2() {
-        let g = design(70.0, 1.0, 20e3, ObserverError::Atan2).unwrap();
+        let g = design(70.0, 1.0, 20e3, ObserverError::Atan2, 1.0).unwrap();
         assert_eq!(g.kp_q31, 15_032_386);
         assert_eq!(g.ki_q31, 26_307);
+    }
+
+    /// Resolver signals at g = 0.4 of full scale (thesis A (4.10): the trig-identity error
+    /// is g·sin Δ): the gains are divided by g, K̃_p = 140/(20000·π·0.4) = 5.570423e-3,
+    /// K̃_i = 4900/(4e8·π·0.4) = 9.748240e-6, so g·K̃ is the full-scale design's; the atan2
+    /// error does not scale, its gains stay those of `thesis_observer_atan2`.
+    #[test]
+    fn trig_identity_gains_follow_the_signal_amplitude() {
+        let g = design(70.0, 1.0, 20e3, ObserverError::TrigIdentity, 0.4).unwrap();
+        assert!((g.kp_scaled - 5.570_423e-3).abs() < 1e-9);
+        assert!((g.ki_scaled - 9.748_240e-6).abs() < 1e-12);
+        assert_eq!(g.signal_gain, 0.4);
+        let a = design(70.0, 1.0, 20e3, ObserverError::Atan2, 0.4).unwrap();
+        assert_eq!((a.kp_q31, a.ki_q31, a.signal_gain), (15_032_386, 26_307, 1.0));
     }
 
     #[test]
     fn refuses_what_does_not_fit_q31() {
         // K̃_p = 2·1·70000/(20000·π) = 2.23 ≥ 1.
         assert!(matches!(
-            design(70_000.0, 1.0, 20e3, ObserverError::TrigIdentity),
+            design(70_000.0, 1.0, 20e3, ObserverError::TrigIdentity, 1.0),
             Err(ObserverGainError::Overflow { gain: "kp", .. })
         ));
         // K̃_i = 0.01²/(4e8·π) ≈ 8e-14 → rounds to 0.
         assert!(matches!(
-            design(0.01, 1.0, 20e3, ObserverError::TrigIdentity),
+            design(0.01, 1.0, 20e3, ObserverError::TrigIdentity, 1.0),
             Err(ObserverGainError::Underflow { gain: "ki", .. })
         ));
     }

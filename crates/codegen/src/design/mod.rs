@@ -110,15 +110,21 @@ pub struct BoardTerms {
     /// ([`timing_of`]): the angle lead k (thesis A (4.23)) unless the spec sets
     /// `angle_observer.lead_samples`.
     pub angle_lead_periods: f64,
+    /// The resolver signals at the observer's input as a fraction of full scale
+    /// ([`crate::board::resolver_signal_gain`]): the trig-identity observer's gains are
+    /// divided by it, so that its loop has the designed ω_n and ζ on the board (thesis A
+    /// (4.10)).
+    pub resolver_signal_gain: f64,
 }
 
 impl BoardTerms {
-    /// No board: the whole linear range and thesis A §4.6's 1.5·T_s
-    /// ([`current_loop::NOMINAL_LOOP_DELAY_PERIODS`]).
+    /// No board: the whole linear range, thesis A §4.6's 1.5·T_s
+    /// ([`current_loop::NOMINAL_LOOP_DELAY_PERIODS`]) and resolver signals at full scale.
     pub const NONE: BoardTerms = BoardTerms {
         max_duty: 1.0,
         loop_delay_periods: current_loop::NOMINAL_LOOP_DELAY_PERIODS,
         angle_lead_periods: current_loop::NOMINAL_LOOP_DELAY_PERIODS,
+        resolver_signal_gain: 1.0,
     };
 }
 
@@ -134,6 +140,7 @@ pub fn design_on(spec: &Spec, src: Source<'_>, terms: BoardTerms) -> Result<Desi
         usable_voltage_fraction: usable,
         loop_delay_periods: terms.loop_delay_periods,
         board_angle_lead_periods: terms.angle_lead_periods,
+        resolver_signal_gain: terms.resolver_signal_gain,
     };
     // The motor values against each other and the drive first: a value off by a unit
     // prefix is refused at its key before it makes the sections below fail confusingly.

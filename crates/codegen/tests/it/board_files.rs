@@ -175,6 +175,13 @@ const CORPUS: &[Case] = &[
         &["4 MHz and 48 MHz", "DS12288"],
     ),
     (
+        "resolver-amplitude-clips.toml",
+        "\"2 V\"",
+        "sensing.resolver_amplitude",
+        &["2 V is outside 0.165 V … 1.650 V", "half the 3.3 V reference"],
+        &["from its schematic", "transformation ratio", "e.g. \"1.3 V\""],
+    ),
+    (
         "bare-number.toml",
         "500 ",
         "pwm.dead_time",

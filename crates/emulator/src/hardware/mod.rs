@@ -144,6 +144,9 @@ pub struct Hardware {
     pub dc_link_ratio: f64,
     /// V_REF+ \[V\].
     pub vref: f64,
+    /// The resolver front end's SIN/COS peak at their pins about mid-scale \[V\], at the
+    /// excitation's peak and the winding's full coupling.
+    pub resolver_amplitude_v: f64,
     /// The over-current comparator's output pin (TIM1_BKIN) and whether it pulls low on
     /// over-current.
     pub break_pin: &'static str,

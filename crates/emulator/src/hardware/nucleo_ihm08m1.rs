@@ -113,6 +113,8 @@ pub fn hardware() -> Hardware {
         current_offset_v: offset,
         dc_link_ratio: r_bottom / (r_top + r_bottom),
         vref: V_SUPPLY,
+        // The resolver add-on (on neither ST board) with the reference board's front end.
+        resolver_amplitude_v: 0.66,
         // The shield's over-current comparator, CN10-13 → PA6, pulls low on over-current
         // (UM1996 §2.3).
         break_pin: "PA6",

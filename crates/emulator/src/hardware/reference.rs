@@ -78,6 +78,10 @@ fn with_sensing(board: &'static str, variant_of: Option<&'static str>, sensitivi
         // 3.3 V at 750 V (1.25 × thesis A's 600 V accumulator).
         dc_link_ratio: 0.0044,
         vref: 3.3,
+        // The front end's figure: thesis A does not publish its controller's resolver
+        // interface; 0.66 V is 40 % of the 1.65 V half range (the board file's stated
+        // assumption, which this hardware is built to).
+        resolver_amplitude_v: 0.66,
         break_pin: "PB12",
         break_active_low: true,
         excitation_pin: "PC6",

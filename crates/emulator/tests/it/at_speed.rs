@@ -15,10 +15,10 @@
 //! or, to keep the run short, the one that reaches the top in [`RAMP_S`] — but never more
 //! than [`MAX_SPEEDUP`] times the drive's, nor more than lets the emulated board's angle
 //! observer lag by [`PROFILE_LAG_DEG`] electrical
-//! (thesis A (4.12)–(4.15): K_i·A·sin Δ = n_r·ω̇_m for the trig-identity error with the
-//! board's resolver amplitude A, K_i·Δ for atan2). Where the drive's own acceleration is
-//! beyond that (amk-dd5-ipm, chalmers-hev50, fischer-ti085: the resolver front end's 0.4 of
-//! full scale lowers the trig-identity gain) the drive's acceleration it is.
+//! (thesis A (4.12)–(4.15): K_i·sin Δ = n_r·ω̇_m for the trig-identity error, whose gains
+//! the design divides by the board's resolver signal amplitude, K_i·Δ for atan2). Where
+//! the drive's own acceleration is beyond that (amk-dd5-ipm, chalmers-hev50, fischer-ti085:
+//! ω_n = 200, 70 and 70 rad/s) the drive's acceleration it is.
 //!
 //! No hold at the top: a linear ramp's acceleration stops at once there, and the type-2
 //! observer's lag, released in one step, swings past; on amk-dd5-ipm at 20 000 rpm both
@@ -146,7 +146,10 @@ pub(crate) fn top_speed(design: &codegen::design::Design, i_lim: f64) -> TopSpee
     let nr = f64::from(obs.resolver_pole_pairs);
     let allowed_r = PROFILE_LAG_DEG.to_radians() * nr / np;
     let follows_r = match obs.error {
-        ObserverError::TrigIdentity => obs.gains.ki * wiring::RESOLVER_AMPLITUDE * allowed_r.sin(),
+        // The design divides the trig-identity gains by the signal's fraction of full
+        // scale, which the emulated front end gives (`boot.rs` checks it): the loop gain
+        // is K_i.
+        ObserverError::TrigIdentity => obs.gains.ki * allowed_r.sin(),
         ObserverError::Atan2 => obs.gains.ki * allowed_r,
     };
     TopSpeed {
@@ -288,12 +291,13 @@ fn torque_along_a_speed_ramp_matches_verify() {
         let n = s.len() - k0;
         // verify's bench: the same torque from its first period, the same profile shifted
         // to its time (its t = 0 is the image's t0).
-        // The emulated resolver front end gives RESOLVER_AMPLITUDE of full scale, and the
-        // trig-identity observer's gain scales with it: verify's bench sees the same.
+        // verify's bench reads the resolver at the fraction of full scale the design
+        // expects of the board (`Setup::signal_gain`), which the emulated front end gives
+        // (`boot.rs` checks it).
         let verify_started = std::time::Instant::now();
         // The frames' torques in verify's time: the first frame acts from its t = 0.
         let command_at = |tv: f64| command(at + (tv / period + 1e-9).floor() * period);
-        let reference = verify_run(&setup, &command_at, &|t| speed(t0 + t), n, wiring::RESOLVER_AMPLITUDE);
+        let reference = verify_run(&setup, &command_at, &|t| speed(t0 + t), n, setup.signal_gain());
         let verify_cpu = verify_started.elapsed().as_secs_f64();
         if let Some(off) = s[k0..].iter().position(|x| x.duties.is_none()) {
             let x = &s[k0 + off];

@@ -111,3 +111,27 @@ fn current_gain_ten_percent_off_fails_the_step() {
         assert!(!out.failed().is_empty(), "{name}: a 10 % gain error passed");
     }
 }
+
+/// The resolver front end's amplitude stated as the full range (1.65 V) where the
+/// hardware gives 0.66 V: the design divides the trig-identity gains by the envelope
+/// alone (0.927), so the image's observer runs at 0.4 of its loop gain (ω_n and ζ at
+/// √0.4 = 0.63 of the designed, thesis A (4.10)) — refused by the boot check's comparison of the signal the
+/// emulated board gives with the one the gains are designed for.
+#[test]
+fn resolver_amplitude_stated_as_full_range_is_refused() {
+    let bench = variant("resolver_amplitude = \"0.66 V\"", "resolver_amplitude = \"1.65 V\"");
+    let name = bench.name();
+    let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{name}: {e}"));
+    rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let end = rig.machine.soc().time_s() + 10.0 * rig.pwm_period_s();
+    rig.run(end, |_| Some(0.0), |_| false)
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+    let (seen, designed) = crate::boot::resolver_signal(&rig);
+    println!(
+        "{name}, resolver_amplitude = \"1.65 V\": the observer sees {seen:.4} of full scale, its gains are designed for {designed:.4}"
+    );
+    // By hand: 0.66/1.65·cos(π·40 kHz·3.059 µs) = 0.4·0.9270 = 0.3708 against 1·0.9270.
+    assert!((seen - 0.3708).abs() < 1e-3, "{name}: {seen}");
+    assert!((designed - 0.9270).abs() < 1e-3, "{name}: {designed}");
+    assert!((seen - designed).abs() > crate::boot::SIGNAL_TOLERANCE);
+}

@@ -157,6 +157,27 @@ fn aden_written_once_after_calibration_is_refused_with_the_rule() {
 /// `motor_test_support::budget`): a regression fails, an improvement asks to be recorded.
 /// The QEMU figures (`qemu_control_step`, firmware/qemu/tests/qemu.rs) count the control
 /// step alone.
+/// How far the resolver signal the emulated front end gives the observer may be from the
+/// one its gains are designed for (fractions of full scale): the 12-bit ADC's and the
+/// excitation's one-tick rounding, well below the 0.4 → 1 a wrong board fact makes.
+pub(crate) const SIGNAL_TOLERANCE: f64 = 2e-3;
+
+/// The resolver signal at the observer's input as a fraction of full scale, as the
+/// emulated board gives it (its front end's peak over V_REF/2 times the excitation's
+/// envelope where SIN was last held, `Soc::resolver_excitation`), and the one the
+/// design divided its trig-identity gains by (`codegen::board::resolver_signal_gain`).
+pub(crate) fn resolver_signal(rig: &Rig) -> (f64, f64) {
+    let soc = rig.machine.soc();
+    let [Some((_, e_sin)), _] = soc.resolver_excitation else {
+        panic!("{}: SIN never converted", rig.bench.name());
+    };
+    let hw = &soc.wiring.hw;
+    (
+        hw.resolver_amplitude_v / (hw.vref / 2.0) * e_sin.abs(),
+        rig.design.angle_observer.gains.signal_gain,
+    )
+}
+
 #[test]
 fn control_interrupt_instructions_fit_the_period_and_the_budget() {
     let mut measured = Vec::new();
@@ -305,9 +326,22 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
             "{motor}: SIN read at envelope gain {e_sin:.4}, COS at {e_cos:.4} ({:.3} µs apart: cos(π·f_s·Δ/2) = {by_hand:.4})",
             (t_cos - t_sin) * 1e6
         );
+        // The signal the observer sees, as a fraction of full scale: the emulated front
+        // end's peak over V_REF/2 times that envelope — what the design divided its
+        // trig-identity gains by (`codegen::board::resolver_signal_gain`, from the board
+        // file's `sensing.resolver_amplitude`), so that the loop has its designed ω_n.
+        let (seen, designed) = resolver_signal(&rig);
+        if rig.design.angle_observer.error == codegen::spec::ObserverError::TrigIdentity {
+            assert!(
+                (seen - designed).abs() <= SIGNAL_TOLERANCE,
+                "{motor}: the observer sees the resolver at {seen:.4} of full scale, its gains are designed for {designed:.4}"
+            );
+        }
+        let gains = &rig.design.angle_observer.gains;
         println!(
-            "{motor}: resolver envelope gain SIN {e_sin:.4}, COS {e_cos:.4}, held {:.3} µs apart (by hand {by_hand:.4})",
-            (t_cos - t_sin) * 1e6
+            "{motor}: resolver envelope gain SIN {e_sin:.4}, COS {e_cos:.4}, held {:.3} µs apart (by hand {by_hand:.4}); signal at {seen:.4} of full scale, the design's {:.4}",
+            (t_cos - t_sin) * 1e6,
+            gains.signal_gain
         );
         println!(
             "{motor}: control interrupt {min} / {max} / {mean:.0} instructions (min / max / mean), \
@@ -330,4 +364,37 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
         });
     }
     motor_test_support::budget::check(&measured).unwrap_or_else(|e| panic!("{e}"));
+}
+
+/// Power-up with the rotor at rest away from the resolver's zero (the boot tests above
+/// read the resolver at 0): on every pair, with the shaft at 2.5 rad and −2 rad, the
+/// image boots to its first enabled period and runs 50 periods at zero torque without a
+/// trip. The observer is acquired on the resolver during the offset calibration
+/// (`AtoState::acquired`); pulled in from θ̂ = 0 instead, its first-period speed kick
+/// K_p·sin Δ is beyond the over-speed trip: maxon-ec45-flat-70w (ω_n = 1000 rad/s) at
+/// 2.5 rad, 2000·sin 2.5 = 1197 rad/s of the shaft against its 5625 rpm = 589 rad/s trip
+/// (measured with the acquisition removed: trip at boot, fault record 4).
+#[test]
+fn every_pair_boots_with_the_rotor_at_any_angle() {
+    for (motor, board) in benches() {
+        for theta_m in [2.5, -2.0] {
+            let bench = Bench::new(&motor, &board).unwrap();
+            let name = format!("{} at {theta_m} rad", bench.name());
+            let spec = motor_emulator::wiring::spec(&motor).unwrap();
+            let mut rig = Rig::with_analog(bench, |d, hw| {
+                let setup = motor_verify::Setup::new(&spec, d);
+                let mut drive =
+                    motor_emulator::drive::Drive::new(&setup, motor_sim::plant::SpeedProfile::constant(0.0), hw);
+                drive.plant.theta_m = theta_m;
+                Ok(Box::new(drive))
+            })
+            .unwrap_or_else(|e| panic!("{name}: {e}"));
+            rig.boot(BOOT_LIMIT_S).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let end = rig.machine.soc().time_s() + 50.0 * rig.pwm_period_s();
+            rig.run(end, |_| Some(0.0), |_| false)
+                .unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert_eq!(rig.fault_cause(), None, "{name}: tripped");
+            assert!(rig.machine.soc().tim1.moe(), "{name}: outputs off");
+        }
+    }
 }

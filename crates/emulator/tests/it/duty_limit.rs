@@ -13,27 +13,35 @@
 //! top speed (its acceleration rule), [`HOLD_S`] there, then the MTPA torque on the
 //! board's current circle for [`AFTER_S`].
 //!
-//! Boards: every board in `boards/`, each with one motor ([`BENCHES`]): the NUCLEO +
-//! X-NUCLEO-IHM08M1 (low-side shunts, d_max < 1) and the reference board (in-line Hall
-//! sensors: d_max = 1, the duty reaches the THPWM linear range's 100 %) with
-//! maxon-ec45-flat-70w, the 400 A variant of the reference board (the same hardware with
-//! another sensing gain, d_max = 1) with emrax-228-hv. The defect: the compare values one
-//! timer tick beyond `MAX_COMPARE` (`Patches::compare_beyond`) and the rule fires.
+//! Pairs ([`BENCHES`]): every board in `boards/`, and on each the motors whose run fits
+//! in CI and shows what it is for: the NUCLEO + X-NUCLEO-IHM08M1 (low-side shunts,
+//! d_max < 1) and the reference board (in-line Hall sensors: d_max = 1, the duty reaches
+//! the THPWM linear range's 100 %) with maxon-ec45-flat-70w; the 400 A variant of the
+//! reference board (the same hardware with another sensing gain, d_max = 1) with
+//! emrax-228-hv (0.13 s of ramp) and chalmers-hev50 (9.8 s of ramp at 10 kHz: 9 s of
+//! CPU). The defect: the compare values one timer tick beyond `MAX_COMPARE`
+//! (`Patches::compare_beyond`) and the rule fires.
 //!
 //! The other motors with a flux linkage, tried on their boards (stop 41) and not run:
-//! * fischer-ti085, amk-dd5-ipm, chalmers-hev50: the trig-identity observer's acceleration
-//!   at a lag Δ is K_i·A·sin Δ (thesis A (4.12)–(4.15)); with ω_n = 70, 200 and 70 rad/s
-//!   and the emulated resolver's A = 0.4 a zero-torque ramp to the top speed within 3° of
-//!   lag takes 81.6 s, 12.5 s and 24.5 s of emulated time. A faster ramp leaves a lag that
-//!   the ramp's end releases within a few 1/ω_n against a back EMF near V'_max: fischer-ti085
-//!   ramped at its drive's 2 000 rpm/s (24° of lag) to 12 000 rpm reached i_d = 100.6 A at
-//!   zero torque 13 ms after the ramp's end, and the over-current trip switched it off. Its
-//!   current loop (thesis A's 100 rad/s, K_p = 0.039 V/A, L = 0.39 mH) cannot reject the
-//!   tens of volts the frame's turn puts on the d axis.
-//! * mit-mini-cheetah-actuator (ω_n = 2000 rad/s, 0.11 s to 2 292 rpm): the step's peak
-//!   duty was 0.98976, not the limit — its field weakening (α_fw = 500 rad/s, V'_max =
-//!   0.8·V_max) keeps the PI output inside the circle, so the duty limit is not exercised
-//!   (the torque was within 0.24 of verify's tolerance, the currents 0.419 A of 1.761 A).
+//! * amk-dd5-ipm (5.0 s of ramp to 20 000 rpm): the duty reached 1 for 34 periods and no
+//!   conversion sampled inside an edge, but the torque was 1.69 of the tolerance off
+//!   verify's and the currents 6.23 A (tolerance 4.85 A) — the image and verify part
+//!   deep in field weakening at 20 000 rpm as in the at-speed scenario's open finding
+//!   (crates/emulator/README.md, "At speed").
+//! * mit-mini-cheetah-actuator (0.07 s of ramp to 2 292 rpm): the step's peak duty is
+//!   0.98976, not the limit — its field weakening (α_fw = 500 rad/s, V'_max = 0.8·V_max)
+//!   keeps the PI output inside the circle, so the duty limit is not exercised (torque
+//!   0.26 of verify's tolerance, currents 0.399 A of 1.761 A).
+//! * fischer-ti085: the trig-identity observer's acceleration at a lag Δ is K_i·sin Δ
+//!   (thesis A (4.12)–(4.15)); with ω_n = 70 rad/s a zero-torque ramp to 20 000 rpm within
+//!   3° of lag takes 32.7 s of emulated time (K_i·sin(3°/4) = 64.1 rad/s² of the shaft). A
+//!   faster ramp leaves a lag that the ramp's end releases within a few 1/ω_n against a
+//!   back EMF near V'_max: ramped at its drive's 2 000 rpm/s to 12 000 rpm — tried before
+//!   the design divided the gains by the resolver signal, so at 0.63 of its ω_n and 24°
+//!   of lag — it reached i_d = 100.6 A at zero torque 13 ms after the ramp's end, and the
+//!   over-current trip switched it off. Its current loop (thesis A's 100 rad/s,
+//!   K_p = 0.039 V/A, L = 0.39 mH) cannot reject the tens of volts the frame's turn puts
+//!   on the d axis.
 
 use std::f64::consts::PI;
 
@@ -69,10 +77,11 @@ struct Outcome {
 }
 
 /// The scenario's (board, motor) pairs (module documentation): every board in `boards/`.
-const BENCHES: [(&str, &str); 3] = [
+const BENCHES: [(&str, &str); 4] = [
     ("nucleo-g474re-ihm08m1", "maxon-ec45-flat-70w"),
     ("motorgen-reference", "maxon-ec45-flat-70w"),
     ("motorgen-reference-400a", "emrax-228-hv"),
+    ("motorgen-reference-400a", "chalmers-hev50"),
 ];
 
 /// Panics unless `rig::benches` runs `motor` on `board`.
@@ -140,7 +149,7 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     let n = s.len() - k0;
     let speed = move |t: f64| imposed.at(t);
     let command_at = |tv: f64| command(t0 + (tv / period + 1e-9).floor() * period);
-    let reference = verify_run(&setup, &command_at, &|t| speed(t0 + t), n, wiring::RESOLVER_AMPLITUDE);
+    let reference = verify_run(&setup, &command_at, &|t| speed(t0 + t), n, setup.signal_gain());
 
     let arr = design.drive.pwm_period;
     let max_duty = out.duty_limit.max_duty;

@@ -469,7 +469,14 @@ fn slow_observer_loses_current_tracking_in_field_weakening() {
     };
     assert!(find(&good, "peak |i_dq − i_dq^ref|").pass, "{:?}", good.checks);
     assert!(find(&good, "peak electrical angle error").pass);
-    let g = observer(40.0, 1.0, 20e3, d.angle_observer.error).unwrap();
+    let g = observer(
+        40.0,
+        1.0,
+        20e3,
+        d.angle_observer.error,
+        d.angle_observer.gains.signal_gain,
+    )
+    .unwrap();
     d.angle_observer.gains.kp_q31 = g.kp_q31;
     d.angle_observer.gains.ki_q31 = g.ki_q31;
     let r = fw_run(&Setup::new(&s, &d));

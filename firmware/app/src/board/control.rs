@@ -7,8 +7,12 @@
 //! [`crate::offset`]); a level beyond `board::OFFSET_BOUND_CODE` from the nominal one is
 //! a fault ([`FaultCause::CurrentOffset`]) and the drive never switches on, otherwise
 //! every later period's currents are taken about the measured levels (trips included).
-//! Meanwhile the step runs with [`Demand::Off`] (the angle observer locks on) and a
-//! commissioning routine sees a fault.
+//! Meanwhile the step runs with [`Demand::Off`] and a commissioning routine sees a
+//! fault, and the angle observer is acquired on each period's sample
+//! ([`motor_control::ato::AtoState::acquired`]: θ̂ = atan2 of SIN and COS, ω̂ = 0, the
+//! rotor at rest): it starts on the rotor's angle instead of pulling in from θ̂ = 0, whose
+//! first-period speed kick (K_p·sin Δ) the over-speed trip would take for a runaway.
+//! The excitation has run for the whole calibration by its end.
 //!
 //! The pre-flight check (CAN routine 6) runs through the commissioning mode like the
 //! chapter-6 routines; a refusal trips the drive here with its own cause (11–18,
@@ -34,6 +38,7 @@ use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::interrupt::Mutex;
+use motor_control::ato::AtoState;
 use motor_control::commissioning_mode::{Guards, Measured};
 use motor_control::setpoint::SetpointState;
 use motor_control::{ControllerState, Demand};
@@ -218,6 +223,10 @@ impl Control {
             i_uvw: out.i_uvw,
         };
         self.omega_e = out.omega_e;
+        if calibrating {
+            self.state.observer = AtoState::acquired(&mut self.cordic, sample.resolver);
+            self.omega_e = 0.0;
+        }
         pwm::set_compare(&self.tim1, out.compare);
         let on = bringup::finish_period(&mut pwm::Break(&self.tim1), &mut self.tripped, run);
         if self.tripped && !was_tripped && self.trip_cause.is_none() {

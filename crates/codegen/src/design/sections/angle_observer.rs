@@ -59,24 +59,28 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
     let fs = cx.switching_frequency();
     let fe_max = cx.max_electrical_frequency();
     let o = &spec.angle_observer;
-    let obs = angle_observer::design(o.natural_frequency.value, o.damping.value, fs, o.error)
-        .map_err(|e| {
-            let (gain, scaled, what) = match e {
-                angle_observer::ObserverGainError::Overflow { gain, scaled } => {
-                    (gain, scaled, "does not fit Q1.31 (|K̃| must be < 1)")
-                }
-                angle_observer::ObserverGainError::Underflow { gain, scaled } => {
-                    (gain, scaled, "rounds to zero in Q1.31")
-                }
-            };
-            cx.errors.push(cx.src.error(
-                o.natural_frequency.span.clone(),
-                &o.natural_frequency.key,
-                format!("observer gain K̃_{} = {scaled:.3e} (4.22) {what}", &gain[1..]),
-                "a natural frequency that keeps K̃_p = 2ζω_n/(f_s·π) below 1 and K̃_i = ω_n²/(f_s²·π) above 2^−32",
-            ))
-        })
-        .ok();
+    let obs = angle_observer::design(
+        o.natural_frequency.value,
+        o.damping.value,
+        fs,
+        o.error,
+        cx.resolver_signal_gain,
+    )
+    .map_err(|e| {
+        let (gain, scaled, what) = match e {
+            angle_observer::ObserverGainError::Overflow { gain, scaled } => {
+                (gain, scaled, "does not fit Q1.31 (|K̃| must be < 1)")
+            }
+            angle_observer::ObserverGainError::Underflow { gain, scaled } => (gain, scaled, "rounds to zero in Q1.31"),
+        };
+        cx.errors.push(cx.src.error(
+            o.natural_frequency.span.clone(),
+            &o.natural_frequency.key,
+            format!("observer gain K̃_{} = {scaled:.3e} (4.22) {what}", &gain[1..]),
+            "a natural frequency that keeps K̃_p = 2ζω_n/(f_s·π) below 1 and K̃_i = ω_n²/(f_s²·π) above 2^−32",
+        ))
+    })
+    .ok();
     let np = m.pole_pairs;
     let nr = spec.resolver.pole_pairs;
     // Observer speed full scale f_s·π rad/s of resolver angle (4.20) must hold the top speed.

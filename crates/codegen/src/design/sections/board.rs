@@ -798,6 +798,12 @@ mod tests {
             "{}",
             nucleo.angle_lead_periods
         );
+        // The resolver signal at the observer: 0.66 V over the 1.65 V half range = 0.4 on
+        // both boards; on the NUCLEO at 40 kHz each winding is held 3.058 824 µs from the
+        // excitation's peak: 0.4·cos(π·40 000·3.058 824e-6) = 0.4·cos(0.384 383) = 0.4·0.927 030 = 0.370 812.
+        let gain = |stem: &str, fs: f64| crate::board::resolver_signal_gain(&board_of(stem), fs);
+        assert!((gain("motorgen-reference", 20e3) - 0.4).abs() < 1e-12);
+        assert!((gain("nucleo-g474re-ihm08m1", 40e3) - 0.370_812).abs() < 1e-6);
     }
 
     /// N: (3·1 LSB/0.25 LSB)² = 144 → the next power of two, 256.

@@ -42,6 +42,9 @@ pub(super) struct Context<'a> {
     pub loop_delay_periods: f64,
     /// The angle lead the board's timing makes, in periods of T_s (`design::BoardTerms`).
     pub board_angle_lead_periods: f64,
+    /// The resolver signals at the observer's input as a fraction of full scale (the
+    /// board's, `design::BoardTerms`; 1 without a board).
+    pub resolver_signal_gain: f64,
 }
 
 impl Context<'_> {
