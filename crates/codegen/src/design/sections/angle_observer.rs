@@ -77,7 +77,14 @@ pub(in crate::design) fn angle_observer(cx: &mut Context<'_>) -> Option<Observer
             o.natural_frequency.span.clone(),
             &o.natural_frequency.key,
             format!("observer gain K̃_{} = {scaled:.3e} (4.22) {what}", &gain[1..]),
-            "a natural frequency that keeps K̃_p = 2ζω_n/(f_s·π) below 1 and K̃_i = ω_n²/(f_s²·π) above 2^−32",
+            if cx.resolver_signal_gain == 1.0 || o.error == ObserverError::Atan2 {
+                "a natural frequency that keeps K̃_p = 2ζω_n/(f_s·π) below 1 and K̃_i = ω_n²/(f_s²·π) above 2^−32".to_string()
+            } else {
+                format!(
+                    "a natural frequency that keeps K̃_p = 2ζω_n/(f_s·π·g) below 1 and K̃_i = ω_n²/(f_s²·π·g) above 2^−32, g = {:.4} the board's resolver signal as a fraction of full scale (4.10), or a board whose front end gives more",
+                    cx.resolver_signal_gain
+                )
+            },
         ))
     })
     .ok();
