@@ -193,6 +193,7 @@ impl Rig {
             16 => "wrong direction",
             17 => "pole-pair ratio",
             18 => "resolver offset",
+            19 => "resolver signal",
             _ => "unknown",
         };
         Some(format!("{cause} ({name})"))

@@ -128,6 +128,9 @@ pub struct Patches {
     /// toggles half a carrier period after TIM1's reset, so its fundamental peaks at the
     /// ADC trigger, not where SIN and COS are held (the image before stop 40).
     pub excitation_peak_at_trigger: bool,
+    /// TIM3_CCER writes are made with CC1E cleared: the excitation pin never toggles (a
+    /// dead excitation: the resolver's windings carry nothing).
+    pub excitation_off: bool,
 }
 
 /// A break pulse the test schedules on the comparator.
@@ -812,6 +815,8 @@ impl Soc {
             Block::Tim3 => {
                 let value = if off == 0x34 && self.patches.excitation_peak_at_trigger {
                     self.tim3.period_ticks() / 2
+                } else if off == 0x20 && self.patches.excitation_off {
+                    value & !1
                 } else {
                     value
                 };

@@ -10,6 +10,7 @@ mod board;
 #[cfg(target_os = "none")]
 use motor_config::{
     adc_frame, bringup, can_commissioning, can_frame, config, fault_frame, fault_record, hw, motor, offset, registers,
+    resolver_check,
 };
 
 // The RTT transport of the `defmt` log lines (README, "defmt logging").

@@ -288,6 +288,15 @@ pub const OFFSETS: crate::offset::OffsetBounds = crate::offset::OffsetBounds {
     samples: board::OFFSET_SAMPLES,
 };
 
+/// The start-up check of the resolver signal ([`crate::resolver_check`]): the signal the
+/// observer's gains are designed for, the accepted ratio, over the offset calibration's
+/// periods.
+pub const RESOLVER_SIGNAL: crate::resolver_check::SignalBounds = crate::resolver_check::SignalBounds {
+    designed: board::RESOLVER_SIGNAL,
+    ratio: (board::RESOLVER_SIGNAL_MIN, board::RESOLVER_SIGNAL_MAX),
+    periods: board::OFFSET_SAMPLES,
+};
+
 /// Taps of the identification FIR.
 pub const FILTER_TAPS: usize = filter::ORDER + 1;
 

@@ -91,6 +91,13 @@ pub enum FaultCause {
     /// Pre-flight: the rotor came to rest away from the commanded electrical angle (a
     /// wrong resolver offset).
     PreflightResolverOffset = 18,
+    /// The resolver signal measured at start-up with the gates off
+    /// (`motor_config::resolver_check`: √(sin² + cos²) over the second half of the
+    /// offset calibration) is outside `board::RESOLVER_SIGNAL_MIN` … `_MAX` of the one the
+    /// observer's gains are designed for (`board::RESOLVER_SIGNAL`): no excitation, a
+    /// resolver unplugged, a front end unlike the board file's `sensing.resolver_amplitude`.
+    /// The outputs were never switched on.
+    ResolverSignal = 19,
 }
 
 impl From<PreflightFault> for FaultCause {
@@ -131,6 +138,7 @@ impl FaultCause {
             PreflightDirection,
             PreflightPolePairRatio,
             PreflightResolverOffset,
+            ResolverSignal,
         ]
         .into_iter()
         .find(|c| *c as u32 == code)
@@ -388,12 +396,12 @@ mod tests {
             reported: true,
         };
         assert_eq!(FaultRecord::from_words(&bare.to_words()), Some(bare));
-        for code in 1..=18 {
-            let c = FaultCause::from_code(code).expect("codes 1–18 are causes");
+        for code in 1..=19 {
+            let c = FaultCause::from_code(code).expect("codes 1–19 are causes");
             assert_eq!(c as u32, code);
         }
         assert_eq!(FaultCause::from_code(0), None);
-        assert_eq!(FaultCause::from_code(19), None);
+        assert_eq!(FaultCause::from_code(20), None);
         // The pre-flight check's refusals keep their numbers in the record.
         for f in [
             PreflightFault::InvertedSensing,

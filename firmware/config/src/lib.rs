@@ -34,6 +34,7 @@ pub mod fault_record;
 pub mod hw;
 pub mod offset;
 pub mod registers;
+pub mod resolver_check;
 pub mod timing;
 
 #[cfg(test)]

@@ -474,7 +474,8 @@ pub const FAULT_REPORT_LEN: u8 = 8;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaultReport {
     /// The cause code (1 HardFault, 2 stack overflow, 3 break, 4 trip, 5 lost
-    /// conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog, 10 current offset).
+    /// conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog, 10 current
+    /// offset, 11–18 pre-flight, 19 resolver signal).
     pub cause: u8,
     /// The stacked PC of a CPU fault.
     pub pc: Option<u32>,

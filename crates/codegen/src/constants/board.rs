@@ -252,6 +252,34 @@ impl<'a> OnBoard<'a> {
             json: Json::At("/board/excitation_shift_ticks"),
         },
         Decl {
+            name: "RESOLVER_SIGNAL",
+            value: F32(|c| c.o.resolver_signal, ""),
+            formula: Lit(
+                "A/(V_REF+/2)·cos(π·f_s·Δt/2): the front end's SIN/COS peak over the ADC's half range, times the f_s/2 excitation's envelope at windings held Δt apart about its peak — the resolver signal's fraction of full scale the image measures at start-up (fault 19 outside RESOLVER_SIGNAL_MIN … RESOLVER_SIGNAL_MAX of it)",
+            ),
+            equation: Lit("thesis A §4.3, (4.10)"),
+            inputs: Of(|c| c.key("sensing.resolver_amplitude")),
+            json: Json::At("/board/resolver_signal"),
+        },
+        Decl {
+            name: "RESOLVER_SIGNAL_MIN",
+            value: F32(|c| c.o.resolver_signal_ratio_min, ""),
+            formula: Lit(
+                "(1 − 0.2)²: the least measured/designed resolver signal the start-up check accepts — the trig-identity observer's ω_n and ζ scale with its square root (4.10), so ω_n stays within 20 % of the design",
+            ),
+            equation: Lit("thesis A (4.10)"),
+            inputs: Lit("—"),
+            json: Json::At("/board/resolver_signal_ratio_min"),
+        },
+        Decl {
+            name: "RESOLVER_SIGNAL_MAX",
+            value: F32(|c| c.o.resolver_signal_ratio_max, ""),
+            formula: Lit("(1 + 0.2)²: the largest measured/designed resolver signal the start-up check accepts"),
+            equation: Lit("thesis A (4.10)"),
+            inputs: Lit("—"),
+            json: Json::At("/board/resolver_signal_ratio_max"),
+        },
+        Decl {
             name: "BREAK_ACTIVE_HIGH",
             value: Custom(|c| {
                 let physical = format!("{:?}", c.b.break_polarity);

@@ -37,7 +37,8 @@ use sections::Context;
 pub use sections::adc::AdcOut;
 pub use sections::angle_observer::ObserverOut;
 pub use sections::board::{
-    BoardOut, MIN_USABLE_VOLTAGE_FRACTION, Trip, TripSource, Trips, duty_limit_key, refuse_duty_limit, timing_of,
+    BoardOut, MIN_USABLE_VOLTAGE_FRACTION, RESOLVER_SIGNAL_RATIO, Trip, TripSource, Trips, duty_limit_key,
+    refuse_duty_limit, timing_of,
 };
 pub use sections::current_loop::{CurrentLoopOut, FeedForward, HotVariant};
 pub use sections::drive::DriveOut;

@@ -13,8 +13,14 @@
 //!   errors injected would read as amperes (stated per case below);
 //! * beyond it: the fault record carries cause 10 (current offset) and no gate could
 //!   switch on at any instant of the run.
+//!
+//! And the resolver signal measured over the same periods (`motor_config::resolver_check`):
+//! with the excitation dead (`Patches::excitation_off`: TIM3's output never enabled, the
+//! windings carry nothing) every pair faults with cause 19 (resolver signal), gates never
+//! on.
 
 use crate::BOOT_LIMIT_S;
+use motor_emulator::Patches;
 use motor_emulator::periph::system::IRQ_ADC1_2;
 use motor_emulator::rig::{Bench, Rig, benches};
 use motor_emulator::wiring::Standstill;
@@ -154,5 +160,38 @@ fn offset_beyond_the_bound_faults_with_the_gates_off() {
             );
         }
         println!("{motor} on {board}: ±1.2·bound on one phase → fault 10 (current offset), gates never on");
+    }
+}
+
+/// No excitation (module documentation): fault 19 and no gate on, on every pair; the
+/// measured signal is 0 against the design's (0.4 on the reference boards, 0.3708 on the
+/// NUCLEO).
+#[test]
+fn dead_excitation_faults_with_the_gates_off() {
+    for (motor, board) in benches() {
+        let bench = Bench::new(&motor, &board).unwrap().patched(Patches {
+            excitation_off: true,
+            ..Patches::default()
+        });
+        let name = bench.name();
+        let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let mut switched = None;
+        rig.run(
+            BOOT_LIMIT_S,
+            |_| Some(0.0),
+            |m| {
+                if m.soc().gates_can_switch() {
+                    switched = Some(m.soc().time_s());
+                }
+                switched.is_some()
+            },
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(switched, None, "{name}: a gate could switch without excitation");
+        assert_eq!(rig.fault_cause().as_deref(), Some("19 (resolver signal)"), "{name}");
+        println!(
+            "{name}: no excitation → fault 19 (resolver signal), gates never on (designed signal {:.4})",
+            rig.design.board.as_ref().expect("board design").resolver_signal
+        );
     }
 }

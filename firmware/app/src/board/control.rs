@@ -50,10 +50,11 @@ use super::{adc, commissioning, fault, pins, pwm};
 use crate::adc_frame::Trips;
 use crate::adc_frame::{self, Excitation};
 use crate::bringup::{self, BreakControl};
-use crate::config::{CONTROLLER, OFFSETS, SETPOINT, TRIPS};
+use crate::config::{CONTROLLER, OFFSETS, RESOLVER_SIGNAL, SETPOINT, TRIPS};
 use crate::fault_record::{ControlState, FaultCause};
 use crate::motor::board;
 use crate::offset::{self, OffsetCalibration, OffsetStatus};
+use crate::resolver_check::{SignalCheck, SignalStatus};
 
 /// Control periods run (wrapping); the main loop refreshes the watchdog only when
 /// this advances.
@@ -105,6 +106,10 @@ pub struct Control {
     calibration: OffsetCalibration,
     /// The measured zero levels \[16-bit codes\], once measured and within the bound.
     zero: Option<[i32; 3]>,
+    /// The start-up measurement of the resolver signal (over the same periods).
+    signal: SignalCheck,
+    /// That measurement still running.
+    signal_pending: bool,
     /// The trips, about the measured zero levels once known.
     trips: Trips,
 }
@@ -136,6 +141,8 @@ impl Control {
             },
             calibration: OffsetCalibration::new(),
             zero: None,
+            signal: SignalCheck::new(),
+            signal_pending: true,
             trips: TRIPS,
         }
     }
@@ -223,6 +230,16 @@ impl Control {
             i_uvw: out.i_uvw,
         };
         self.omega_e = out.omega_e;
+        if self.signal_pending {
+            match self.signal.add(&RESOLVER_SIGNAL, sample.resolver) {
+                SignalStatus::Measuring => {}
+                SignalStatus::Within(_) => self.signal_pending = false,
+                SignalStatus::Outside(_) => {
+                    self.signal_pending = false;
+                    self.trip(FaultCause::ResolverSignal);
+                }
+            }
+        }
         if calibrating {
             self.state.observer = AtoState::acquired(&mut self.cordic, sample.resolver);
             self.omega_e = 0.0;

@@ -121,6 +121,16 @@ pub struct BoardOut {
     /// ω_e·|Δt|/2 (first order in ε = ω_r·Δt/2, times n_p/n_r), the most the drive can
     /// see of it.
     pub resolver_skew_ripple_rad: f64,
+    /// The resolver signal at the observer's input as a fraction of full scale
+    /// (`board::resolver_signal_gain`: the front end's amplitude over V_REF/2 times the
+    /// excitation's envelope where SIN and COS are held): what the image measures at
+    /// start-up against [`RESOLVER_SIGNAL_RATIO`].
+    pub resolver_signal: f64,
+    /// The least and largest measured/designed resolver signal the start-up check
+    /// accepts ([`RESOLVER_SIGNAL_RATIO`]).
+    pub resolver_signal_ratio_min: f64,
+    /// See `resolver_signal_ratio_min`.
+    pub resolver_signal_ratio_max: f64,
     /// The delay from the resolver's sample to the mean of the voltage computed from it
     /// [periods of T_s], the default angle lead k (thesis A (4.23)).
     pub angle_lead_periods: f64,
@@ -524,6 +534,9 @@ pub(in crate::design) fn board(
         resolver_skew_s,
         excitation_shift_ticks: excitation_shift_ticks(timing.resolver_sample_instant_s),
         resolver_skew_ripple_rad: 0.5 * over_speed_electrical_rad_s * resolver_skew_s.abs(),
+        resolver_signal: crate::board::resolver_signal_gain(board, d.drive.switching_frequency_hz),
+        resolver_signal_ratio_min: RESOLVER_SIGNAL_RATIO.0,
+        resolver_signal_ratio_max: RESOLVER_SIGNAL_RATIO.1,
         trigger_to_update_ticks: timing.trigger_to_update_ticks,
         current_sample_instant_s: timing.current_sample_instant_s,
         resolver_sample_instant_s: timing.resolver_sample_instant_s,
@@ -686,6 +699,13 @@ struct HoldInstants {
     /// The resolver SIN's and COS's mean (`board::resolver_sample_instant`).
     resolver_s: f64,
 }
+
+/// The start-up resolver check's bounds on the measured signal over the designed one
+/// (`resolver_signal`): the trig-identity observer's ω_n and ζ scale with the square
+/// root of that ratio (thesis A (4.10)), so (1 ∓ 20 %)² = 0.64 … 1.44 keeps them within
+/// 20 % of the design; a dead excitation or an unplugged resolver (≈ 0) and a front end
+/// unlike the board file's fall outside.
+pub const RESOLVER_SIGNAL_RATIO: (f64, f64) = (0.64, 1.44);
 
 /// `control_timing` of `board` at switching frequency `fs_hz` (T_s = 1/f_s, TIM1's
 /// period for it, the board's sampling instant and ADC sequences); `None` where TIM1
