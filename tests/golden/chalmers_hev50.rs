@@ -84,11 +84,11 @@ pub mod current_loop {
 
 /// Angle tracking observer (Q1.31) and resolver → electrical angle.
 pub mod observer {
-    /// 0.00445634: `K̃_p = 2ζω_n/(f_s·π·g), Q1.31`, thesis A (4.15), (4.22).
+    /// 0.00445634: `K̃_p = 2ζω_n/(f_s·π·g), Q1.31`, thesis A (4.10), (4.15), (4.22).
     ///
     /// Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 10000 Hz (spec), g = 1 (the resolver signal's fraction of full scale the error scales with, thesis A (4.10): no board: signals at full scale).
     pub const KP: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(9569914);
-    /// 0.0000155972: `K̃_i = ω_n²/(f_s²·π·g), Q1.31`, thesis A (4.15), (4.22).
+    /// 0.0000155972: `K̃_i = ω_n²/(f_s²·π·g), Q1.31`, thesis A (4.10), (4.15), (4.22).
     ///
     /// Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 10000 Hz (spec), g = 1 (the resolver signal's fraction of full scale the error scales with, thesis A (4.10): no board: signals at full scale).
     pub const KI: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(33495);

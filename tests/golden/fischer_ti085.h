@@ -89,11 +89,11 @@ static const float FISCHER_TI085_CURRENT_LOOP_IQ_PER_NM = 2.7584343f;
 
 /* Angle tracking observer (Q1.31) and resolver → electrical angle. */
 
-/** 0.00222817: K̃_p = 2ζω_n/(f_s·π·g), Q1.31, thesis A (4.15), (4.22).
+/** 0.00222817: K̃_p = 2ζω_n/(f_s·π·g), Q1.31, thesis A (4.10), (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec), g = 1 (the resolver signal's fraction of full scale the error scales with, thesis A (4.10): no board: signals at full scale). */
 #define FISCHER_TI085_OBSERVER_KP INT32_C(4784957)
 
-/** 0.0000038993: K̃_i = ω_n²/(f_s²·π·g), Q1.31, thesis A (4.15), (4.22).
+/** 0.0000038993: K̃_i = ω_n²/(f_s²·π·g), Q1.31, thesis A (4.10), (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec), g = 1 (the resolver signal's fraction of full scale the error scales with, thesis A (4.10): no board: signals at full scale). */
 #define FISCHER_TI085_OBSERVER_KI INT32_C(8374)
 

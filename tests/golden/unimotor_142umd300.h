@@ -89,11 +89,11 @@ static const float UNIMOTOR_142UMD300_CURRENT_LOOP_IQ_PER_NM = 0.0f;
 
 /* Angle tracking observer (Q1.31) and resolver → electrical angle. */
 
-/** 0.007: K̃_p = 2ζω_n/(f_s·1 (atan2 error already normalised by π)), Q1.31, thesis A (4.15), (4.22).
+/** 0.007: K̃_p = 2ζω_n/(f_s·1 (atan2 error already normalised by π)), Q1.31, thesis A (4.10), (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec). */
 #define UNIMOTOR_142UMD300_OBSERVER_KP INT32_C(15032386)
 
-/** 0.00001225: K̃_i = ω_n²/(f_s²·1 (atan2 error already normalised by π)), Q1.31, thesis A (4.15), (4.22).
+/** 0.00001225: K̃_i = ω_n²/(f_s²·1 (atan2 error already normalised by π)), Q1.31, thesis A (4.10), (4.15), (4.22).
  *  Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec). */
 #define UNIMOTOR_142UMD300_OBSERVER_KI INT32_C(26307)
 

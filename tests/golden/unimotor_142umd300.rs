@@ -84,11 +84,11 @@ pub mod current_loop {
 
 /// Angle tracking observer (Q1.31) and resolver → electrical angle.
 pub mod observer {
-    /// 0.007: `K̃_p = 2ζω_n/(f_s·1 (atan2 error already normalised by π)), Q1.31`, thesis A (4.15), (4.22).
+    /// 0.007: `K̃_p = 2ζω_n/(f_s·1 (atan2 error already normalised by π)), Q1.31`, thesis A (4.10), (4.15), (4.22).
     ///
     /// Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec).
     pub const KP: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(15032386);
-    /// 0.00001225: `K̃_i = ω_n²/(f_s²·1 (atan2 error already normalised by π)), Q1.31`, thesis A (4.15), (4.22).
+    /// 0.00001225: `K̃_i = ω_n²/(f_s²·1 (atan2 error already normalised by π)), Q1.31`, thesis A (4.10), (4.15), (4.22).
     ///
     /// Inputs: ω_n = 70 rad/s (spec), ζ = 1 (spec), f_s = 20000 Hz (spec).
     pub const KI: ::fixed::types::I1F31 = ::fixed::types::I1F31::from_bits(26307);

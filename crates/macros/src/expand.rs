@@ -263,7 +263,7 @@ pub fn ato_gains(input: TokenStream) -> syn::Result<TokenStream> {
     } else {
         ObserverError::TrigIdentity
     };
-    // The macro knows no board: resolver signals at full scale (thesis A (4.8)).
+    // The macro knows no board: resolver signals at full scale (g = 1 in thesis A (4.10)).
     let g = angle_observer::design(wn, zeta, fs, error, 1.0).map_err(|e| {
         let what = match e {
             angle_observer::ObserverGainError::Overflow { gain, scaled } => {

@@ -92,8 +92,8 @@ pub enum FaultCause {
     /// wrong resolver offset).
     PreflightResolverOffset = 18,
     /// The resolver signal measured at start-up with the gates off
-    /// (`motor_config::resolver_check`: √(sin² + cos²) over the second half of the
-    /// offset calibration) is outside `board::RESOLVER_SIGNAL_MIN` … `_MAX` of the one the
+    /// (`motor_config::resolver_check`: the RMS √mean(sin² + cos²) over the second half
+    /// of the offset calibration) is outside `board::RESOLVER_SIGNAL_MIN` … `_MAX` of the one the
     /// observer's gains are designed for (`board::RESOLVER_SIGNAL`): no excitation, a
     /// resolver unplugged, a front end unlike the board file's `sensing.resolver_amplitude`.
     /// The outputs were never switched on.

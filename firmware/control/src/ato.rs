@@ -322,8 +322,8 @@ mod tests {
     /// Acquisition at rest: seeded on a sample at any angle (here 2.5 rad, and −3 rad near
     /// the ±π wrap) at 0.4 of full scale, the next steps on the same sample keep the angle
     /// within 2^−20 rad and the speed at zero (no kick), where the observer pulled in
-    /// from θ̂ = 0 kicks its speed by K̃_p·sin Δ in the first period: with ω_n = 2000
-    /// rad/s at 20 kHz, by hand K_p·0.4·sin 2.5 = 4000·0.4·0.598 = 957.6 rad/s.
+    /// from θ̂ = 0 kicks its speed by K_p·g·sin Δ (rad/s) in the first period: with
+    /// ω_n = 2000 rad/s and g = 0.4, by hand 4000·0.4·sin 2.5 = 4000·0.4·0.598 = 957.6 rad/s.
     #[test]
     fn acquired_at_rest_needs_no_pull_in() {
         let cfg = config(ObserverError::TrigIdentity, 2000.0, 1.0);

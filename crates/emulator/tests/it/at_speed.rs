@@ -17,8 +17,10 @@
 //! observer lag by [`PROFILE_LAG_DEG`] electrical
 //! (thesis A (4.12)–(4.15): K_i·sin Δ = n_r·ω̇_m for the trig-identity error, whose gains
 //! the design divides by the board's resolver signal amplitude, K_i·Δ for atan2). Where
-//! the drive's own acceleration is beyond that (amk-dd5-ipm, chalmers-hev50, fischer-ti085:
-//! ω_n = 200, 70 and 70 rad/s) the drive's acceleration it is.
+//! the drive's own acceleration is beyond that (fischer-ti085: ω_n = 70 rad/s, K_i·sin(3°/4)
+//! = 64.1 rad/s² against its drive's 209.4) the drive's acceleration it is; amk-dd5-ipm's
+//! observer allows 418.9 rad/s² (twice its drive's), chalmers-hev50's 128.3 (its drive's
+//! 125.7).
 //!
 //! No hold at the top: a linear ramp's acceleration stops at once there, and the type-2
 //! observer's lag, released in one step, swings past; on amk-dd5-ipm at 20 000 rpm both
@@ -34,9 +36,9 @@
 //! `motorgen check` puts them on: the reference board's 100 A cannot carry them) every
 //! motor reaches its `max_speed`.
 //!
-//! Cost: the emulated image runs at about 2 s of CPU per simulated second; the longest
-//! profiles are the traction motors whose observers allow no faster ramp than their drives'
-//! (amk-dd5-ipm and fischer-ti085 10 s, chalmers-hev50 8 s of simulated time).
+//! Cost: the emulated image runs at about 1–2 s of CPU per simulated second; the longest
+//! profiles are fischer-ti085's 10.05 s and chalmers-hev50's 9.85 s of simulated time,
+//! amk-dd5-ipm's 5.05 s (stop 41).
 
 use std::f64::consts::PI;
 

@@ -26,7 +26,8 @@ use motor_verify::Setup;
 use motor_verify::scenarios::{current_step, current_step_checks, current_step_samples, step_amplitude};
 
 /// Zero-torque time after the first enabled period before the step \[s\]: the image's
-/// angle observer starts at 0 and locks onto the resolver (its offset) meanwhile.
+/// angle observer, acquired on the resolver during the offset calibration, settles at
+/// zero torque meanwhile.
 const SETTLE_S: f64 = 0.02;
 
 /// Carrier periods from the frame to the first update with moved duties, beyond the

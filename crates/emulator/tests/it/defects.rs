@@ -271,6 +271,10 @@ fn a_break_pulse_inside_the_interrupt_is_not_missed() {
 /// envelope gains — by hand cos(π·f_s·t) for a winding held t after the peak, 0.982 and
 /// 0.574 at the 1.52 µs and 7.64 µs the emulator measures at 40 kHz — which the boot test
 /// (`control_interrupt_instructions_fit_the_period_and_the_budget`) refuses on every pair.
+/// The image's own start-up check sees it too, depending on the rotor's angle: here the
+/// resolver rests at 0 (COS only), so it measures 0.4·0.5736 = 0.2294 of full scale,
+/// below 0.64 of the designed 0.3708 (0.2373): fault 19, the outputs never on. (At 90°,
+/// SIN only, it would measure 0.4·0.9818 = 0.3927, 1.06 of the design, and pass.)
 #[test]
 fn excitation_peak_at_the_trigger_reads_sin_and_cos_at_different_gains() {
     let bench = Bench::new("maxon-ec45-flat-70w", "nucleo-g474re-ihm08m1").unwrap();
@@ -304,4 +308,6 @@ fn excitation_peak_at_the_trigger_reads_sin_and_cos_at_different_gains() {
         (e_sin - e_cos).abs() > 0.3,
         "{name}: SIN and COS read at gains {e_sin:.4} and {e_cos:.4}"
     );
+    assert_eq!(rig.fault_cause().as_deref(), Some("19 (resolver signal)"), "{name}");
+    assert!(!rig.machine.soc().tim1.moe(), "{name}: outputs on");
 }

@@ -35,13 +35,12 @@
 //! * fischer-ti085: the trig-identity observer's acceleration at a lag Δ is K_i·sin Δ
 //!   (thesis A (4.12)–(4.15)); with ω_n = 70 rad/s a zero-torque ramp to 20 000 rpm within
 //!   3° of lag takes 32.7 s of emulated time (K_i·sin(3°/4) = 64.1 rad/s² of the shaft). A
-//!   faster ramp leaves a lag that the ramp's end releases within a few 1/ω_n against a
-//!   back EMF near V'_max: ramped at its drive's 2 000 rpm/s to 12 000 rpm — tried before
-//!   the design divided the gains by the resolver signal, so at 0.63 of its ω_n and 24°
-//!   of lag — it reached i_d = 100.6 A at zero torque 13 ms after the ramp's end, and the
-//!   over-current trip switched it off. Its current loop (thesis A's 100 rad/s,
-//!   K_p = 0.039 V/A, L = 0.39 mH) cannot reject the tens of volts the frame's turn puts
-//!   on the d axis.
+//!   faster ramp leaves a lag that the ramp's end releases within a few 1/ω_n against the
+//!   back EMF: ramped at its drive's 2 000 rpm/s (9.8° electrical of lag) to 20 000 rpm
+//!   the drive tripped 8.3 ms after the ramp's end (fault 4), as it did before the gain
+//!   fix at 12 000 rpm with 24° of lag (i_d = 100.6 A at zero torque 13 ms after the
+//!   ramp's end). Its current loop (thesis A's 100 rad/s, K_p = 0.039 V/A, L = 0.39 mH)
+//!   cannot reject the tens of volts the frame's turn puts on the d axis.
 
 use std::f64::consts::PI;
 

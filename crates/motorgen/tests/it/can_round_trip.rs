@@ -235,7 +235,9 @@ fn every_seed_motor_identifies_over_can() {
         plant.motor.psi_q = [0.0; 2];
         plant.resolver_offset = OFFSET;
         plant.theta_m = 0.4 / np;
-        let bench = Bench::new(setup.cfg, plant);
+        let mut bench = Bench::new(setup.cfg, plant);
+        // The resolver read at the signal the design's observer gains are made for.
+        bench.resolver_amplitude = setup.signal_gain();
         let align = Command {
             routine: Some(Routine::ResolverOffset),
             axis_q: false,
