@@ -1192,17 +1192,18 @@ impl Soc {
                 // The rank ends at `at`; its input was held SAR_CYCLES earlier, at the end
                 // of its sampling phase (§21.4.12).
                 let held = at - SAR_CYCLES * clk;
-                match input.signal {
-                    crate::hardware::Analog::Current(phase) => currents.push((ch, phase, (held - sampled, held))),
-                    crate::hardware::Analog::Sin => resolver.push((0, held)),
-                    crate::hardware::Analog::Cos => resolver.push((1, held)),
-                    crate::hardware::Analog::DcLink => {}
-                }
                 let excitation = tim3.excitation((held * UNITS_PER_S) as u64);
                 match input.signal {
-                    crate::hardware::Analog::Sin => envelope[0] = Some((held, excitation)),
-                    crate::hardware::Analog::Cos => envelope[1] = Some((held, excitation)),
-                    _ => {}
+                    crate::hardware::Analog::Current(phase) => currents.push((ch, phase, (held - sampled, held))),
+                    crate::hardware::Analog::Sin => {
+                        resolver.push((0, held));
+                        envelope[0] = Some((held, excitation));
+                    }
+                    crate::hardware::Analog::Cos => {
+                        resolver.push((1, held));
+                        envelope[1] = Some((held, excitation));
+                    }
+                    crate::hardware::Analog::DcLink => {}
                 }
                 let v = analog.volts(input.signal, held, excitation);
                 // Ideal 12-bit conversion: code = V/V_REF·4096, clamped (RM0440 §21.4.1).

@@ -51,14 +51,19 @@ impl Tim3 {
         let Some(r) = self.reset_at else {
             return self.level_at_reset;
         };
+        self.level_at_reset ^ (self.toggles(r, t) % 2 == 1)
+    }
+
+    /// OC1REF's toggles from the reset at `r` to `t` (toggle mode: one each time the
+    /// counter, counting 0..=ARR from `r`, matches CCR1).
+    fn toggles(&self, r: u64, t: u64) -> u64 {
         let ticks = t.saturating_sub(r) / self.tick;
         let (ccr, arr) = (u64::from(self.reg(0x34)), self.arr());
-        let toggles = if (self.reg(0x18) >> 4) & 7 == 0b011 && ticks >= ccr && ccr <= arr {
+        if (self.reg(0x18) >> 4) & 7 == 0b011 && ticks >= ccr && ccr <= arr {
             1 + (ticks - ccr) / (arr + 1)
         } else {
             0
-        };
-        self.level_at_reset ^ (toggles % 2 == 1)
+        }
     }
 
     /// The auto-reload value: TIM3 is a 16-bit timer (RM0440 §29.2, ARR[15:0] of
@@ -78,13 +83,8 @@ impl Tim3 {
         let Some(r) = self.reset_at else {
             return self.edges_at_reset;
         };
-        let ticks = t.saturating_sub(r) / self.tick;
+        let n = self.toggles(r, t);
         let (ccr, arr) = (u64::from(self.reg(0x34)), self.arr());
-        let n = if (self.reg(0x18) >> 4) & 7 == 0b011 && ticks >= ccr && ccr <= arr {
-            1 + (ticks - ccr) / (arr + 1)
-        } else {
-            0
-        };
         let at = |k: u64| Some(r + (ccr + k * (arr + 1)) * self.tick);
         match n {
             0 => self.edges_at_reset,

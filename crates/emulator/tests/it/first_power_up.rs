@@ -131,6 +131,25 @@ fn offset_within_the_bound_runs_about_the_measured_zero() {
     }
 }
 
+/// Runs `rig` from reset for [`BOOT_LIMIT_S`] at zero-torque setpoints; the first instant
+/// at which a gate could switch on, if any (the run stops there).
+fn first_switchable(rig: &mut Rig) -> Option<f64> {
+    let name = rig.bench.name();
+    let mut switched = None;
+    rig.run(
+        BOOT_LIMIT_S,
+        |_| Some(0.0),
+        |m| {
+            if m.soc().gates_can_switch() {
+                switched = Some(m.soc().time_s());
+            }
+            switched.is_some()
+        },
+    )
+    .unwrap_or_else(|e| panic!("{name}: {e}"));
+    switched
+}
+
 /// A zero-level error of 1.2 of the bound on one phase (v, then −1.2 on u): the fault
 /// record says "current offset" (cause 10) and no gate could switch on at any instant of
 /// the run (the boot limit with zero-torque setpoints).
@@ -140,18 +159,7 @@ fn offset_beyond_the_bound_faults_with_the_gates_off() {
         for errors in [[0.0, 1.2, 0.0], [-1.2, 0.0, 0.0]] {
             let mut rig = rig_with_errors(&motor, &board, |b| errors.map(|e| e * b));
             let name = rig.bench.name();
-            let mut switched = None;
-            rig.run(
-                BOOT_LIMIT_S,
-                |_| Some(0.0),
-                |m| {
-                    if m.soc().gates_can_switch() {
-                        switched = Some(m.soc().time_s());
-                    }
-                    switched.is_some()
-                },
-            )
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
+            let switched = first_switchable(&mut rig);
             assert_eq!(switched, None, "{name}: errors {errors:?}·bound, a gate could switch");
             assert_eq!(
                 rig.fault_cause().as_deref(),
@@ -175,18 +183,7 @@ fn dead_excitation_faults_with_the_gates_off() {
         });
         let name = bench.name();
         let mut rig = Rig::new(bench).unwrap_or_else(|e| panic!("{name}: {e}"));
-        let mut switched = None;
-        rig.run(
-            BOOT_LIMIT_S,
-            |_| Some(0.0),
-            |m| {
-                if m.soc().gates_can_switch() {
-                    switched = Some(m.soc().time_s());
-                }
-                switched.is_some()
-            },
-        )
-        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let switched = first_switchable(&mut rig);
         assert_eq!(switched, None, "{name}: a gate could switch without excitation");
         assert_eq!(rig.fault_cause().as_deref(), Some("19 (resolver signal)"), "{name}");
         println!(
