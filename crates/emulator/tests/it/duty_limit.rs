@@ -10,37 +10,43 @@
 //! transient is over (the image takes a frame a period or two after verify's bench).
 //!
 //! The run: boot, 20 ms at zero torque, a ramp at zero torque to the at-speed scenario's
-//! top speed (its acceleration rule), [`HOLD_S`] there, then the MTPA torque on the
-//! board's current circle for [`AFTER_S`].
+//! top speed, [`HOLD_S`] there, then the MTPA torque on the board's current circle for
+//! [`AFTER_S`]. The ramp is `verify`'s own field-weakening ramp
+//! ([`motor_verify::field_weakening::Ramp`]: ω rises as (1 − cos πτ)/2, so the
+//! acceleration ends smoothly), its peak acceleration the at-speed scenario's rule, its
+//! values at every setpoint period joined by straight lines on both sides. Until stop 42
+//! the ramp was linear: its acceleration stopped at once at the top, and the observer's
+//! type-2 lag, released in one step, turned the frame against the back EMF — on
+//! fischer-ti085 (9.8° electrical of lag at its drive's 2 000 rpm/s) the drive tripped
+//! 8.3 ms after the ramp's end (fault 4), and on mit-mini-cheetah-actuator the step then
+//! peaked at duty 0.98976, short of the limit.
 //!
 //! Pairs ([`BENCHES`]): every board in `boards/`, and on each the motors whose run fits
 //! in CI and shows what it is for: the NUCLEO + X-NUCLEO-IHM08M1 (low-side shunts,
 //! d_max < 1) and the reference board (in-line Hall sensors: d_max = 1, the duty reaches
-//! the THPWM linear range's 100 %) with maxon-ec45-flat-70w; the 400 A variant of the
-//! reference board (the same hardware with another sensing gain, d_max = 1) with
-//! emrax-228-hv (0.13 s of ramp) and chalmers-hev50 (9.8 s of ramp at 10 kHz: 9 s of
-//! CPU). The defect: the compare values one timer tick beyond `MAX_COMPARE`
+//! the THPWM linear range's 100 %) with maxon-ec45-flat-70w, and mit-mini-cheetah-actuator
+//! on the reference board; the 400 A variant of the reference board (the same hardware
+//! with another sensing gain, d_max = 1) with emrax-228-hv and chalmers-hev50 (15.4 s of
+//! ramp at 10 kHz). The defect: the compare values one timer tick beyond `MAX_COMPARE`
 //! (`Patches::compare_beyond`) and the rule fires.
 //!
-//! The other motors with a flux linkage, tried on their boards (stop 41) and not run:
-//! * amk-dd5-ipm (5.0 s of ramp to 20 000 rpm): the duty reached 1 for 34 periods and no
-//!   conversion sampled inside an edge, but the torque was 1.69 of the tolerance off
-//!   verify's and the currents 6.23 A (tolerance 4.85 A) — the image and verify part
-//!   deep in field weakening at 20 000 rpm as in the at-speed scenario's open finding
-//!   (crates/emulator/README.md, "At speed").
-//! * mit-mini-cheetah-actuator (0.07 s of ramp to 2 292 rpm): the step's peak duty is
-//!   0.98976, not the limit — its field weakening (α_fw = 500 rad/s, V'_max = 0.8·V_max)
-//!   keeps the PI output inside the circle, so the duty limit is not exercised (torque
-//!   0.26 of verify's tolerance, currents 0.399 A of 1.761 A).
-//! * fischer-ti085: the trig-identity observer's acceleration at a lag Δ is K_i·sin Δ
-//!   (thesis A (4.12)–(4.15)); with ω_n = 70 rad/s a zero-torque ramp to 20 000 rpm within
-//!   3° of lag takes 32.7 s of emulated time (K_i·sin(3°/4) = 64.1 rad/s² of the shaft). A
-//!   faster ramp leaves a lag that the ramp's end releases within a few 1/ω_n against the
-//!   back EMF: ramped at its drive's 2 000 rpm/s (9.8° electrical of lag) to 20 000 rpm
-//!   the drive tripped 8.3 ms after the ramp's end (fault 4), as it did before the gain
-//!   fix at 12 000 rpm with 24° of lag (i_d = 100.6 A at zero torque 13 ms after the
-//!   ramp's end). Its current loop (thesis A's 100 rad/s, K_p = 0.039 V/A, L = 0.39 mH)
-//!   cannot reject the tens of volts the frame's turn puts on the d axis.
+//! The two motors with a flux linkage not run, tried on their boards with this ramp
+//! (stop 42): both reach 20 000 rpm without a trip, the duty reaches its limit (30 and
+//! 36 periods) and never passes it, but in the step's saturated transient the image's
+//! currents part from verify's:
+//! * amk-dd5-ipm (400 A board, 7.9 s simulated, 16 s of CPU): the torque 1.58 of the
+//!   tolerance off verify's, the currents 5.97 A (tolerance 4.85 A). At zero torque
+//!   before the step the two agree within 1 A (i_d ≈ −54 A); after it both swing (i_q
+//!   between 12 and 47 A against its 89 A reference, about 15 ms a swing) while the
+//!   field weakening lowers i_d^ref, the image's swing a few amperes smaller.
+//! * fischer-ti085 (reference board, 15.75 s simulated, 26.5 s of CPU): the torque 2.97
+//!   of the tolerance off verify's, the currents 8.66 A (tolerance 3.61 A). Before the
+//!   step within 0.3 A (i_d ≈ −58.3 A); after it the image's i_q rises to 33 A where
+//!   verify's reaches 38.7 A, 10–15 ms into the step.
+//!
+//! Both are the at-speed scenario's open finding (crates/emulator/README.md, "At speed"):
+//! at 20 000 rpm, where ω_e·L is 1.3 Ω (amk) and 3.3 Ω (fischer) and the current loops'
+//! bandwidths are 220 and 100 rad/s, the image and verify part once the voltage saturates.
 
 use std::f64::consts::PI;
 
@@ -51,7 +57,7 @@ use motor_emulator::rig::{Bench, benches};
 use motor_emulator::wiring;
 use motor_sim::plant::{Shaft, SpeedProfile};
 use motor_verify::Setup;
-use motor_verify::field_weakening::{run as verify_run, torque as machine_torque};
+use motor_verify::field_weakening::{Ramp, run as verify_run, torque as machine_torque};
 
 /// Zero torque at the top speed before the step \[s\].
 const HOLD_S: f64 = 0.01;
@@ -76,9 +82,10 @@ struct Outcome {
 }
 
 /// The scenario's (board, motor) pairs (module documentation): every board in `boards/`.
-const BENCHES: [(&str, &str); 4] = [
+const BENCHES: [(&str, &str); 5] = [
     ("nucleo-g474re-ihm08m1", "maxon-ec45-flat-70w"),
     ("motorgen-reference", "maxon-ec45-flat-70w"),
+    ("motorgen-reference", "mit-mini-cheetah-actuator"),
     ("motorgen-reference-400a", "emrax-228-hv"),
     ("motorgen-reference-400a", "chalmers-hev50"),
 ];
@@ -121,19 +128,37 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     let period = rig.setpoint_period_s();
     let now = rig.machine.soc().time_s();
     let at = (now / period).ceil() * period;
-    let imposed = SpeedProfile {
-        from: 0.0,
-        to: top_e / np,
-        start: at,
-        acceleration: acc_m,
+    // verify's own field-weakening ramp (a cosine: the acceleration ends smoothly, so the
+    // observer's lag is not released at once), its knots every setpoint period joined
+    // by straight lines, the same profile on both sides.
+    let ramp = Ramp::new(0.0, top_e / np, at, acc_m);
+    let knot = move |t: f64| {
+        let k = ((t - at) / period).floor();
+        let (t0, t1) = (at + k * period, at + (k + 1.0) * period);
+        let (w0, w1) = (ramp.at(t0), ramp.at(t1));
+        (t0, w0, w1)
     };
-    let t_step = ((at + top_e / np / acc_m + HOLD_S) / period).ceil() * period;
+    let speed = move |t: f64| {
+        let (t0, w0, w1) = knot(t);
+        w0 + (w1 - w0) * (t - t0) / period
+    };
+    let t_step = ((at + ramp.duration + HOLD_S) / period).ceil() * period;
     let end = t_step + AFTER_S;
     let command = move |tf: f64| if tf + 1e-9 >= t_step { torque } else { 0.0 };
-    rig.analog_as::<Drive>().unwrap().plant.shaft = Shaft::Imposed(imposed);
     let started = std::time::Instant::now();
-    rig.run(end, |t| Some(command(t)), |_| false)
-        .map_err(|e| format!("{e}; {}", rig.machine.summary()))?;
+    let mut t = at;
+    while t < end - 1e-12 {
+        let (t0, w0, w1) = knot(t + 1e-9);
+        rig.analog_as::<Drive>().unwrap().plant.shaft = Shaft::Imposed(SpeedProfile {
+            from: w0,
+            to: w1,
+            start: t0,
+            acceleration: (w1 - w0).abs() / period,
+        });
+        t = (t0 + period).min(end);
+        rig.run(t, |t| Some(command(t)), |_| false)
+            .map_err(|e| format!("{e}; {}", rig.machine.summary()))?;
+    }
     let cpu_s = started.elapsed().as_secs_f64();
     let s: Vec<Sample> = rig.analog_as::<Drive>().unwrap().samples.clone();
     let k0 = s.iter().rposition(|x| x.t < at).expect("samples before the ramp") + 1;
@@ -146,7 +171,6 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     }
     let t0 = s[k0].t;
     let n = s.len() - k0;
-    let speed = move |t: f64| imposed.at(t);
     let command_at = |tv: f64| command(t0 + (tv / period + 1e-9).floor() * period);
     let reference = verify_run(&setup, &command_at, &|t| speed(t0 + t), n, setup.signal_gain());
 
