@@ -331,9 +331,11 @@ pub fn board(b: &crate::design::BoardOut, d: &Design) -> String {
         }
         let l = &b.duty_limit;
         let why = match l.bound {
-            crate::design::duty_limit::DutyBound::None => {
-                "in-line sensing reads the current whatever the switches do".to_string()
-            }
+            crate::design::duty_limit::DutyBound::DeadTime => format!(
+                "no pulse shorter than the {:.0} ns dead time lets through ({} compare ticks from either end; in-line sensing reads the current whatever the switches do)",
+                l.dead_time_s * 1e9,
+                l.min_pulse
+            ),
             crate::design::duty_limit::DutyBound::Settling => format!(
                 "low-side shunts: ±{:.2} µs of low-side pulse about the carrier maximum, dead time {:.0} ns + settling {:.0} ns before the first current rank samples",
                 l.half_window_s * 1e6,

@@ -524,6 +524,22 @@ impl<'a> OnBoard<'a> {
             json: Json::At("/board/duty_limit/half_window_s"),
         },
         Decl {
+            name: "MIN_PULSE",
+            value: Custom(|c| {
+                let l = &c.o.duty_limit;
+                (
+                    intv(l.min_pulse.into(), "u16", "uint16_t"),
+                    format!("ticks of ARR {}", c.d.drive.pwm_period),
+                )
+            }),
+            formula: Lit(
+                "p = ⌈t_d/2⌉ with t_d TIM1's dead time in timer ticks (DTG decoded): a compare value within p of 0 or ARR gives a pulse 2·g < t_d the dead time swallows, so MAX_COMPARE ≤ ARR − p",
+            ),
+            equation: Lit("RM0440 §28.3.15 (dead-time insertion), §28.6.20 (DTG); design::duty_limit"),
+            inputs: Of(|c| format!("pwm.dead_time ({}), drive.dead_time ({})", c.b.file, c.d.spec_file)),
+            json: Json::At("/board/duty_limit/min_pulse"),
+        },
+        Decl {
             name: "MAX_COMPARE",
             value: Custom(|c| {
                 let l = &c.o.duty_limit;
@@ -532,15 +548,24 @@ impl<'a> OnBoard<'a> {
                     format!("ticks of ARR {}", c.d.drive.pwm_period),
                 )
             }),
-            formula: Lit("ARR − ⌈h·f_TIM⌉: the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h"),
+            formula: Lit(
+                "min(ARR − ⌈h·f_TIM⌉, ARR − MIN_PULSE): the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h and that the dead time does not swallow",
+            ),
             equation: Lit("RM0440 §29.3.10 (centre-aligned PWM); design::duty_limit"),
-            inputs: Of(|c| format!("SAMPLING_HALF_WINDOW_S, drive.switching_frequency ({})", c.d.spec_file)),
+            inputs: Of(|c| {
+                format!(
+                    "SAMPLING_HALF_WINDOW_S, MIN_PULSE, drive.switching_frequency ({}), bound: {:?}",
+                    c.d.spec_file, c.o.duty_limit.bound
+                )
+            }),
             json: Json::At("/board/duty_limit/max_compare"),
         },
         Decl {
             name: "MAX_DUTY",
             value: F32(|c| c.o.duty_limit.max_duty, ""),
-            formula: Lit("d_max = MAX_COMPARE/ARR = 1 − 2·h/T_s, rounded down to a whole compare value"),
+            formula: Lit(
+                "d_max = MAX_COMPARE/ARR: 1 − 2·h/T_s rounded down to a whole compare value, at most 1 − MIN_PULSE/ARR",
+            ),
             equation: Lit("design::duty_limit"),
             inputs: Of(|c| format!("SAMPLING_HALF_WINDOW_S ({})", c.b.file)),
             json: Json::At("/board/duty_limit/max_duty"),

@@ -30,9 +30,36 @@
 //! carrier's: the low-side pulse is split evenly about the maximum.
 //!
 //! **In-line sensing** (Hall sensors, in-line shunts) measures the phase current whatever
-//! the switches do: no limit from the sampling (`d_max = 1`). The reference boards'
-//! isolated drivers (1EDI20N12AF) state no bootstrap supply that a 100 % duty would
-//! starve, so nothing else limits it either.
+//! the switches do: no limit from the sampling. The reference boards' isolated drivers
+//! (1EDI20N12AF) state no bootstrap supply that a 100 % duty would starve, so only the
+//! dead time's shortest pulse (below) limits it.
+//!
+//! **Pulses the dead time swallows.** A compare value within `p` of either end of the
+//! carrier gives a pulse the dead time swallows: OCxREF is low for `2·(ARR − CCR)` timer
+//! ticks about the maximum (high for `2·CCR` about the minimum), and the complementary
+//! output rises `t_d` after OCxREF's edge (RM0440 §28.3.15), so a pulse of `2·g < t_d`
+//! ticks never turns its switch on: both switches are off for `2·g + t_d` ticks and the
+//! phase follows its current's sign through a diode (`design::dead_time`) instead of the
+//! command. With `t_d` in timer ticks (TIM1_BDTR.DTG as the image programs it, RM0440
+//! §28.6.20),
+//!
+//! ```text
+//! p = ⌈t_d/2⌉   compare units,      d_max ≤ (ARR − p)/ARR
+//! ```
+//!
+//! `p` is the shortest gap whose switch still turns on; with `d ≤ d_max` and the
+//! modulator's symmetry about 1/2 (`d ≥ 1 − d_max`) no leg's pulse is swallowed at either
+//! end. In-line sensing has no other limit, so there `d_max = 1 − p/ARR` (0.98988 for
+//! 500 ns at 20 kHz). Without it a leg within `p` of a rail loses up to `t_d/2` of its
+//! period's volt-seconds, and which legs do depends on where the rotor's angle falls on
+//! the carrier. Measured (stop 42) with a torque step at 20 000 rpm on fischer-ti085,
+//! whose electrical turn there is 15 carrier periods: the emulated bridge, which swallows
+//! such pulses, put the image's i_q 4–6 A below `verify`'s ideal inverter; and `verify`
+//! itself, with those compare values moved to the nearer of no pulse and `p`, gave
+//! 32.4–39.5 A of i_q 14 ms into the step for four shifts of the rotor by a quarter
+//! period against the carrier (38.7–38.8 A with the rails reached as the ideal inverter
+//! has them). A low-side shunt's window already ends more than `t_d` into the low-side
+//! pulse, so the limit changes only in-line boards.
 //!
 //! **Usable voltage.** The modulator (thesis A (3.7), (3.8), `motor_control::modulation`)
 //! keeps the duties symmetric about 1/2, so `d ≤ d_max` also bounds the low duties at
@@ -63,8 +90,9 @@ pub struct CurrentRank {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DutyBound {
-    /// In-line sensing: no limit from the sampling.
-    None,
+    /// No limit from the sampling (in-line sensing): the dead time's shortest pulse
+    /// (module documentation, "Pulses the dead time swallows").
+    DeadTime,
     /// The dead time and settling before the first current rank's sampling starts.
     Settling,
     /// The last current rank's sampling end before the low side turns off.
@@ -90,11 +118,15 @@ pub struct DutyLimit {
     pub ranks: Vec<CurrentRank>,
     /// The usable fraction of the THPWM linear range U_dc/√3 ([`usable_voltage_fraction`]).
     pub usable_voltage_fraction: f64,
+    /// The shortest pulse the dead time lets through, p = ⌈t_d/2⌉ \[compare units\]
+    /// ([`min_pulse`]; module documentation, "Pulses the dead time swallows").
+    pub min_pulse: u16,
 }
 
 /// The duty limit of `board` at switching frequency `fs_hz` with dead time
 /// `dead_time_s` (the longer of the board's and the spec's): low-side shunts as the
-/// module documentation derives it, else none (d_max = 1). `None` when f_s needs an
+/// module documentation derives it, and on every board no pulse the dead time swallows
+/// (d_max ≤ 1 − p/ARR). `None` when f_s needs an
 /// auto-reload TIM1 cannot hold (refused elsewhere, `firmware::pwm_period`).
 pub fn for_board(board: &crate::board::Board, fs_hz: f64, dead_time_s: f64) -> Option<DutyLimit> {
     use crate::board::Placement;
@@ -110,7 +142,14 @@ pub fn for_board(board: &crate::board::Board, fs_hz: f64, dead_time_s: f64) -> O
         (Vec::new(), 0.0)
     };
     let (h, bound) = half_window(&ranks, dead_time_s, settling, 1.0 / timer_hz);
-    let max_compare = if low_side { max_compare(h, arr, timer_hz) } else { arr };
+    let p = min_pulse(dead_time_s);
+    let window = if low_side { max_compare(h, arr, timer_hz) } else { arr };
+    // The sampling window or the dead time's shortest pulse, whichever is shorter.
+    let (max_compare, bound) = if window <= arr.saturating_sub(p) {
+        (window, bound)
+    } else {
+        (arr.saturating_sub(p), DutyBound::DeadTime)
+    };
     let max_duty = f64::from(max_compare) / f64::from(arr);
     Some(DutyLimit {
         max_duty,
@@ -121,7 +160,16 @@ pub fn for_board(board: &crate::board::Board, fs_hz: f64, dead_time_s: f64) -> O
         settling_time_s: settling,
         ranks,
         usable_voltage_fraction: usable_voltage_fraction(max_duty),
+        min_pulse: p,
     })
+}
+
+/// p = ⌈t_d/2⌉ \[compare units\] of a dead time of `dead_time_s` as TIM1 makes it: the
+/// image's DTG code (`firmware::dead_time`, never shorter than asked) decoded to ticks
+/// of the timer clock (RM0440 §28.6.20); 0 where TIM1 cannot make it (refused at the
+/// key, `firmware::dead_time`).
+pub fn min_pulse(dead_time_s: f64) -> u16 {
+    crate::firmware::dead_time(dead_time_s).map_or(0, |dtg| motor_control::timing::dtg_ticks(dtg).div_ceil(2) as u16)
 }
 
 /// The ranks of `board`'s sequences that sample a phase current (padding repeats
@@ -160,7 +208,7 @@ pub use crate::board::{CONVERSION_CYCLES, TRIGGER_LATENCY_CYCLES};
 /// with `tick_s` the trigger's lead before the carrier maximum; and which one set it.
 pub fn half_window(ranks: &[CurrentRank], dead_time_s: f64, settling_s: f64, tick_s: f64) -> (f64, DutyBound) {
     let mut h = 0.0;
-    let mut bound = DutyBound::None;
+    let mut bound = DutyBound::DeadTime;
     for r in ranks {
         let settle = dead_time_s + settling_s - (r.start_s - tick_s);
         let end = r.end_s - tick_s;
@@ -231,6 +279,18 @@ mod tests {
 
     /// (3.8) at the edge of the linear range: the peak is exactly U_dc/2 (m = 1), and
     /// at m = 0 the third harmonic alone, 1/(6√3) = 0.096225.
+    /// By hand: 500 ns at 170 MHz is 85 ticks (DTG = 85, RM0440 §28.6.20: `0xx` codes
+    /// count single ticks), p = ⌈85/2⌉ = 43; 320 ns → 54.4 → 55 ticks (never shorter),
+    /// p = 28; 1 µs → 170 ticks, above 127 so DTG = 0x80 | (85 − 64) = 170 ticks, p = 85;
+    /// no dead time, p = 0.
+    #[test]
+    fn min_pulse_by_hand() {
+        assert_eq!(min_pulse(500e-9), 43);
+        assert_eq!(min_pulse(320e-9), 28);
+        assert_eq!(min_pulse(1e-6), 85);
+        assert_eq!(min_pulse(0.0), 0);
+    }
+
     #[test]
     fn phase_peak_by_hand() {
         assert!((thpwm_phase_peak(1.0) - 0.5).abs() < 1e-12);
@@ -294,6 +354,6 @@ mod tests {
         let (h, bound) = half_window(&ranks, 500e-9, 2e-6, tick);
         assert!((h - 2505.88e-9).abs() < 0.01e-9, "{h}");
         assert_eq!(bound, DutyBound::Settling);
-        assert_eq!(half_window(&[], 500e-9, 1e-6, tick), (0.0, DutyBound::None));
+        assert_eq!(half_window(&[], 500e-9, 1e-6, tick), (0.0, DutyBound::DeadTime));
     }
 }

@@ -350,14 +350,25 @@ fn the_nucleo_duty_limit_and_usable_voltage_by_hand() {
         "{}",
         fw.voltage_limit_v
     );
-    // The same motor on the reference board (Hall sensors): no limit, the whole range.
+    // The same motor on the reference board (Hall sensors): no limit from the sampling,
+    // only the dead time's shortest pulse. By hand: 500 ns at 170 MHz is 85 ticks
+    // (TIM1_BDTR.DTG = 85, RM0440 §28.6.20), p = ⌈85/2⌉ = 43 compare units, so
+    // MAX_COMPARE = 2125 − 43 = 2082 and d_max = 2082/2125 = 0.979765; k from the same
+    // phase-peak property as above.
     let r = on_board("maxon-ec45-flat-70w", &[], "motorgen-reference").unwrap();
     let lr = &r.board.as_ref().unwrap().duty_limit;
-    assert_eq!(
-        (lr.max_duty, lr.max_compare, lr.usable_voltage_fraction),
-        (1.0, 2125, 1.0)
-    );
-    assert!((r.current_loop.voltage_limit_v - 24.0 / s3).abs() < 1e-9);
+    assert_eq!((lr.min_pulse, lr.max_compare), (43, 2082));
+    assert!((lr.max_duty - 2082.0 / 2125.0).abs() < 1e-12);
+    assert_eq!(lr.bound, codegen::design::duty_limit::DutyBound::DeadTime);
+    let kr = lr.usable_voltage_fraction;
+    let peak_r = (0..100_000)
+        .map(|i| {
+            let phi = f64::from(i) * std::f64::consts::PI / 100_000.0;
+            kr / s3 * phi.cos() - (3.0 * phi).cos() / (6.0 * s3)
+        })
+        .fold(f64::MIN, f64::max);
+    assert!((peak_r - (2082.0 / 2125.0 - 0.5)).abs() < 1e-8, "{peak_r}");
+    assert!((r.current_loop.voltage_limit_v - kr * 24.0 / s3).abs() < 1e-9);
 }
 
 /// A settling time that leaves the NUCLEO too little duty is refused at that key: 10 µs

@@ -570,7 +570,8 @@ pub fn duty_limit_key(l: &DutyLimit) -> &'static str {
     match l.bound {
         DutyBound::Settling if l.dead_time_s > l.settling_time_s => "pwm.dead_time",
         DutyBound::Settling => "current_sensing.settling_time",
-        DutyBound::SamplingEnd | DutyBound::None => "sensing.source_resistance.current",
+        DutyBound::DeadTime => "pwm.dead_time",
+        DutyBound::SamplingEnd => "sensing.source_resistance.current",
     }
 }
 
