@@ -512,9 +512,9 @@ impl<'a> OnBoard<'a> {
             name: "SAMPLING_HALF_WINDOW_S",
             value: F32(|c| c.o.duty_limit.half_window_s, "s"),
             formula: Lit(
-                "h = max over the current ranks of (t_d + t_set − (t_k − t_tick), t_k + t_s,k − t_tick): the low-side on-time each side of the carrier maximum the sampling needs (0: in-line sensing, no limit)",
+                "h = max over the current ranks of (t_d + t_set − (t_k − t_tick), t_k + t_s,k − t_tick): the low-side on-time each side of the carrier maximum the sampling needs (0: in-line sensing, no limit from the sampling)",
             ),
-            equation: Lit("RM0440 §29.3.15 (dead time), §21.4.12 (sampling); DS12288 Table 66; design::duty_limit"),
+            equation: Lit("RM0440 §28.3.15 (dead time), §21.4.12 (sampling); DS12288 Table 66; design::duty_limit"),
             inputs: Of(|c| {
                 format!(
                     "current_sensing.placement, current_sensing.settling_time, pwm.dead_time, sensing.source_resistance.current ({}), bound: {:?}",
@@ -567,7 +567,7 @@ impl<'a> OnBoard<'a> {
                 "d_max = MAX_COMPARE/ARR: 1 − 2·h/T_s rounded down to a whole compare value, at most 1 − MIN_PULSE/ARR",
             ),
             equation: Lit("design::duty_limit"),
-            inputs: Of(|c| format!("SAMPLING_HALF_WINDOW_S ({})", c.b.file)),
+            inputs: Of(|c| format!("SAMPLING_HALF_WINDOW_S, MIN_PULSE ({})", c.b.file)),
             json: Json::At("/board/duty_limit/max_duty"),
         },
         Decl {

@@ -5,7 +5,7 @@
 //! conducts. With TIM1's centre-aligned carrier (PWM mode 1, RM0440 §29.3.10) a leg's
 //! OCxREF is low for `(1 − d)·T_s` centred on the carrier maximum; the complementary
 //! output, which turns the low side on, rises one dead time `t_d` after OCxREF falls
-//! (RM0440 §29.3.15) and falls with OCxREF. The ADC trigger TRGO2 rises one timer tick
+//! (RM0440 §28.3.15) and falls with OCxREF. The ADC trigger TRGO2 rises one timer tick
 //! before the maximum (`sections::board::control_timing`); rank k of a converter samples
 //! from `t_k = t_lat + Σ_{j<k} (t_s,j + 12.5)` ADC cycles to `t_k + t_s,k` after it (RM0440
 //! §21.4.12: sampling, then 12.5 cycles of conversion at 12 bits; the held charge no
@@ -37,8 +37,9 @@
 //! **Pulses the dead time swallows.** A compare value within `p` of either end of the
 //! carrier gives a pulse the dead time swallows: OCxREF is low for `2·(ARR − CCR)` timer
 //! ticks about the maximum (high for `2·CCR` about the minimum), and the complementary
-//! output rises `t_d` after OCxREF's edge (RM0440 §28.3.15), so a pulse of `2·g < t_d`
-//! ticks never turns its switch on: both switches are off for `2·g + t_d` ticks and the
+//! output rises `t_d` after OCxREF's edge (RM0440 §28.3.15: "if the delay is greater
+//! than the width of the active output … the corresponding pulse is not generated"), so
+//! a pulse of `2·g < t_d` ticks never turns its switch on: both switches are off for `2·g + t_d` ticks and the
 //! phase follows its current's sign through a diode (`design::dead_time`) instead of the
 //! command. With `t_d` in timer ticks (TIM1_BDTR.DTG as the image programs it, RM0440
 //! §28.6.20),
@@ -47,7 +48,8 @@
 //! p = ⌈t_d/2⌉   compare units,      d_max ≤ (ARR − p)/ARR
 //! ```
 //!
-//! `p` is the shortest gap whose switch still turns on; with `d ≤ d_max` and the
+//! `p` is the shortest gap whose volt-seconds are the command's (its switch turns on, or
+//! for an even `t_d` just reaches its turn-on); with `d ≤ d_max` and the
 //! modulator's symmetry about 1/2 (`d ≥ 1 − d_max`) no leg's pulse is swallowed at either
 //! end. In-line sensing has no other limit, so there `d_max = 1 − p/ARR` (0.98988 for
 //! 500 ns at 20 kHz). Without it a leg within `p` of a rail loses up to `t_d/2` of its
@@ -58,8 +60,11 @@
 //! itself, with those compare values moved to the nearer of no pulse and `p`, gave
 //! 32.4–39.5 A of i_q 14 ms into the step for four shifts of the rotor by a quarter
 //! period against the carrier (38.7–38.8 A with the rails reached as the ideal inverter
-//! has them). A low-side shunt's window already ends more than `t_d` into the low-side
-//! pulse, so the limit changes only in-line boards.
+//! has them). A low-side shunt's window needs more: its two conditions together give
+//! `2·h ≥ t_d + t_set + t_s,k + t_lat > t_d`, so the limit changes only in-line boards
+//! (the code takes the smaller limit all the same). The dead time is TIM1's; a gate
+//! driver inserting a longer one of its own would need the longer (the NUCLEO's L6398
+//! inserts 320 ns under TIM1's 500 ns; no in-line board in `boards/` has one).
 //!
 //! **Usable voltage.** The modulator (thesis A (3.7), (3.8), `motor_control::modulation`)
 //! keeps the duties symmetric about 1/2, so `d ≤ d_max` also bounds the low duties at
@@ -108,7 +113,8 @@ pub struct DutyLimit {
     pub max_compare: u16,
     /// Half the low-side pulse the sampling needs, h \[s\] (0 for in-line sensing).
     pub half_window_s: f64,
-    /// Which condition set h.
+    /// Which condition set `max_compare`: the sampling window's h, or the dead time's
+    /// shortest pulse.
     pub bound: DutyBound,
     /// Dead time t_d \[s\].
     pub dead_time_s: f64,
@@ -277,12 +283,10 @@ pub fn usable_voltage_fraction(max_duty: f64) -> f64 {
 mod tests {
     use super::*;
 
-    /// (3.8) at the edge of the linear range: the peak is exactly U_dc/2 (m = 1), and
-    /// at m = 0 the third harmonic alone, 1/(6√3) = 0.096225.
     /// By hand: 500 ns at 170 MHz is 85 ticks (DTG = 85, RM0440 §28.6.20: `0xx` codes
     /// count single ticks), p = ⌈85/2⌉ = 43; 320 ns → 54.4 → 55 ticks (never shorter),
-    /// p = 28; 1 µs → 170 ticks, above 127 so DTG = 0x80 | (85 − 64) = 170 ticks, p = 85;
-    /// no dead time, p = 0.
+    /// p = 28; 1 µs → 170 ticks, above 127 so DTG = 0x80 | (85 − 64) = 0x95, which is
+    /// (64 + 21)·2 = 170 ticks, p = 85; no dead time, p = 0.
     #[test]
     fn min_pulse_by_hand() {
         assert_eq!(min_pulse(500e-9), 43);
@@ -291,6 +295,8 @@ mod tests {
         assert_eq!(min_pulse(0.0), 0);
     }
 
+    /// (3.8) at the edge of the linear range: the peak is exactly U_dc/2 (m = 1), and
+    /// at m = 0 the third harmonic alone, 1/(6√3) = 0.096225.
     #[test]
     fn phase_peak_by_hand() {
         assert!((thpwm_phase_peak(1.0) - 0.5).abs() < 1e-12);

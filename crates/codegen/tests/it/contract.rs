@@ -371,6 +371,31 @@ fn the_nucleo_duty_limit_and_usable_voltage_by_hand() {
     assert!((r.current_loop.voltage_limit_v - kr * 24.0 / s3).abs() < 1e-9);
 }
 
+/// A dead time that leaves an in-line board too little duty is refused at its key, with
+/// a switching frequency that would leave enough. By hand: maxon-ec45-flat-70w switched
+/// at 80 kHz (ARR = 170 MHz/160 kHz = 1062.5 → 1063) on the reference board with a
+/// 5.9 µs dead time: 1003 ticks, encoded as the next TIM1_BDTR.DTG step (`111` codes
+/// count 16 ticks: 63·16 = 1008, RM0440 §28.6.20), so p = 504 and d_max = (1063 − 504)/1063
+/// = 0.5259, below the 0.7722 that leaves half of U_dc/√3 (0.5 plus the THPWM phase peak
+/// at k = ½, by a dense scan of φ).
+#[test]
+fn a_dead_time_leaving_an_in_line_board_too_little_duty_is_refused_at_its_key() {
+    let spec = read("motors/maxon-ec45-flat-70w.toml")
+        .replace("switching_frequency = \"40 kHz\"", "switching_frequency = \"80 kHz\"");
+    assert!(spec.contains("80 kHz"));
+    let board = read("boards/motorgen-reference.toml");
+    let long = board.replace("dead_time = \"500 ns\"", "dead_time = \"5900 ns\"");
+    assert_ne!(long, board);
+    let e = codegen::design_with_board("m.toml", &spec, "b.toml", &long).unwrap_err();
+    let d = refused_at(&e, &long, "pwm.dead_time");
+    assert!(
+        d.problem.contains("swallows every pulse shorter than 1008 timer ticks"),
+        "{e}"
+    );
+    assert!(d.problem.contains("0.526"), "{e}");
+    assert!(d.accepted.contains("switching at most"), "{e}");
+}
+
 /// A settling time that leaves the NUCLEO too little duty is refused at that key: 10 µs
 /// at 40 kHz needs ±(0.5 + 10 + 0.006) µs of the 25 µs period, d_max = 1 − 2·10.506/25
 /// ≈ 0.16, below ½: no usable voltage at all. And a low-side shunt board without the

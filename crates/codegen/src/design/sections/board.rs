@@ -585,8 +585,30 @@ pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs
     }
     // d_floor: the duty whose usable fraction is the floor; T_s ≥ 2h/(1 − d_floor).
     let d_floor = 0.5 + duty_limit::thpwm_phase_peak(MIN_USABLE_VOLTAGE_FRACTION);
-    let fs_max = (1.0 - d_floor) / (2.0 * l.half_window_s);
     let key = duty_limit_key(l);
+    if l.bound == DutyBound::DeadTime {
+        // The dead time's shortest pulse p of ARR = f_TIM/(2·f_s): p/ARR ≤ 1 − d_floor.
+        let timer_hz = f64::from(crate::firmware::TIMER_CLOCK_HZ);
+        let fs_max = (1.0 - d_floor) * timer_hz / (2.0 * f64::from(l.min_pulse));
+        return Some(board_src.error(
+            board.span(key),
+            key,
+            format!(
+                "a dead time of {:.0} ns swallows every pulse shorter than {} timer ticks, so at f_s = {fs_hz} Hz no compare value may come within {} of either end of the carrier: the duty may reach only {:.3}, leaving {:.0} % of U_dc/√3 (at least {:.0} % is needed)",
+                l.dead_time_s * 1e9,
+                2 * u32::from(l.min_pulse),
+                l.min_pulse,
+                l.max_duty,
+                l.usable_voltage_fraction * 100.0,
+                MIN_USABLE_VOLTAGE_FRACTION * 100.0
+            ),
+            format!(
+                "a shorter dead time, or a motor switching at most {:.0} Hz (d_max ≥ {d_floor:.3})",
+                fs_max.floor()
+            ),
+        ));
+    }
+    let fs_max = (1.0 - d_floor) / (2.0 * l.half_window_s);
     Some(board_src.error(
         board.span(key),
         key,
