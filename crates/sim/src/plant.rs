@@ -126,6 +126,17 @@ impl SpeedProfile {
         }
     }
 
+    /// The straight line from `from` at `start` to `to` at `start + length` [rad/s, s],
+    /// then `to`: one piece of a piecewise-linear profile.
+    pub fn segment(start: f64, length: f64, from: f64, to: f64) -> Self {
+        Self {
+            from,
+            to,
+            start,
+            acceleration: (to - from).abs() / length,
+        }
+    }
+
     /// ω_m(t) [rad/s].
     pub fn at(&self, t: f64) -> f64 {
         if self.from == self.to || t <= self.start {

@@ -201,12 +201,7 @@ pub fn run(
     for _ in 0..n {
         let t = b.plant.t;
         let (a, z) = (speed(t), speed(t + ts));
-        b.plant.shaft = Shaft::Imposed(SpeedProfile {
-            from: a,
-            to: z,
-            start: t,
-            acceleration: (z - a).abs() / ts,
-        });
+        b.plant.shaft = Shaft::Imposed(SpeedProfile::segment(t, ts, a, z));
         let smp = b.step(Demand::Torque(torque_nm(t) as f32));
         // The references the stage produced this period (its state after the step).
         let reference = reference_of(&b);

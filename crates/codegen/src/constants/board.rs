@@ -11,7 +11,7 @@
 
 use super::Source::{Custom, F32};
 use super::Text::{Lit, Of};
-use super::{Decl, Group, Json, count, declare, intv, phys, u8_array};
+use super::{Decl, Group, Json, Value, count, declare, intv, phys, u8_array};
 use crate::board::{ADC_CLOCK_HZ, AdcSlot, Board};
 use crate::design::BoardOut;
 use crate::design::Design;
@@ -525,13 +525,7 @@ impl<'a> OnBoard<'a> {
         },
         Decl {
             name: "MIN_PULSE",
-            value: Custom(|c| {
-                let l = &c.o.duty_limit;
-                (
-                    intv(l.min_pulse.into(), "u16", "uint16_t"),
-                    format!("ticks of ARR {}", c.d.drive.pwm_period),
-                )
-            }),
+            value: Custom(|c| c.compare_ticks(c.o.duty_limit.min_pulse)),
             formula: Lit(
                 "p = ⌈t_d/2⌉ with t_d TIM1's dead time in timer ticks (DTG decoded): a compare value within p of 0 or ARR gives a pulse 2·g < t_d the dead time swallows, so MAX_COMPARE ≤ ARR − p",
             ),
@@ -541,13 +535,7 @@ impl<'a> OnBoard<'a> {
         },
         Decl {
             name: "MAX_COMPARE",
-            value: Custom(|c| {
-                let l = &c.o.duty_limit;
-                (
-                    intv(l.max_compare.into(), "u16", "uint16_t"),
-                    format!("ticks of ARR {}", c.d.drive.pwm_period),
-                )
-            }),
+            value: Custom(|c| c.compare_ticks(c.o.duty_limit.max_compare)),
             formula: Lit(
                 "min(ARR − ⌈h·f_TIM⌉, ARR − MIN_PULSE): the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h and that the dead time does not swallow",
             ),
@@ -585,6 +573,14 @@ impl<'a> OnBoard<'a> {
     /// A trip's inputs: which limit set it and the other one.
     fn trip(&self, t: &crate::design::Trip, unit: &str, scale: f64) -> String {
         format!("{}, {}", t.describe(unit, scale), self.b.file)
+    }
+
+    /// A compare value of TIM1 as a `u16` constant, "ticks of ARR …".
+    fn compare_ticks(&self, ticks: u16) -> (Value, String) {
+        (
+            intv(ticks.into(), "u16", "uint16_t"),
+            format!("ticks of ARR {}", self.d.drive.pwm_period),
+        )
     }
 
     /// The board file's key `k` as an input: `pins.gate_* (boards/x.toml)`.

@@ -152,12 +152,7 @@ fn step_at_top_speed(motor: &str, board: &str, patches: Patches) -> Result<Outco
     let mut t = at;
     while t < end - 1e-12 {
         let (t0, w0, w1) = knot(t + 1e-9);
-        rig.analog_as::<Drive>().unwrap().plant.shaft = Shaft::Imposed(SpeedProfile {
-            from: w0,
-            to: w1,
-            start: t0,
-            acceleration: (w1 - w0).abs() / period,
-        });
+        rig.analog_as::<Drive>().unwrap().plant.shaft = Shaft::Imposed(SpeedProfile::segment(t0, period, w0, w1));
         t = (t0 + period).min(end);
         rig.run(t, |t| Some(command(t)), |_| false)
             .map_err(|e| format!("{e}; {}", rig.machine.summary()))?;
