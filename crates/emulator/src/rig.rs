@@ -21,9 +21,13 @@ pub const OPTR_FACTORY: u32 = 0xFFEF_F8AA;
 /// README, "Option bytes"): the delivered value with nSWBOOT0 (bit 26) programmed to 0 and
 /// nBOOT0 (bit 27) left at 1.
 pub const OPTR_BOOT_FROM_FLASH: u32 = OPTR_FACTORY & !OPTR_NSWBOOT0;
-/// First word of a valid fault record of layout version 2, "MFR2" (firmware README
-/// "Fault record"; version 2 added the CAN bus-off count).
-pub const FAULT_RECORD_MAGIC: u32 = 0x4D46_5232;
+/// First word of a valid fault record of layout version 3, "MFR3" (firmware README
+/// "Fault record"; version 2 added the CAN bus-off count, version 3 the start-up checks'
+/// measurement in word 6).
+pub const FAULT_RECORD_MAGIC: u32 = 0x4D46_5233;
+/// The record's flags word (2): bit 3 a measurement is present, bits 4–5 its index
+/// (firmware README "Fault record").
+const RECORD_HAS_MEASURED: u32 = 1 << 3;
 
 /// What a rig runs: a motor's image built from a board file, on a board's hardware.
 #[derive(Clone, Debug)]
@@ -197,6 +201,22 @@ impl Rig {
             _ => "unknown",
         };
         Some(format!("{cause} ({name})"))
+    }
+
+    /// What the start-up check that refused the drive measured, from the sealed fault
+    /// record (word 6, an f32, and the index in bits 4–5 of word 2; firmware README
+    /// "Fault record", read as a probe would): `None` without a record or a measurement.
+    pub fn fault_measurement(&self) -> Option<(f32, u8)> {
+        let at = self.machine.symbol("MOTOR_FAULT_RECORD")?;
+        if self.machine.peek(at).ok()? != FAULT_RECORD_MAGIC {
+            return None;
+        }
+        let flags = self.machine.peek(at + 8).ok()?;
+        if flags & RECORD_HAS_MEASURED == 0 {
+            return None;
+        }
+        let value = f32::from_bits(self.machine.peek(at + 24).ok()?);
+        Some((value, ((flags >> 4) & 0b11) as u8))
     }
 
     /// The CAN bus-off count the control interrupt last wrote into its state

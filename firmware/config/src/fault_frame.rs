@@ -6,8 +6,8 @@
 //! | byte | content |
 //! |---|---|
 //! | 0 | cause code ([`FaultCause`] as `u8`: 1 HardFault, 2 stack overflow, 3 break, 4 trip, 5 lost conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog, 10 current offset, 11–18 the pre-flight check's refusals, 19 resolver signal) |
-//! | 1 | flags: bit 0 PC valid, bit 1 state valid, bit 2 outputs were on, bit 3 tripped |
-//! | 2–5 | stacked PC, little-endian (0 when not valid) |
+//! | 1 | flags: bit 0 PC valid, bit 1 state valid, bit 2 outputs were on, bit 3 tripped, bit 4 measurement valid, bits 5–6 the measurement's index |
+//! | 2–5 | stacked PC, little-endian, when valid; else the start-up check's measurement (causes 10–19: IEEE 754 single, little-endian; its unit and index by cause, README "First power-up"); else 0 |
 //! | 6–7 | i_q of the last period, little-endian `i16` in units of the generated `can::FAULT_CURRENT_PER_LSB`, rounded, saturating; `i16::MIN` when not a number; 0 when the state is not valid |
 //!
 //! The full record (currents, angle, speed, DC link, CFSR/HFSR) is read with a probe
@@ -42,6 +42,7 @@ pub fn encode(r: &FaultRecord) -> [u8; 8] {
                 tripped: s.tripped,
                 i_q: s.i_q,
             }),
+            measured: r.measured,
         },
     )
 }
@@ -55,6 +56,7 @@ pub fn cause_of(data: &[u8; 8]) -> Option<FaultCause> {
 mod tests {
     use super::*;
     use crate::fault_record::ControlState;
+    use motor_control::can_protocol::FaultMeasurement;
 
     fn state(i_q: f32) -> ControlState {
         ControlState {
@@ -82,6 +84,7 @@ mod tests {
             hfsr: 0,
             state: Some(state(212.26)),
             reported: false,
+            measured: None,
         };
         let d = encode(&r);
         assert_eq!(d, [4, 0x0F, 0x34, 0x12, 0x00, 0x08, 0x4B, 0x08]);
@@ -99,12 +102,42 @@ mod tests {
             hfsr: 0,
             state: None,
             reported: false,
+            measured: None,
         };
         assert_eq!(encode(&r), [9, 0, 0, 0, 0, 0, 0, 0]);
         r.state = Some(state(5000.0));
         assert_eq!(&encode(&r)[6..], &0x7FFFu16.to_le_bytes());
         r.state = Some(state(f32::NAN));
         assert_eq!(&encode(&r)[6..], &[0x00, 0x80]);
+    }
+
+    /// A start-up check's refusal: the resolver signal at 0.25 of the designed one
+    /// (0.25 = 2^−2: exponent 125 = 0x7D, mantissa 0 → 0x3E80_0000, bytes 00 00 80 3E);
+    /// flags = state | measurement = 0x12, index 0; phase w's offset (index 2) sets bits
+    /// 5–6 to 0b10: 0x52. A record with a PC sends the PC and clears the measurement's
+    /// flag.
+    #[test]
+    fn measurement_report() {
+        let mut r = FaultRecord {
+            cause: FaultCause::ResolverSignal,
+            pc: None,
+            cfsr: 0,
+            hfsr: 0,
+            state: Some(ControlState {
+                running: false,
+                tripped: false,
+                ..state(0.0)
+            }),
+            reported: false,
+            measured: Some(FaultMeasurement::of(0.25)),
+        };
+        assert_eq!(encode(&r), [19, 0x12, 0x00, 0x00, 0x80, 0x3E, 0, 0]);
+        r.cause = FaultCause::CurrentOffset;
+        r.measured = Some(FaultMeasurement::at(-2_992.0, 2));
+        // −2 992.0 = 0xC53B_0000 (fault_record's layout test).
+        assert_eq!(encode(&r), [10, 0x52, 0x00, 0x00, 0x3B, 0xC5, 0, 0]);
+        r.pc = Some(0x0800_1234);
+        assert_eq!(encode(&r)[1..6], [0x03, 0x34, 0x12, 0x00, 0x08]);
     }
 
     /// The generated identifier is 0x0E0; ID 0x0E0 → T0 = 0x0E0 << 18 = 0x0380_0000; DLC 8 → T1 = 0x0008_0000; the

@@ -19,19 +19,22 @@
 //! [`FaultCause::Watchdog`] carrying the live state the control interrupt left.
 #![forbid(unsafe_code)]
 
-use motor_control::can_protocol::Crc32;
+use motor_control::can_protocol::{Crc32, FaultMeasurement, MEASUREMENT_INDEX_MASK};
 use motor_control::preflight::PreflightFault;
 
-/// Words of the sealed record: magic, cause, flags, PC, CFSR, HFSR, the control state
-/// ([`STATE_WORDS`]), CRC.
-pub const RECORD_WORDS: usize = 6 + STATE_WORDS + 1;
+/// Words of the sealed record: magic, cause, flags, PC, CFSR, HFSR, the start-up check's
+/// measurement, the control state ([`STATE_WORDS`]), CRC.
+pub const RECORD_WORDS: usize = HEAD_WORDS + STATE_WORDS + 1;
+/// Words before the control state.
+const HEAD_WORDS: usize = 7;
 /// Words of the live control state.
 pub const STATE_WORDS: usize = 8;
-/// First word of a sealed record ("MFR2" in ASCII, little-endian bytes `2RFM`): a
+/// First word of a sealed record ("MFR3" in ASCII, little-endian bytes `3RFM`): a
 /// version of this layout; a record of another layout fails the check. Version 2 (issue
-/// 26) added the CAN bus-off count to the state; a version-1 record (`MFR1`, 14 words)
-/// left by an older image is not read.
-pub const MAGIC: u32 = 0x4D46_5232;
+/// 26) added the CAN bus-off count to the state, version 3 the start-up check's
+/// measurement; a record of an older version (`MFR1` 14 words, `MFR2` 15) left by an
+/// older image is not read.
+pub const MAGIC: u32 = 0x4D46_5233;
 
 /// Why the outputs were switched off. The numbers are the record's and the CAN
 /// frame's encoding (never reuse one).
@@ -227,28 +230,40 @@ pub struct FaultRecord {
     pub state: Option<ControlState>,
     /// Already sent on CAN after a boot (sent once, kept for a probe).
     pub reported: bool,
+    /// What the start-up check that refused the drive measured (causes 10–19; the
+    /// figure and unit by cause: README, "First power-up").
+    pub measured: Option<FaultMeasurement>,
 }
 
 /// Flag bits of the record's flags word.
 const HAS_PC: u32 = 1;
 const HAS_STATE: u32 = 1 << 1;
 const REPORTED: u32 = 1 << 2;
+const HAS_MEASURED: u32 = 1 << 3;
+/// The measurement's index, bits 4–5.
+const INDEX_SHIFT: u32 = 4;
+const INDEX_BITS: u32 = (MEASUREMENT_INDEX_MASK as u32) << INDEX_SHIFT;
 
 impl FaultRecord {
-    /// The sealed words: [`MAGIC`], cause, flags, PC, CFSR, HFSR, state, CRC-32 of the
-    /// words before it.
+    /// The sealed words: [`MAGIC`], cause, flags (bit 0 PC, 1 state, 2 reported, 3
+    /// measurement, 4–5 its index), PC, CFSR, HFSR, the measurement (f32 bits, 0 when
+    /// none), state, CRC-32 of the words before it.
     pub fn to_words(&self) -> [u32; RECORD_WORDS] {
         let mut w = [0; RECORD_WORDS];
         let flags = if self.pc.is_some() { HAS_PC } else { 0 }
             | if self.state.is_some() { HAS_STATE } else { 0 }
-            | if self.reported { REPORTED } else { 0 };
-        let head = [
+            | if self.reported { REPORTED } else { 0 }
+            | self.measured.map_or(0, |m| {
+                HAS_MEASURED | (u32::from(m.index & MEASUREMENT_INDEX_MASK) << INDEX_SHIFT)
+            });
+        let head: [u32; HEAD_WORDS] = [
             MAGIC,
             self.cause as u32,
             flags,
             self.pc.unwrap_or(0),
             self.cfsr,
             self.hfsr,
+            self.measured.map_or(0, |m| m.value.to_bits()),
         ];
         let state = self.state.map_or([0; STATE_WORDS], |s| s.to_words());
         for (slot, v) in w.iter_mut().zip(head.into_iter().chain(state)) {
@@ -268,12 +283,12 @@ impl FaultRecord {
         if crc != [crc32_words(body)] {
             return None;
         }
-        let [magic, cause, flags, pc, cfsr, hfsr, ..] = *w;
-        if magic != MAGIC || flags & !(HAS_PC | HAS_STATE | REPORTED) != 0 {
+        let [magic, cause, flags, pc, cfsr, hfsr, measured, ..] = *w;
+        if magic != MAGIC || flags & !(HAS_PC | HAS_STATE | REPORTED | HAS_MEASURED | INDEX_BITS) != 0 {
             return None;
         }
         let mut state = [0; STATE_WORDS];
-        state.copy_from_slice(body.get(6..6 + STATE_WORDS)?);
+        state.copy_from_slice(body.get(HEAD_WORDS..HEAD_WORDS + STATE_WORDS)?);
         let state = if flags & HAS_STATE != 0 {
             Some(ControlState::from_words(&state)?)
         } else {
@@ -286,6 +301,8 @@ impl FaultRecord {
             hfsr,
             state,
             reported: flags & REPORTED != 0,
+            measured: (flags & HAS_MEASURED != 0)
+                .then(|| FaultMeasurement::at(f32::from_bits(measured), ((flags & INDEX_BITS) >> INDEX_SHIFT) as u8)),
         })
     }
 }
@@ -303,6 +320,7 @@ pub fn at_boot(record: &[u32; RECORD_WORDS], state: &[u32; STATE_WORDS], watchdo
             hfsr: 0,
             state: ControlState::from_words(state),
             reported: false,
+            measured: None,
         })
     })
 }
@@ -370,6 +388,7 @@ mod tests {
                 tripped: true,
             }),
             reported: false,
+            measured: None,
         }
     }
 
@@ -394,8 +413,26 @@ mod tests {
             hfsr: 1 << 30,
             state: None,
             reported: true,
+            measured: None,
         };
         assert_eq!(FaultRecord::from_words(&bare.to_words()), Some(bare));
+        // A start-up check's refusal with its figure: phase w's zero level 2 992 codes
+        // below nominal (the offset test's case), and a NaN kept bit for bit.
+        let offset = FaultRecord {
+            cause: FaultCause::CurrentOffset,
+            measured: Some(FaultMeasurement::at(-2_992.0, 2)),
+            ..record()
+        };
+        assert_eq!(FaultRecord::from_words(&offset.to_words()), Some(offset));
+        let nan = FaultRecord {
+            measured: Some(FaultMeasurement::of(f32::NAN)),
+            ..offset
+        };
+        let back = FaultRecord::from_words(&nan.to_words()).and_then(|r| r.measured);
+        assert_eq!(
+            back.map(|m| (m.value.to_bits(), m.index)),
+            Some((f32::NAN.to_bits(), 0))
+        );
         for code in 1..=19 {
             let c = FaultCause::from_code(code).expect("codes 1–19 are causes");
             assert_eq!(c as u32, code);
@@ -422,18 +459,29 @@ mod tests {
     #[test]
     fn layout() {
         let w = record().to_words();
-        // "MFR2": 'M' 0x4D, 'F' 0x46, 'R' 0x52, '2' 0x32.
-        assert_eq!(w[0], 0x4D46_5232);
+        // "MFR3": 'M' 0x4D, 'F' 0x46, 'R' 0x52, '3' 0x33.
+        assert_eq!(w[0], 0x4D46_5233);
         assert_eq!(w[1], 4);
         assert_eq!(w[2], 0b011);
         assert_eq!(w[3], 0x0800_1234);
-        assert_eq!(w[7], 212.25f32.to_bits());
-        // Words 6–13 the state (README "Fault record"): periods in 11, bus-off count in
-        // 12, the flags (bit 31 written) in 13, the CRC in 14.
-        assert_eq!(RECORD_WORDS, 15);
-        assert_eq!((w[11], w[12]), (40_000, 2));
-        assert_eq!(w[13] >> 31, 1);
+        assert_eq!(w[6], 0, "no measurement");
+        assert_eq!(w[8], 212.25f32.to_bits());
+        // Words 7–14 the state (README "Fault record"): periods in 12, bus-off count in
+        // 13, the flags (bit 31 written) in 14, the CRC in 15.
+        assert_eq!(RECORD_WORDS, 16);
+        assert_eq!((w[12], w[13]), (40_000, 2));
+        assert_eq!(w[14] >> 31, 1);
         assert_eq!(w[RECORD_WORDS - 1], crc32_words(&w[..RECORD_WORDS - 1]));
+        // A measurement: flag bit 3, index 2 in bits 4–5 (0b10_1011 with PC and state),
+        // −2 992.0 = 0xC53B_0000 in word 6 (sign 1, exponent 11 + 127 = 138 = 0x8A,
+        // mantissa 2992/2048 − 1 = 0.4609375 = 0x3B0000/2^23).
+        let w = FaultRecord {
+            measured: Some(FaultMeasurement::at(-2_992.0, 2)),
+            ..record()
+        }
+        .to_words();
+        assert_eq!(w[2], 0b10_1011);
+        assert_eq!(w[6], 0xC53B_0000);
     }
 
     /// Every single-bit error anywhere in the record is rejected (CRC-32 detects all
@@ -463,9 +511,9 @@ mod tests {
         assert_eq!(reseal(0, MAGIC ^ 1), None);
         assert_eq!(reseal(1, 0), None);
         assert_eq!(reseal(1, 77), None);
-        assert_eq!(reseal(2, 1 << 5), None);
+        assert_eq!(reseal(2, 1 << 6), None);
         // HAS_STATE with state words the interrupt never wrote.
-        assert_eq!(reseal(6 + STATE_WORDS - 1, 0), None);
+        assert_eq!(reseal(HEAD_WORDS + STATE_WORDS - 1, 0), None);
         assert!(
             reseal(3, 0x0800_0000).is_some(),
             "the check itself accepts a resealed record"

@@ -41,6 +41,15 @@ pub enum SignalStatus {
     Outside(f32),
 }
 
+impl SignalBounds {
+    /// The measured/designed ratio of a mean of sin² + cos² (what [`SignalStatus`]
+    /// carries): √square/designed, the figure judged against `ratio` and the one the
+    /// fault record keeps (`FaultCause::ResolverSignal`).
+    pub fn ratio_of(&self, square: f32) -> f32 {
+        libm::sqrtf(square) / self.designed
+    }
+}
+
 /// The running sum of sin² + cos² over the averaged periods.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct SignalCheck {
@@ -133,5 +142,12 @@ mod tests {
         assert!(matches!(verdict(0.57), SignalStatus::Within(_)));
         assert!(matches!(verdict(0.58), SignalStatus::Outside(_)));
         assert!(matches!(verdict(0.0), SignalStatus::Outside(m) if m == 0.0));
+        // The ratio the record keeps: 0.58/0.4 = 1.45, 0.25/0.4 = 0.625.
+        for (a, ratio) in [(0.58, 1.45), (0.25, 0.625)] {
+            let SignalStatus::Outside(m) = verdict(a) else {
+                panic!("{a}")
+            };
+            assert!((BOUNDS.ratio_of(m) - ratio).abs() < 1e-4, "{a}: {}", BOUNDS.ratio_of(m));
+        }
     }
 }

@@ -20,7 +20,7 @@
 //! | capture header | 8 | 0 routine (bits 0–3), axis (bit 4), tripped (bit 5); 1 decimation; 2–3 T_s in 100 ns (u16); 4–5 sample count (u16); 6–7 trip level (i16) |
 //! | capture data | 7 | 0 routine (multiplexor), 1–2 sequence (u16), 3–4 channel A (i16), 5–6 channel B (i16) |
 //! | capture end | 8 | 0–3 CRC-32 of every header and data byte sent, 4–5 trip sample (u16), 6–7 trip current (i16) |
-//! | fault report | 8 | 0 cause, 1 flags (PC valid, state valid, outputs on, tripped), 2–5 PC (u32), 6–7 i_q (i16) |
+//! | fault report | 8 | 0 cause, 1 flags (PC valid, state valid, outputs on, tripped, measurement valid, measurement index), 2–5 PC (u32) or the start-up check's measurement (f32), 6–7 i_q (i16) |
 
 /// A classic CAN data frame (standard identifier, up to 8 bytes).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -469,6 +469,36 @@ pub fn decode_end(layout: &Layout, data: &[u8]) -> Option<End> {
 /// Data length of the fault-report frame.
 pub const FAULT_REPORT_LEN: u8 = 8;
 
+/// What a start-up check measured when it refused the drive (causes 10–19 of
+/// `motor_config::fault_record::FaultCause`): the figure it judged, in the unit its
+/// cause documents, and which phase or instance it was (0 … 3). The fault record keeps
+/// it and the fault report sends it, so a user sees by how much the bench missed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FaultMeasurement {
+    /// The judged figure (its unit by cause: README, "First power-up").
+    pub value: f32,
+    /// The phase (0 u, 1 v, 2 w) or the instance the figure belongs to, 0 … 3.
+    pub index: u8,
+}
+
+impl FaultMeasurement {
+    /// `value` of instance 0.
+    pub const fn of(value: f32) -> Self {
+        Self { value, index: 0 }
+    }
+
+    /// `value` of phase or instance `index` (kept to its two bits).
+    pub const fn at(value: f32, index: u8) -> Self {
+        Self {
+            value,
+            index: index & MEASUREMENT_INDEX_MASK,
+        }
+    }
+}
+
+/// The two bits a [`FaultMeasurement`]'s index takes in the report's flags byte.
+pub const MEASUREMENT_INDEX_MASK: u8 = 0b11;
+
 /// What the fault-report frame carries: the record the image found at boot
 /// (`motor_config::fault_record`), reduced to what a logger on the bus needs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -481,6 +511,8 @@ pub struct FaultReport {
     pub pc: Option<u32>,
     /// The control state of the last period.
     pub state: Option<FaultState>,
+    /// What the start-up check that refused the drive measured.
+    pub measured: Option<FaultMeasurement>,
 }
 
 /// The last period's control state in a fault report.
@@ -495,16 +527,28 @@ pub struct FaultState {
 }
 
 /// The fault-report frame's bytes: 0 cause; 1 flags (bit 0 PC valid, bit 1 state valid,
-/// bit 2 outputs were on, bit 3 tripped); 2–5 the PC, little-endian (0 when not valid);
-/// 6–7 i_q in units of `amps_per_lsb` (the generated `FAULT_CURRENT_PER_LSB`), rounded
-/// and saturated to i16, `i16::MIN` for not a number, 0 when the state is not valid.
+/// bit 2 outputs were on, bit 3 tripped, bit 4 measurement valid, bits 5–6 the
+/// measurement's index); 2–5 the PC, little-endian, when valid — else the measurement as
+/// an IEEE 754 single, little-endian, when valid — else 0 (a CPU fault has a PC and a
+/// start-up check a measurement, never both: the PC wins, the measurement's flag is then
+/// clear); 6–7 i_q in units of `amps_per_lsb` (the generated `FAULT_CURRENT_PER_LSB`),
+/// rounded and saturated to i16, `i16::MIN` for not a number, 0 when the state is not
+/// valid.
 pub fn encode_fault_report(amps_per_lsb: f32, r: &FaultReport) -> [u8; 8] {
     let state = r.state;
+    let measured = if r.pc.is_some() { None } else { r.measured };
     let flags = u8::from(r.pc.is_some())
         | u8::from(state.is_some()) << 1
         | u8::from(state.is_some_and(|s| s.running)) << 2
-        | u8::from(state.is_some_and(|s| s.tripped)) << 3;
-    let [p0, p1, p2, p3] = r.pc.unwrap_or(0).to_le_bytes();
+        | u8::from(state.is_some_and(|s| s.tripped)) << 3
+        | u8::from(measured.is_some()) << 4
+        | measured.map_or(0, |m| m.index & MEASUREMENT_INDEX_MASK) << 5;
+    let word = match (r.pc, measured) {
+        (Some(pc), _) => pc,
+        (None, Some(m)) => m.value.to_bits(),
+        (None, None) => 0,
+    };
+    let [p0, p1, p2, p3] = word.to_le_bytes();
     let iq = state.map_or(0, |s| {
         if s.i_q.is_nan() {
             i16::MIN

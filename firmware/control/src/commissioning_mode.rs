@@ -32,7 +32,7 @@ use crate::commissioning::{
     Axis, CommissioningError, FluxLinkage, FluxLinkageState, FrequencyResponse, FrequencyResponseState, PolePairRatio,
     PolePairRatioState, Progress, ResolverOffset, ResolverOffsetState, VoltageStep, VoltageStepState, multisine_lines,
 };
-use crate::preflight::{Preflight, PreflightFault, PreflightInput, PreflightState};
+use crate::preflight::{Preflight, PreflightInput, PreflightState, Refusal};
 use crate::step::Demand;
 use crate::transforms::{Dq, Uvw};
 use crate::trig::Trig;
@@ -234,7 +234,7 @@ pub struct CommissioningMode {
     crc: p::Crc32,
     len: usize,
     /// Why the last pre-flight check refused the drive, until taken.
-    refused: Option<PreflightFault>,
+    refused: Option<Refusal>,
 }
 
 impl Default for CommissioningMode {
@@ -274,7 +274,7 @@ impl CommissioningMode {
 
     /// The pre-flight check's refusal, once (the board trips with its cause: outputs
     /// off until reset, the fault record).
-    pub fn take_refusal(&mut self) -> Option<PreflightFault> {
+    pub fn take_refusal(&mut self) -> Option<Refusal> {
         self.refused.take()
     }
 
@@ -1015,7 +1015,10 @@ mod tests {
         // Hold 100 + turn 256 + hold 100 periods (EXAMPLE): the verdict at the end.
         assert!(periods > 400, "{periods}");
         assert_eq!(m.state(), (State::Fault, Reason::PreflightFailed));
-        assert_eq!(m.take_refusal(), Some(PreflightFault::OpenPhase));
+        // Phase u first, at the 0 A every phase read (`Measured::default()`).
+        let refusal = m.take_refusal().expect("refused");
+        assert_eq!(refusal.fault, crate::preflight::PreflightFault::OpenPhase);
+        assert_eq!(refusal.measured, p::FaultMeasurement::at(0.0, 0));
         assert_eq!(m.take_refusal(), None);
         assert_eq!(m.next_frame(&c, &buf), None);
         assert_eq!(

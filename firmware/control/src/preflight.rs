@@ -72,7 +72,22 @@
 //!
 //! Any |phase current| above [`Preflight::current_trip`] (more than the lowest accepted
 //! R would draw) ends the check at once as [`PreflightFault::Resistance`].
+//!
+//! A refusal ([`Refusal`]) carries the figure it judged ([`FaultMeasurement`]: value and
+//! index), which the fault record keeps and the CAN fault report sends:
+//!
+//! | fault | value | index |
+//! |---|---|---|
+//! | 11 inverted sensing | the current along the voltage \[A\] (≤ 0 or below the hold's margin) | 0 the first hold, 1 the + pulse, 2 the − pulse |
+//! | 12 resistance | R \[Ω\] of the pulse (negative or infinite when the second level drew no more than the first) | 0 + pulse, 1 − pulse; 3: the largest \|phase current\| \[A\] beyond `current_trip` |
+//! | 13 inductance | L \[H\] of the pulse | 0 + pulse, 1 − pulse |
+//! | 14 current sum | \|i_u + i_v + i_w\| \[A\] | 0 + pulse, 1 − pulse |
+//! | 15 open phase | the phase's \|current\| \[A\]: at the pulse's end, or its peak during the turn | the phase: 0 u, 1 v, 2 w |
+//! | 16 direction | resolver travel / the expected n_r/n_p turn (negative) | 0 |
+//! | 17 pole-pair ratio | the measured n_p/n_r (turned/travelled; infinite if the resolver did not move) | 0 |
+//! | 18 resolver offset | θ_e(resolver) − θ_commanded at rest \[° electrical\] | 0 |
 
+use crate::can_protocol::FaultMeasurement;
 use crate::commissioning::Progress;
 use crate::step::Demand;
 use crate::transforms::{AlphaBeta, INV_SQRT_3, TWO_THIRDS, Uvw};
@@ -116,7 +131,25 @@ impl PreflightFault {
     pub fn code(self) -> u8 {
         self as u8
     }
+
+    /// A refusal for this fault with the figure it judged (module documentation).
+    fn measured(self, measured: FaultMeasurement) -> Refusal {
+        Refusal { fault: self, measured }
+    }
 }
+
+/// The pre-flight check's refusal: which check failed and what it measured (the table
+/// in the module documentation gives each fault's figure and unit).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Refusal {
+    /// The check that failed.
+    pub fault: PreflightFault,
+    /// The figure it judged.
+    pub measured: FaultMeasurement,
+}
+
+/// Degrees per π-scaled Q1.31 LSB (180°/2^31).
+const DEGREES_PER_LSB: f32 = 180.0 / 2_147_483_648.0;
 
 /// The check's fixed parameters (generated: codegen's `commissioning` group,
 /// `PREFLIGHT_*`).
@@ -266,7 +299,7 @@ fn along<T: Trig>(trig: &mut T, angle: i32, i: Uvw) -> f32 {
 }
 
 /// The open-loop αβ voltage of magnitude `v` at angle `angle`.
-fn at_angle<T: Trig>(trig: &mut T, angle: i32, v: f32) -> Progress<Result<PulseFigures, PreflightFault>> {
+fn at_angle<T: Trig>(trig: &mut T, angle: i32, v: f32) -> Progress<Result<PulseFigures, Refusal>> {
     let sc = trig.sin_cos(angle).to_f32();
     Progress::Running(Demand::VoltageAlphaBeta(AlphaBeta {
         alpha: v * sc.cos,
@@ -299,11 +332,18 @@ impl Preflight {
         st: &mut PreflightState,
         trig: &mut T,
         m: &PreflightInput,
-    ) -> Progress<Result<PulseFigures, PreflightFault>> {
+    ) -> Progress<Result<PulseFigures, Refusal>> {
         // Beyond what the lowest accepted R would draw (NaN trips too).
         let trip = |i: f32| !at_most(libm::fabsf(i), self.current_trip);
         if trip(m.i_uvw.u) || trip(m.i_uvw.v) || trip(m.i_uvw.w) {
-            return Progress::Finished(Err(PreflightFault::Resistance));
+            let [u, v, w] = [m.i_uvw.u, m.i_uvw.v, m.i_uvw.w].map(libm::fabsf);
+            // The largest (NaN when one is: `max` would drop it).
+            let peak = if u.is_nan() || v.is_nan() || w.is_nan() {
+                f32::NAN
+            } else {
+                u.max(v).max(w)
+            };
+            return Progress::Finished(Err(PreflightFault::Resistance.measured(FaultMeasurement::at(peak, 3))));
         }
         if !st.started {
             st.started = true;
@@ -328,7 +368,7 @@ impl Preflight {
         st: &mut PreflightState,
         trig: &mut T,
         m: &PreflightInput,
-    ) -> Progress<Result<PulseFigures, PreflightFault>> {
+    ) -> Progress<Result<PulseFigures, Refusal>> {
         let d = m.theta_r.wrapping_sub(st.previous_r);
         st.previous_r = m.theta_r;
         st.n = st.n.saturating_add(1);
@@ -397,38 +437,42 @@ impl Preflight {
     /// and down to 0 with one open at 90° to the voltage; measured at less than
     /// −`open_fraction` of that least current, the sensing is inverted. Judged here,
     /// before the turn, rather than only at the pulses 1–3 s later.
-    fn hold_verdict<T: Trig>(&self, st: &mut PreflightState, trig: &mut T, average: u32) -> Result<(), PreflightFault> {
+    fn hold_verdict<T: Trig>(&self, st: &mut PreflightState, trig: &mut T, average: u32) -> Result<(), Refusal> {
         let n = average.max(1) as f32;
         let [u, v, w] = st.sum_uvw.map(|s| s / n);
         st.sum_uvw = [0.0; 3];
         let i = along(trig, st.start, Uvw { u, v, w });
         if !at_least(i, -self.open_fraction * self.least_rotation_current()) {
-            return Err(PreflightFault::InvertedSensing);
+            return Err(PreflightFault::InvertedSensing.measured(FaultMeasurement::of(i)));
         }
         Ok(())
     }
 
-    fn rotation_verdict(&self, st: &PreflightState, average: u32) -> Result<(), PreflightFault> {
+    fn rotation_verdict(&self, st: &PreflightState, average: u32) -> Result<(), Refusal> {
         let least = self.least_rotation_current();
-        if st.peak.iter().any(|&p| !at_least(p, self.open_fraction * least)) {
-            return Err(PreflightFault::OpenPhase);
+        if let Some((k, &p)) = (0u8..)
+            .zip(&st.peak)
+            .find(|&(_, &p)| !at_least(p, self.open_fraction * least))
+        {
+            return Err(PreflightFault::OpenPhase.measured(FaultMeasurement::at(p, k)));
         }
         // Expected resolver travel: one electrical turn · n_r/n_p.
         let expected_travel = TURN as f32 / self.ratio;
         let travelled = st.travelled as f32;
+        // Turned/travelled: the measured n_p/n_r (±∞ when the resolver did not move).
+        let ratio = st.generated as f32 / travelled;
         if !at_least(libm::fabsf(travelled), 0.25 * expected_travel) {
-            return Err(PreflightFault::PolePairRatio);
+            return Err(PreflightFault::PolePairRatio.measured(FaultMeasurement::of(ratio)));
         }
         if travelled < 0.0 {
-            return Err(PreflightFault::Direction);
+            return Err(PreflightFault::Direction.measured(FaultMeasurement::of(travelled / expected_travel)));
         }
-        let ratio = st.generated as f32 / travelled;
         if !at_most(libm::fabsf(ratio - self.ratio), self.ratio_bound) {
-            return Err(PreflightFault::PolePairRatio);
+            return Err(PreflightFault::PolePairRatio.measured(FaultMeasurement::of(ratio)));
         }
         let error = st.angle_error.checked_div(i64::from(average.max(1))).unwrap_or(0);
         if error.unsigned_abs() > u64::from(self.angle_bound.unsigned_abs()) {
-            return Err(PreflightFault::ResolverOffset);
+            return Err(PreflightFault::ResolverOffset.measured(FaultMeasurement::of(error as f32 * DEGREES_PER_LSB)));
         }
         Ok(())
     }
@@ -439,7 +483,7 @@ impl Preflight {
         st: &mut PreflightState,
         trig: &mut T,
         m: &PreflightInput,
-    ) -> Progress<Result<PulseFigures, PreflightFault>> {
+    ) -> Progress<Result<PulseFigures, Refusal>> {
         let levels = self.level_samples.max(1);
         if st.level < 2 {
             // Sample n of this level: taken in the period that computed the level's
@@ -497,10 +541,12 @@ impl Preflight {
         trig: &mut T,
         mean: f32,
         uvw: [f32; 3],
-    ) -> Result<(), PreflightFault> {
+    ) -> Result<(), Refusal> {
         let i = signed(st.pulse, mean);
+        // The figures' index: the pulse (0 +, 1 −).
+        let k = st.pulse.min(1);
         if !at_least(i, f32::MIN_POSITIVE) {
-            return Err(PreflightFault::InvertedSensing);
+            return Err(PreflightFault::InvertedSensing.measured(FaultMeasurement::at(i, k.saturating_add(1))));
         }
         if st.level == 0 {
             st.first = i;
@@ -509,37 +555,36 @@ impl Preflight {
         let sum = libm::fabsf(uvw.iter().sum::<f32>());
         st.figures.sum = st.figures.sum.max(sum);
         if self.sum_bound > 0.0 && !at_most(sum, self.sum_bound) {
-            return Err(PreflightFault::CurrentSum);
+            return Err(PreflightFault::CurrentSum.measured(FaultMeasurement::at(sum, k)));
         }
         // Open phase: the phases within 60° of the pulse carry their share.
         let mut axis = st.angle;
-        for measured in uvw {
+        for (phase, measured) in (0u8..).zip(uvw) {
             let c = trig.sin_cos(axis).to_f32().cos;
             axis = axis.wrapping_sub(THIRD);
             let expected = mean * c;
             if libm::fabsf(c) >= 0.5 && !at_least(libm::fabsf(measured), self.open_fraction * libm::fabsf(expected)) {
-                return Err(PreflightFault::OpenPhase);
+                return Err(PreflightFault::OpenPhase.measured(FaultMeasurement::at(libm::fabsf(measured), phase)));
             }
         }
         let rise = i - st.first;
         let r = 0.5 * self.voltage / rise;
-        let k = usize::from(st.pulse.min(1));
-        if let Some(slot) = st.figures.resistance.get_mut(k) {
+        if let Some(slot) = st.figures.resistance.get_mut(usize::from(k)) {
             *slot = r;
         }
         let within = |x: f32, nominal: f32, ratio: f32| x >= nominal / ratio && x <= nominal * ratio;
         if !(rise > 0.0 && within(r, self.resistance, self.resistance_ratio)) {
-            return Err(PreflightFault::Resistance);
+            return Err(PreflightFault::Resistance.measured(FaultMeasurement::at(r, k)));
         }
         // τ = T_s·Σ(I_2 − i_k)/(I_2 − I_1) − offset over the level's samples.
         let area = self.level_samples.max(1) as f32 * i - signed(st.pulse, st.area);
         let tau = self.sample_period * area / rise - self.tau_offset;
         let l = r * tau;
-        if let Some(slot) = st.figures.inductance.get_mut(k) {
+        if let Some(slot) = st.figures.inductance.get_mut(usize::from(k)) {
             *slot = l;
         }
         if !within(l, self.inductance, self.inductance_ratio) {
-            return Err(PreflightFault::Inductance);
+            return Err(PreflightFault::Inductance.measured(FaultMeasurement::at(l, k)));
         }
         Ok(())
     }

@@ -147,7 +147,9 @@ impl<'a> Can<'a> {
         Decl {
             name: "FAULT_REPORT_LEN",
             value: Custom(|_| length(p::FAULT_REPORT_LEN)),
-            formula: Lit("data length code of the fault report: cause, flags, PC, i_q"),
+            formula: Lit(
+                "data length code of the fault report: cause, flags, PC or a start-up check's measurement, i_q",
+            ),
             equation: Lit(PROTOCOL),
             inputs: Lit("the firmware's frame layout"),
             json: Json::None,

@@ -7,7 +7,7 @@
 
 use std::collections::BTreeSet;
 
-use can_dbc::{ByteOrder, Dbc, MessageId, MultiplexIndicator, Signal, ValueType};
+use can_dbc::{ByteOrder, Dbc, MessageId, MultiplexIndicator, Signal, SignalExtendedValueType, ValueType};
 use codegen::render::{Output, render};
 use motor_commission::candump::layout;
 use motor_control::can_protocol::{self as p, Command, End, Header, Layout, Quantity, Reason, Routine, State};
@@ -221,6 +221,7 @@ fn generated_dbc_matches_the_firmware_encoders() {
                 tripped: false,
                 i_q: -212.26,
             }),
+            measured: None,
         };
         let bytes = p::encode_fault_report(amps, &r);
         let mut seen = BTreeSet::new();
@@ -229,8 +230,46 @@ fn generated_dbc_matches_the_firmware_encoders() {
         check(sigs, &mut seen, "STATE_VALID", &bytes, 1.0);
         check(sigs, &mut seen, "OUTPUTS_ON", &bytes, 1.0);
         check(sigs, &mut seen, "TRIPPED", &bytes, 0.0);
+        check(sigs, &mut seen, "MEASURED_VALID", &bytes, 0.0);
+        check(sigs, &mut seen, "MEASURED_INDEX", &bytes, 0.0);
         check(sigs, &mut seen, "PC", &bytes, f64::from(0x0800_1234u32));
         check(sigs, &mut seen, "I_Q", &bytes, -212.26);
+        // A start-up check's refusal: no PC, so bytes 2–5 carry the measurement (the
+        // multiplexor PC_VALID = 0 selects MEASURED, an IEEE single by SIG_VALTYPE_):
+        // phase w's zero level 2 992 codes low (cause 10, index 2).
+        let r = p::FaultReport {
+            cause: 10,
+            pc: None,
+            measured: Some(p::FaultMeasurement::at(-2_992.0, 2)),
+            ..r
+        };
+        let bytes = p::encode_fault_report(amps, &r);
+        check(sigs, &mut seen, "CAUSE", &bytes, 10.0);
+        check(sigs, &mut seen, "PC_VALID", &bytes, 0.0);
+        check(sigs, &mut seen, "MEASURED_VALID", &bytes, 1.0);
+        check(sigs, &mut seen, "MEASURED_INDEX", &bytes, 2.0);
+        let fault_msg = MessageId::Standard(fault_id);
+        for (name, mux) in [("PC", 1), ("MEASURED", 0)] {
+            let sig = sigs.iter().find(|s| s.name == name).unwrap();
+            assert_eq!(
+                sig.multiplexer_indicator,
+                MultiplexIndicator::MultiplexedSignal(mux),
+                "{name}"
+            );
+        }
+        let pc_valid = sigs.iter().find(|s| s.name == "PC_VALID").unwrap();
+        assert_eq!(pc_valid.multiplexer_indicator, MultiplexIndicator::Multiplexor);
+        let measured = sigs.iter().find(|s| s.name == "MEASURED").unwrap();
+        assert_eq!(
+            dbc.extended_value_type_for_signal(fault_msg, "MEASURED"),
+            Some(&SignalExtendedValueType::IEEEfloat32Bit),
+            "{stem}: MEASURED is declared a float"
+        );
+        // The raw 32 bits the DBC places (bits 16–47), read as the IEEE single it declares.
+        let raw = u32::from_le_bytes(bytes[2..6].try_into().unwrap());
+        assert_eq!((measured.start_bit, measured.size), (16, 32));
+        assert_eq!(f32::from_bits(raw), -2_992.0, "{stem}: MEASURED");
+        seen.insert("MEASURED".to_string());
         assert_eq!(seen, all_names(sigs), "{stem} FAULT_REPORT");
     }
 }

@@ -152,11 +152,13 @@ fn first_switchable(rig: &mut Rig) -> Option<f64> {
 
 /// A zero-level error of 1.2 of the bound on one phase (v, then −1.2 on u): the fault
 /// record says "current offset" (cause 10) and no gate could switch on at any instant of
-/// the run (the boot limit with zero-torque setpoints).
+/// the run (the boot limit with zero-torque setpoints); its measurement names the phase
+/// and its deviation, 1.2 bounds in 16-bit codes (the error injected in volts, over the
+/// hardware's V_REF/65 536), within 1 % of the bound (quantisation and the averaged noise).
 #[test]
 fn offset_beyond_the_bound_faults_with_the_gates_off() {
     for (motor, board) in benches() {
-        for errors in [[0.0, 1.2, 0.0], [-1.2, 0.0, 0.0]] {
+        for (phase, errors) in [(1u8, [0.0, 1.2, 0.0]), (0, [-1.2, 0.0, 0.0])] {
             let mut rig = rig_with_errors(&motor, &board, |b| errors.map(|e| e * b));
             let name = rig.bench.name();
             let switched = first_switchable(&mut rig);
@@ -165,6 +167,14 @@ fn offset_beyond_the_bound_faults_with_the_gates_off() {
                 rig.fault_cause().as_deref(),
                 Some("10 (current offset)"),
                 "{name}: errors {errors:?}·bound"
+            );
+            let bound_code = f64::from(rig.design.board.as_ref().expect("board design").offset_bound_code);
+            let want = errors[usize::from(phase)] * bound_code;
+            let (value, index) = rig.fault_measurement().expect("a measurement in the record");
+            assert_eq!(index, phase, "{name}: errors {errors:?}·bound");
+            assert!(
+                (f64::from(value) - want).abs() <= 0.01 * bound_code,
+                "{name}: deviation {value} codes recorded, {want:.0} injected"
             );
         }
         println!("{motor} on {board}: ±1.2·bound on one phase → fault 10 (current offset), gates never on");
@@ -186,6 +196,10 @@ fn dead_excitation_faults_with_the_gates_off() {
         let switched = first_switchable(&mut rig);
         assert_eq!(switched, None, "{name}: a gate could switch without excitation");
         assert_eq!(rig.fault_cause().as_deref(), Some("19 (resolver signal)"), "{name}");
+        // The measured/designed ratio: the windings carry nothing, the demodulated SIN and
+        // COS only the converter's noise — far below the 0.64 accepted.
+        let (ratio, _) = rig.fault_measurement().expect("a measurement in the record");
+        assert!((0.0..0.05).contains(&ratio), "{name}: signal {ratio} of the designed");
         println!(
             "{name}: no excitation → fault 19 (resolver signal), gates never on (designed signal {:.4})",
             rig.design.board.as_ref().expect("board design").resolver_signal

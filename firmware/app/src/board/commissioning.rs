@@ -12,7 +12,7 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 use cortex_m::interrupt::{self, Mutex};
 use motor_control::can_protocol::decode_command;
 use motor_control::commissioning_mode::{Control, Guards, Measured, Sample, prepare};
-use motor_control::preflight::PreflightFault;
+use motor_control::preflight::Refusal;
 use motor_control::{Demand, Trig};
 
 use super::can::Can;
@@ -94,7 +94,7 @@ pub fn control_step<T: Trig>(
     omega_e: f32,
     normal: Demand,
     run: bool,
-) -> (Demand, bool, Option<PreflightFault>) {
+) -> (Demand, bool, Option<Refusal>) {
     OMEGA_E.store(omega_e.to_bits(), Ordering::Relaxed);
     FAULT.store(guards.fault, Ordering::Relaxed);
     TIMED_OUT.store(guards.setpoint_timeout, Ordering::Relaxed);

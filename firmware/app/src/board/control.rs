@@ -16,7 +16,10 @@
 //!
 //! The pre-flight check (CAN routine 6) runs through the commissioning mode like the
 //! chapter-6 routines; a refusal trips the drive here with its own cause (11–18,
-//! `FaultCause::from(PreflightFault)`): outputs off until reset, the record sealed.
+//! `FaultCause::from(PreflightFault)`): outputs off until reset, the record sealed with
+//! what it measured (`motor_control::preflight::Refusal`), as are the zero level's
+//! refusal (the phase and its deviation in 16-bit codes) and the resolver signal's
+//! (measured/designed).
 //!
 //! Order: read and acknowledge the conversions; trip on the board's levels
 //! ([`crate::config::TRIPS`]: a phase current beyond the over-current level or at the
@@ -39,6 +42,7 @@ use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::interrupt::Mutex;
 use motor_control::ato::AtoState;
+use motor_control::can_protocol::FaultMeasurement;
 use motor_control::commissioning_mode::{Guards, Measured};
 use motor_control::setpoint::SetpointState;
 use motor_control::{ControllerState, Demand};
@@ -98,8 +102,9 @@ pub struct Control {
     tripped: bool,
     /// Electrical speed of the last step \[rad/s\], for the over-speed trip.
     omega_e: f32,
-    /// Why this period tripped, recorded at its end with its state.
-    trip_cause: Option<FaultCause>,
+    /// Why this period tripped (and what the start-up check that refused the drive
+    /// measured), recorded at its end with its state.
+    trip_cause: Option<(FaultCause, Option<FaultMeasurement>)>,
     /// What the last step measured, for a commissioning routine.
     measured: Measured,
     /// The start-up measurement of the current sensing's zero level.
@@ -150,8 +155,14 @@ impl Control {
     /// Latches a trip and switches the gates off at once; the first trip's cause goes
     /// into the fault record.
     fn trip(&mut self, cause: FaultCause) {
+        self.refuse(cause, None);
+    }
+
+    /// [`Self::trip`] by a start-up check, with the figure it judged (the fault
+    /// record's measurement).
+    fn refuse(&mut self, cause: FaultCause, measured: Option<FaultMeasurement>) {
         if !self.tripped && self.trip_cause.is_none() {
-            self.trip_cause = Some(cause);
+            self.trip_cause = Some((cause, measured));
         }
         self.tripped = true;
         pwm::outputs_off(&self.tim1);
@@ -174,7 +185,10 @@ impl Control {
                     self.zero = Some(levels);
                     self.trips.current_offset = levels;
                 }
-                OffsetStatus::OutOfBound { .. } => self.trip(FaultCause::CurrentOffset),
+                OffsetStatus::OutOfBound { phase, deviation } => self.refuse(
+                    FaultCause::CurrentOffset,
+                    Some(FaultMeasurement::at(deviation as f32, phase)),
+                ),
             }
         }
         if self.trips.tripped(&raw, phases, self.omega_e) {
@@ -211,8 +225,8 @@ impl Control {
             commissioning::control_step(&mut self.cordic, &self.measured, &guards, self.omega_e, normal, run);
         // The pre-flight check refused the drive: outputs off until reset, its cause
         // (11–18) in the fault record.
-        if let Some(f) = refused {
-            self.trip(FaultCause::from(f));
+        if let Some(r) = refused {
+            self.refuse(FaultCause::from(r.fault), Some(r.measured));
         }
         let (demand, run) = if calibrating {
             (Demand::Off, false)
@@ -234,9 +248,10 @@ impl Control {
             match self.signal.add(&RESOLVER_SIGNAL, sample.resolver) {
                 SignalStatus::Measuring => {}
                 SignalStatus::Within(_) => self.signal_pending = false,
-                SignalStatus::Outside(_) => {
+                SignalStatus::Outside(square) => {
                     self.signal_pending = false;
-                    self.trip(FaultCause::ResolverSignal);
+                    let ratio = RESOLVER_SIGNAL.ratio_of(square);
+                    self.refuse(FaultCause::ResolverSignal, Some(FaultMeasurement::of(ratio)));
                 }
             }
         }
@@ -247,7 +262,7 @@ impl Control {
         pwm::set_compare(&self.tim1, out.compare);
         let on = bringup::finish_period(&mut pwm::Break(&self.tim1), &mut self.tripped, run);
         if self.tripped && !was_tripped && self.trip_cause.is_none() {
-            self.trip_cause = Some(FaultCause::Break);
+            self.trip_cause = Some((FaultCause::Break, None));
         }
         let periods = TICKS.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
         fault::keep_state(&ControlState {
@@ -267,8 +282,8 @@ impl Control {
     /// Seals the fault record once, for the first trip (the drive stays off until
     /// reset, and the record waits for it).
     fn record_trip(&mut self) {
-        if let Some(cause) = self.trip_cause.take() {
-            fault::record(cause);
+        if let Some((cause, measured)) = self.trip_cause.take() {
+            fault::record(cause, measured);
         }
     }
 }

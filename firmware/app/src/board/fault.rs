@@ -19,7 +19,7 @@ use crate::fault_record::{
     ControlState, FaultCause, FaultRecord, RECORD_WORDS, STATE_WORDS, at_boot, classify_hard_fault,
 };
 use crate::hw;
-use motor_control::can_protocol::Frame;
+use motor_control::can_protocol::{FaultMeasurement, Frame};
 
 /// Routes faults the software can no longer handle to TIM1's break input and stops TIM1
 /// under a debugger halt (defect 6): SYSCFG_CFGR2.CLL (Cortex-M4 LOCKUP), SPL (SRAM
@@ -45,7 +45,7 @@ pub fn halt() -> ! {
 /// Records `cause` (with the control state of the last period) and stops.
 pub fn stop(cause: FaultCause) -> ! {
     cortex_m::interrupt::disable();
-    let record = seal(cause, None, 0, 0);
+    let record = seal(cause, None, 0, 0, None);
     outputs_off_and_wait(&record)
 }
 
@@ -99,7 +99,7 @@ extern "C" fn hard_fault(sp: u32) -> ! {
     // SAFETY: `classify_hard_fault` returns an address only when the whole exception
     // frame lies inside the stack region, which is RAM.
     let pc = pc_at.map(|a| unsafe { core::ptr::read_volatile(a as *const u32) });
-    let record = seal(cause, pc, cfsr, hfsr);
+    let record = seal(cause, pc, cfsr, hfsr, None);
     outputs_off_and_wait(&record)
 }
 
@@ -157,13 +157,13 @@ pub fn keep_state(state: &ControlState) {
 }
 
 /// Records a trip of the control interrupt (the outputs are already off; the drive
-/// stays off until reset).
-pub fn record(cause: FaultCause) {
-    seal(cause, None, 0, 0);
+/// stays off until reset), with what the start-up check that refused the drive measured.
+pub fn record(cause: FaultCause, measured: Option<FaultMeasurement>) {
+    seal(cause, None, 0, 0, measured);
 }
 
 /// Seals a record of `cause` with the live control state; returns it.
-fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32) -> FaultRecord {
+fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32, measured: Option<FaultMeasurement>) -> FaultRecord {
     let state = read_words((&raw const MOTOR_CONTROL_STATE).cast());
     let record = FaultRecord {
         cause,
@@ -172,6 +172,7 @@ fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32) -> FaultRecord
         hfsr,
         state: ControlState::from_words(&state),
         reported: false,
+        measured,
     };
     write_words((&raw mut MOTOR_FAULT_RECORD).cast(), &record.to_words());
     record
@@ -226,13 +227,15 @@ pub fn take_at_boot(rcc: &pac::RCC) -> Option<FaultRecord> {
     #[cfg(feature = "defmt")]
     match &record {
         Some(r) => defmt::warn!(
-            "previous run: fault record cause {=u32}, PC {=?}, CFSR {=u32:#010x}, HFSR {=u32:#010x}, control state {=bool}, sent on CAN {=bool}",
+            "previous run: fault record cause {=u32}, PC {=?}, CFSR {=u32:#010x}, HFSR {=u32:#010x}, control state {=bool}, sent on CAN {=bool}, measured {=?} (index {=?})",
             r.cause as u32,
             r.pc,
             r.cfsr,
             r.hfsr,
             r.state.is_some(),
-            r.reported
+            r.reported,
+            r.measured.map(|m| m.value),
+            r.measured.map(|m| m.index)
         ),
         None => defmt::info!("previous run: no fault record"),
     }

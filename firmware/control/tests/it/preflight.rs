@@ -11,8 +11,9 @@
 
 use crate::common::*;
 use core::f64::consts::PI;
+use motor_control::can_protocol::FaultMeasurement;
 use motor_control::commissioning::Progress;
-use motor_control::preflight::{Preflight, PreflightFault, PreflightInput, PreflightState, PulseFigures};
+use motor_control::preflight::{Preflight, PreflightFault, PreflightInput, PreflightState, PulseFigures, Refusal};
 
 fn check() -> Preflight {
     let m = FISCHER;
@@ -50,8 +51,14 @@ fn bench() -> Bench {
     Bench::new(config(m, cl), plant(m, free(1e-3, 1e-3)))
 }
 
+/// The refusal of `r`, its fault and measured figure (panics on a pass).
+fn refused(r: Result<PulseFigures, Refusal>) -> (PreflightFault, FaultMeasurement) {
+    let r = r.expect_err("refused");
+    (r.fault, r.measured)
+}
+
 /// Runs the check to its verdict; the periods it took and the largest |phase current|.
-fn run(mut bench: Bench, check: &Preflight) -> (Result<PulseFigures, PreflightFault>, u64, f64) {
+fn run(mut bench: Bench, check: &Preflight) -> (Result<PulseFigures, Refusal>, u64, f64) {
     let mut st = PreflightState::default();
     let mut periods = 0u64;
     let mut peak = 0.0f64;
@@ -102,8 +109,13 @@ fn inverted_sensing_is_refused() {
     b.current_gain = [-1.0; 3];
     let c = check();
     let (r, periods, _) = run(b, &c);
-    assert_eq!(r, Err(PreflightFault::InvertedSensing));
+    let (fault, m) = refused(r);
+    assert_eq!(fault, PreflightFault::InvertedSensing);
     assert_eq!(periods, u64::from(c.settle_samples), "{periods}");
+    // The hold's current along its voltage, read inverted: −V_rot/R = −10 A once settled
+    // (the held voltage draws R·I = V through the star: 1.26 V/0.126 Ω), within 0.5 %.
+    assert_eq!(m.index, 0);
+    assert!((f64::from(m.value) + 10.0).abs() < 0.05, "{m:?}");
 }
 
 /// Inverted sensing on a drive whose hold cannot see it — phase u open with the hold's
@@ -118,8 +130,12 @@ fn inverted_sensing_with_no_hold_current_is_left_to_the_turn() {
     assert_eq!(b.plant.theta_e(), 0.0);
     let c = check();
     let (r, periods, _) = run(b, &c);
-    assert_eq!(r, Err(PreflightFault::OpenPhase));
+    let (fault, m) = refused(r);
+    assert_eq!(fault, PreflightFault::OpenPhase);
     assert!(periods > u64::from(c.settle_samples), "{periods}");
+    // Phase u (index 0) carried nothing during the turn.
+    assert_eq!(m.index, 0);
+    assert!(m.value.abs() < 0.05, "{m:?}");
 }
 
 /// One phase's gain 20 % high: the currents no longer sum to zero.
@@ -127,7 +143,10 @@ fn inverted_sensing_with_no_hold_current_is_left_to_the_turn() {
 fn a_wrong_gain_breaks_the_sum() {
     let mut b = bench();
     b.current_gain[0] = 1.2;
-    assert_eq!(run(b, &check()).0, Err(PreflightFault::CurrentSum));
+    let (fault, m) = refused(run(b, &check()).0);
+    assert_eq!(fault, PreflightFault::CurrentSum);
+    // |Σ| = 0.2·|i_u| beyond the 1 A bound, at most 0.2 of the 10 A pulse.
+    assert!(m.value > 1.0 && m.value <= 2.1, "{m:?}");
 }
 
 /// Phase w open with the resolver's θ_e = 0.3·4 rad (69° from w's axis at 240°: |cos| =
@@ -140,7 +159,11 @@ fn an_open_phase_is_refused() {
         b.plant.open_phase = Some(k);
         let (r, periods, _) = run(b, &check());
         eprintln!("phase {k} open: {r:?} after {periods} periods");
-        assert_eq!(r, Err(PreflightFault::OpenPhase), "phase {k}");
+        let (fault, m) = refused(r);
+        assert_eq!(fault, PreflightFault::OpenPhase, "phase {k}");
+        // The open phase is the one named, and it carried nothing.
+        assert_eq!(usize::from(m.index), k, "{m:?}");
+        assert!(m.value.abs() < 0.05, "phase {k}: {m:?}");
     }
 }
 
@@ -149,7 +172,11 @@ fn an_open_phase_is_refused() {
 fn a_high_resistance_is_refused() {
     let mut b = bench();
     b.plant.motor.resistance *= 3.0;
-    assert_eq!(run(b, &check()).0, Err(PreflightFault::Resistance));
+    let (fault, m) = refused(run(b, &check()).0);
+    assert_eq!(fault, PreflightFault::Resistance);
+    // The + pulse's R: 3·0.126 = 0.378 Ω within the healthy drive's 5 %.
+    assert_eq!(m.index, 0);
+    assert!((f64::from(m.value) / (3.0 * FISCHER.r) - 1.0).abs() < 0.05, "{m:?}");
 }
 
 /// L three times the spec's: refused on L.
@@ -161,7 +188,11 @@ fn a_wrong_inductance_is_refused() {
     let mut c = check();
     // Long enough levels for the slower rise (8τ of 3·L).
     c.level_samples = 1500;
-    assert_eq!(run(b, &c).0, Err(PreflightFault::Inductance));
+    let (fault, m) = refused(run(b, &c).0);
+    assert_eq!(fault, PreflightFault::Inductance);
+    // The + pulse's L: 3·0.393 = 1.179 mH within the healthy drive's 5 %.
+    assert_eq!(m.index, 0);
+    assert!((f64::from(m.value) / (3.0 * FISCHER.ld) - 1.0).abs() < 0.05, "{m:?}");
 }
 
 /// Two motor leads swapped: the field turns the other way, and so does the resolver —
@@ -171,7 +202,10 @@ fn reversed_rotation_is_refused() {
     let mut b = bench();
     b.plant.resolver_reversed = true;
     b.sim = motor_sim::bench::Bench::new(b.cfg, b.plant.clone());
-    assert_eq!(run(b, &check()).0, Err(PreflightFault::Direction));
+    let (fault, m) = refused(run(b, &check()).0);
+    assert_eq!(fault, PreflightFault::Direction);
+    // The resolver travelled the whole expected turn, backwards: −1.
+    assert!((m.value + 1.0).abs() < 0.01, "{m:?}");
 }
 
 /// The motor has 5 pole pairs, the configuration says 4: the resolver turns 4/5 of the
@@ -180,7 +214,10 @@ fn reversed_rotation_is_refused() {
 fn a_wrong_pole_pair_count_is_refused() {
     let mut b = bench();
     b.plant.motor.pole_pairs = 5;
-    assert_eq!(run(b, &check()).0, Err(PreflightFault::PolePairRatio));
+    let (fault, m) = refused(run(b, &check()).0);
+    assert_eq!(fault, PreflightFault::PolePairRatio);
+    // The measured n_p/n_r is the plant's 5.
+    assert!((m.value - 5.0).abs() < 0.01, "{m:?}");
 }
 
 /// The resolver offset 90° electrical off (the plant's θ_off moved by π/2 /n_p·n_r):
@@ -190,5 +227,8 @@ fn a_resolver_offset_is_refused() {
     let mut b = bench();
     b.plant.resolver_offset += PI / 2.0 / 4.0;
     b.sim = motor_sim::bench::Bench::new(b.cfg, b.plant.clone());
-    assert_eq!(run(b, &check()).0, Err(PreflightFault::ResolverOffset));
+    let (fault, m) = refused(run(b, &check()).0);
+    assert_eq!(fault, PreflightFault::ResolverOffset);
+    // 90° electrical off (the rotor at rest under the hold: no load angle).
+    assert!((m.value.abs() - 90.0).abs() < 0.5, "{m:?}");
 }
