@@ -65,6 +65,12 @@ impl SignalCheck {
         Self { seen: 0, sum: 0.0 }
     }
 
+    /// Whether the last sample added fell in the averaged half (the excitation has
+    /// settled: the demodulated signals are the resolver's).
+    pub fn averaging(&self, bounds: &SignalBounds) -> bool {
+        self.seen > bounds.periods / 2
+    }
+
     /// One period's sample; the verdict once `bounds.periods` have been seen (and on
     /// every later call).
     pub fn add(&mut self, bounds: &SignalBounds, sample: ResolverSample) -> SignalStatus {

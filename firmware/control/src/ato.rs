@@ -86,6 +86,58 @@ impl AtoState {
     }
 }
 
+/// The observer's start on a rotor that may be turning: each period the resolver's
+/// angle by atan2 (as [`AtoState::acquired`]) and, over the periods counted, the mean of
+/// its per-period increments — ω̂ in the observer's own unit (4.19), the travel between
+/// the first and the last counted angle over their distance in periods (each increment
+/// taken wrapping, so a turn through ±π counts as the small step it is: a resolver turns
+/// far less than half a turn per control period, f_s ≥ 12·f_e, thesis A (1.1)). Seeded
+/// at rest ([`AtoState::acquired`]: ω̂ = 0) an observer on a turning rotor must pull in
+/// from a speed error of the whole speed, a transient of about 4/ω_n whose speed kick
+/// an over-speed trip takes for a runaway (fischer-ti085 at 6 000 rpm on the emulated
+/// board: fault 4 at the first enabled periods); seeded with θ and ω it starts locked.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Acquisition {
+    /// The last angle (π-scaled Q1.31), once one was taken.
+    previous: Option<i32>,
+    /// Σ of the counted increments (π-scaled LSB).
+    travel: i64,
+    /// Increments counted.
+    steps: u32,
+}
+
+impl Acquisition {
+    /// Nothing seen.
+    pub const fn new() -> Self {
+        Self {
+            previous: None,
+            travel: 0,
+            steps: 0,
+        }
+    }
+
+    /// One period's sample; `counted`: its increment over the previous angle enters the
+    /// mean (false while the excitation settles, when the demodulated signals are not
+    /// yet the resolver's). Returns the observer state for the next period:
+    /// θ̂ = this angle, ω̂ = the mean increment so far (0 before the first counted one).
+    pub fn add<T: Trig>(&mut self, trig: &mut T, resolver: ResolverSample, counted: bool) -> AtoState {
+        let theta = trig.atan2(resolver.sin, resolver.cos);
+        if let (true, Some(previous)) = (counted, self.previous) {
+            self.travel = self.travel.saturating_add(i64::from(theta.wrapping_sub(previous)));
+            self.steps = self.steps.saturating_add(1);
+        }
+        self.previous = Some(theta);
+        AtoState::locked(theta, self.speed())
+    }
+
+    /// The mean increment \[π-scaled LSB per period\] (0 before any was counted).
+    pub fn speed(&self) -> i32 {
+        let mean = self.travel.checked_div(i64::from(self.steps)).unwrap_or(0);
+        // |mean| ≤ 2^31: each increment is an i32.
+        i32::try_from(mean).unwrap_or(0)
+    }
+}
+
 /// One demodulated resolver sample (4.3): envelopes of the SIN and COS windings,
 /// Q1.31 (amplitude ≤ 1; a common gain only scales the trig-identity error, 4.10).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -161,6 +213,35 @@ mod tests {
             ki: I1F31::from_bits((ki / (FS * FS * norm) * Q31).round() as i32),
             error,
         }
+    }
+
+    /// A rotor turning −0.3 rad per period from 3.0 rad (through ±π after one period): the
+    /// first 10 periods are not counted and give ω̂ = 0; over the next 50 the mean
+    /// increment is −0.3 rad = −0.3/π·2^31 = −205 069 923 LSB within the atan2's error
+    /// (the CORDIC-free `SoftTrig`: a few LSB); θ̂ is each period's angle. At rest the
+    /// mean is 0 and nothing counted gives 0.
+    #[test]
+    fn acquisition_measures_the_speed_across_the_wrap() {
+        let mut trig = SoftTrig;
+        let mut a = Acquisition::new();
+        let step = -0.3;
+        let mut st = AtoState::new();
+        for k in 0..60 {
+            let theta = 3.0 + step * f64::from(k);
+            st = a.add(&mut trig, sample(theta), k >= 10);
+            assert!((wrap(rad(st.theta) - theta)).abs() < 1e-6, "θ̂ at {k}");
+            if k < 10 {
+                assert_eq!(st.omega, 0, "period {k}: nothing counted yet");
+            }
+        }
+        let want = (step / PI * Q31).round();
+        assert!((f64::from(st.omega) - want).abs() < 64.0, "{} vs {want}", st.omega);
+        let mut rest = Acquisition::new();
+        for _ in 0..20 {
+            st = rest.add(&mut trig, sample(-2.0), true);
+        }
+        assert!(st.omega.abs() <= 2, "{}", st.omega);
+        assert_eq!(Acquisition::new().speed(), 0);
     }
 
     fn sample(theta: f64) -> ResolverSample {

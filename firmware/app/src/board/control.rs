@@ -9,10 +9,12 @@
 //! every later period's currents are taken about the measured levels (trips included).
 //! Meanwhile the step runs with [`Demand::Off`] and a commissioning routine sees a
 //! fault, and the angle observer is acquired on each period's sample
-//! ([`motor_control::ato::AtoState::acquired`]: θ̂ = atan2 of SIN and COS, ω̂ = 0, the
-//! rotor at rest): it starts on the rotor's angle instead of pulling in from θ̂ = 0, whose
-//! first-period speed kick (K_p·sin Δ) the over-speed trip would take for a runaway.
-//! The excitation has run for the whole calibration by its end.
+//! ([`motor_control::ato::Acquisition`]: θ̂ = atan2 of SIN and COS, ω̂ = the mean
+//! per-period increment of that angle over the calibration's second half, once the
+//! excitation has settled): it starts on the rotor's angle and speed — at rest or
+//! turning — instead of pulling in from θ̂ = 0, ω̂ = 0, whose speed kick (K_p·sin Δ at
+//! rest, the whole speed on a turning rotor) the over-speed trip would take for a
+//! runaway. The excitation has run for the whole calibration by its end.
 //!
 //! The pre-flight check (CAN routine 6) runs through the commissioning mode like the
 //! chapter-6 routines; a refusal trips the drive here with its own cause (11–18,
@@ -41,7 +43,7 @@ use core::cell::Cell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::interrupt::Mutex;
-use motor_control::ato::AtoState;
+use motor_control::ato::Acquisition;
 use motor_control::can_protocol::FaultMeasurement;
 use motor_control::commissioning_mode::{Guards, Measured};
 use motor_control::setpoint::SetpointState;
@@ -115,6 +117,8 @@ pub struct Control {
     signal: SignalCheck,
     /// That measurement still running.
     signal_pending: bool,
+    /// The angle observer's start: the resolver's angle and speed over the calibration.
+    acquisition: Acquisition,
     /// The trips, about the measured zero levels once known.
     trips: Trips,
 }
@@ -148,6 +152,7 @@ impl Control {
             zero: None,
             signal: SignalCheck::new(),
             signal_pending: true,
+            acquisition: Acquisition::new(),
             trips: TRIPS,
         }
     }
@@ -256,7 +261,12 @@ impl Control {
             }
         }
         if calibrating {
-            self.state.observer = AtoState::acquired(&mut self.cordic, sample.resolver);
+            // The rotor's angle and its speed over the settled half of the calibration
+            // (the resolver signal check's averaged periods): the observer starts locked
+            // on a turning rotor too. The over-speed trip judges the observer's speed
+            // only once it runs.
+            let counted = self.signal.averaging(&RESOLVER_SIGNAL);
+            self.state.observer = self.acquisition.add(&mut self.cordic, sample.resolver, counted);
             self.omega_e = 0.0;
         }
         pwm::set_compare(&self.tim1, out.compare);
