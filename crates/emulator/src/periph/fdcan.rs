@@ -115,6 +115,9 @@ pub struct Fdcan {
     sent: std::collections::VecDeque<(f64, Frame)>,
     /// Frames transmitted since reset.
     pub transmitted: u32,
+    /// When the image last acknowledged an RX FIFO 0 element (RXF0A written) \[s\]: the
+    /// instant it took a received frame.
+    pub last_ack_s: Option<f64>,
 }
 
 impl Default for Fdcan {
@@ -151,6 +154,7 @@ impl Fdcan {
             bus_free_s: 0.0,
             sent: std::collections::VecDeque::new(),
             transmitted: 0,
+            last_ack_s: None,
         }
     }
 
@@ -332,6 +336,7 @@ impl Fdcan {
                 self.fill -= n;
                 self.get = (ai + 1) % RX_ELEMENTS;
                 self.regs[0x94 / 4] = ai;
+                self.last_ack_s = Some(now);
             }
             // TXBAR: add requests (RM0440 §44.4.31); in FIFO mode the buffer is the put
             // index TXFQS.TFQPI, free (ST's HAL_FDCAN_AddMessageToTxFifoQ writes the
