@@ -7,7 +7,7 @@
 //! |---|---|
 //! | 0 | cause code ([`FaultCause`] as `u8`: 1 HardFault, 2 stack overflow, 3 break, 4 trip, 5 lost conversion, 6 bring-up, 7 unhandled interrupt, 8 panic, 9 watchdog, 10 current offset, 11–18 the pre-flight check's refusals, 19 resolver signal) |
 //! | 1 | flags: bit 0 PC valid, bit 1 state valid, bit 2 outputs were on, bit 3 tripped, bit 4 measurement valid, bits 5–6 the measurement's index |
-//! | 2–5 | stacked PC, little-endian, when valid; else the start-up check's measurement (causes 10–19: IEEE 754 single, little-endian; its unit and index by cause, README "First power-up"); else 0 |
+//! | 2–5 | stacked PC, little-endian, when valid; else the start-up check's measurement (causes 10–19: IEEE 754 single, little-endian; its unit and index by cause, README "What a refusal reports"); else 0 |
 //! | 6–7 | i_q of the last period, little-endian `i16` in units of the generated `can::FAULT_CURRENT_PER_LSB`, rounded, saturating; `i16::MIN` when not a number; 0 when the state is not valid |
 //!
 //! The full record (currents, angle, speed, DC link, CFSR/HFSR) is read with a probe

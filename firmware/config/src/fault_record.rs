@@ -231,7 +231,7 @@ pub struct FaultRecord {
     /// Already sent on CAN after a boot (sent once, kept for a probe).
     pub reported: bool,
     /// What the start-up check that refused the drive measured (causes 10–19; the
-    /// figure and unit by cause: README, "First power-up").
+    /// figure and unit by cause: README, "What a refusal reports").
     pub measured: Option<FaultMeasurement>,
 }
 
@@ -245,6 +245,19 @@ const INDEX_SHIFT: u32 = 4;
 const INDEX_BITS: u32 = (MEASUREMENT_INDEX_MASK as u32) << INDEX_SHIFT;
 
 impl FaultRecord {
+    /// A record of `cause` alone: no PC, fault status, state or measurement, not sent.
+    pub const fn of(cause: FaultCause) -> Self {
+        Self {
+            cause,
+            pc: None,
+            cfsr: 0,
+            hfsr: 0,
+            state: None,
+            reported: false,
+            measured: None,
+        }
+    }
+
     /// The sealed words: [`MAGIC`], cause, flags (bit 0 PC, 1 state, 2 reported, 3
     /// measurement, 4–5 its index), PC, CFSR, HFSR, the measurement (f32 bits, 0 when
     /// none), state, CRC-32 of the words before it.
@@ -285,6 +298,11 @@ impl FaultRecord {
         }
         let [magic, cause, flags, pc, cfsr, hfsr, measured, ..] = *w;
         if magic != MAGIC || flags & !(HAS_PC | HAS_STATE | REPORTED | HAS_MEASURED | INDEX_BITS) != 0 {
+            return None;
+        }
+        // Only what `to_words` writes: an index or a measurement word without its flag is
+        // another layout's record.
+        if flags & HAS_MEASURED == 0 && (flags & INDEX_BITS != 0 || measured != 0) {
             return None;
         }
         let mut state = [0; STATE_WORDS];
@@ -512,6 +530,9 @@ mod tests {
         assert_eq!(reseal(1, 0), None);
         assert_eq!(reseal(1, 77), None);
         assert_eq!(reseal(2, 1 << 6), None);
+        // An index (bits 4–5) or a measurement word without the measurement's flag.
+        assert_eq!(reseal(2, 0b11 | (1 << 4)), None);
+        assert_eq!(reseal(6, 1.5f32.to_bits()), None);
         // HAS_STATE with state words the interrupt never wrote.
         assert_eq!(reseal(HEAD_WORDS + STATE_WORDS - 1, 0), None);
         assert!(

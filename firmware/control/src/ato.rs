@@ -89,7 +89,8 @@ impl AtoState {
 /// The observer's start on a rotor that may be turning: each period the resolver's
 /// angle by atan2 (as [`AtoState::acquired`]) and, over the periods counted, the mean of
 /// its per-period increments — ω̂ in the observer's own unit (4.19), the travel between
-/// the first and the last counted angle over their distance in periods (each increment
+/// the first and the last counted angle over their distance in periods (only increments
+/// between two counted angles: the first counted angle is the reference; each increment
 /// taken wrapping, so a turn through ±π counts as the small step it is: a resolver turns
 /// far less than half a turn per control period, f_s ≥ 12·f_e, thesis A (1.1)). Seeded
 /// at rest ([`AtoState::acquired`]: ω̂ = 0) an observer on a turning rotor must pull in
@@ -98,7 +99,7 @@ impl AtoState {
 /// board: fault 4 at the first enabled periods); seeded with θ and ω it starts locked.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Acquisition {
-    /// The last angle (π-scaled Q1.31), once one was taken.
+    /// The last counted angle (π-scaled Q1.31), once one was.
     previous: Option<i32>,
     /// Σ of the counted increments (π-scaled LSB).
     travel: i64,
@@ -116,17 +117,20 @@ impl Acquisition {
         }
     }
 
-    /// One period's sample; `counted`: its increment over the previous angle enters the
-    /// mean (false while the excitation settles, when the demodulated signals are not
-    /// yet the resolver's). Returns the observer state for the next period:
-    /// θ̂ = this angle, ω̂ = the mean increment so far (0 before the first counted one).
+    /// One period's sample; `counted`: the angle is the resolver's (false while the
+    /// excitation settles, when the demodulated signals are not yet the resolver's), and
+    /// its increment over the previous counted angle enters the mean. Returns the
+    /// observer state for the next period: θ̂ = this angle, ω̂ = the mean increment so far
+    /// (0 before the second counted angle).
     pub fn add<T: Trig>(&mut self, trig: &mut T, resolver: ResolverSample, counted: bool) -> AtoState {
         let theta = trig.atan2(resolver.sin, resolver.cos);
-        if let (true, Some(previous)) = (counted, self.previous) {
-            self.travel = self.travel.saturating_add(i64::from(theta.wrapping_sub(previous)));
-            self.steps = self.steps.saturating_add(1);
+        if counted {
+            if let Some(previous) = self.previous {
+                self.travel = self.travel.saturating_add(i64::from(theta.wrapping_sub(previous)));
+                self.steps = self.steps.saturating_add(1);
+            }
+            self.previous = Some(theta);
         }
-        self.previous = Some(theta);
         AtoState::locked(theta, self.speed())
     }
 
@@ -215,11 +219,13 @@ mod tests {
         }
     }
 
-    /// A rotor turning −0.3 rad per period from 3.0 rad (through ±π after one period): the
-    /// first 10 periods are not counted and give ω̂ = 0; over the next 50 the mean
-    /// increment is −0.3 rad = −0.3/π·2^31 = −205 069 923 LSB within the atan2's error
-    /// (the CORDIC-free `SoftTrig`: a few LSB); θ̂ is each period's angle. At rest the
-    /// mean is 0 and nothing counted gives 0.
+    /// A rotor turning −0.3 rad per period from 3.0 rad (through −π at periods 21 and
+    /// 42): the first 10 periods are not counted (a wild angle among them, as before the
+    /// excitation settles, does not count either) and, with the first counted one the
+    /// reference, give ω̂ = 0 up to period 10; over the next 49 increments the mean is
+    /// −0.3 rad = −0.3/π·2^31 = −205 069 583 LSB within the atan2's error (the
+    /// CORDIC-free `SoftTrig`: a few LSB); θ̂ is each period's angle. At rest the mean is
+    /// 0 and nothing counted gives 0.
     #[test]
     fn acquisition_measures_the_speed_across_the_wrap() {
         let mut trig = SoftTrig;
@@ -227,10 +233,10 @@ mod tests {
         let step = -0.3;
         let mut st = AtoState::new();
         for k in 0..60 {
-            let theta = 3.0 + step * f64::from(k);
+            let theta = if k == 9 { 2.0 } else { 3.0 + step * f64::from(k) };
             st = a.add(&mut trig, sample(theta), k >= 10);
             assert!((wrap(rad(st.theta) - theta)).abs() < 1e-6, "θ̂ at {k}");
-            if k < 10 {
+            if k <= 10 {
                 assert_eq!(st.omega, 0, "period {k}: nothing counted yet");
             }
         }

@@ -475,7 +475,7 @@ pub const FAULT_REPORT_LEN: u8 = 8;
 /// it and the fault report sends it, so a user sees by how much the bench missed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FaultMeasurement {
-    /// The judged figure (its unit by cause: README, "First power-up").
+    /// The judged figure (its unit by cause: README, "What a refusal reports").
     pub value: f32,
     /// The phase (0 u, 1 v, 2 w) or the instance the figure belongs to, 0 … 3.
     pub index: u8,

@@ -268,6 +268,11 @@ fn generated_dbc_matches_the_firmware_encoders() {
         // The raw 32 bits the DBC places (bits 16–47), read as the IEEE single it declares.
         let raw = u32::from_le_bytes(bytes[2..6].try_into().unwrap());
         assert_eq!((measured.start_bit, measured.size), (16, 32));
+        assert_eq!(
+            measured.byte_order,
+            ByteOrder::LittleEndian,
+            "{stem}: MEASURED byte order"
+        );
         assert_eq!(f32::from_bits(raw), -2_992.0, "{stem}: MEASURED");
         seen.insert("MEASURED".to_string());
         assert_eq!(seen, all_names(sigs), "{stem} FAULT_REPORT");

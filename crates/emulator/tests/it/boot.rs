@@ -370,7 +370,9 @@ fn control_interrupt_instructions_fit_the_period_and_the_budget() {
 /// read the resolver at 0): on every pair, with the shaft at 2.5 rad and −2 rad, the
 /// image boots to its first enabled period and runs 50 periods at zero torque without a
 /// trip. The observer is acquired on the resolver during the offset calibration
-/// (`AtoState::acquired`); pulled in from θ̂ = 0 instead, its first-period speed kick
+/// (`AtoState::acquired` until stop 43, `motor_control::ato::Acquisition` since, which
+/// also measures the speed: [`every_pair_boots_with_the_rotor_turning`]); pulled in from
+/// θ̂ = 0 instead, its first-period speed kick
 /// K_p·sin Δ is beyond the over-speed trip: maxon-ec45-flat-70w (ω_n = 1000 rad/s) at
 /// 2.5 rad, 2000·sin 2.5 = 1197 rad/s of the shaft against its 5625 rpm = 589 rad/s trip
 /// (measured with the acquisition removed: trip at boot, fault record 4).
@@ -412,7 +414,8 @@ fn observed_speed(rig: &Rig) -> f64 {
 /// gates off, starts its angle observer on the resolver's angle *and speed*
 /// (`motor_control::ato::Acquisition`) and runs at zero torque without a trip for six
 /// time constants of its current loop (at least 20 ms; fischer-ti085's 100 rad/s: 60 ms),
-/// its ω̂_e (mean of 20 periods) within 1 % of the shaft's and the true currents within 5 % of the
+/// its ω̂_e (mean of 20 periods) within 1 % of the shaft's (measured: within 0.1 % on
+/// every pair) and the true currents within 5 % of the
 /// over-current trip; then, on the motors with a torque stage (a flux linkage), as long
 /// plus 10 ms at a tenth of the top of the MTPA table, whose last 10 ms give that torque
 /// within 5 % of it plus 1 % of the table's top (the torque of the true currents, (2.33): an observer started

@@ -59,7 +59,8 @@
 //! timing are each what `verify` models at the other motors' ratios of carrier to
 //! electrical frequency. So fischer-ti085's run asserts what holds at every phase — the
 //! duty reaches its limit and never passes it, and no conversion samples inside an edge
-//! — and reports its comparison with verify without asserting it.
+//! — and reports its comparison with verify without asserting it. The ignored test
+//! [`duty_limit_at_four_carrier_phases`] prints these figures.
 //!
 //! The one motor with a flux linkage not run: amk-dd5-ipm (400 A board, 7.9 s
 //! simulated, 18 s of CPU) reaches the limit (49 periods) and never passes it, but its
@@ -381,5 +382,27 @@ fn a_duty_one_tick_beyond_the_limit_samples_inside_an_edge() {
             "{motor} on {board}: compare values one tick beyond the limit passed (peak duty {})",
             o.peak_duty
         ),
+    }
+}
+
+/// The figures of the module documentation's carrier-phase paragraph, reproducible: every
+/// pair of [`BENCHES`] at the carrier phases 0, ¼, ½ and ¾ of a period, printed, nothing
+/// asserted (the comparison is asserted at phase 0 by the tests above). Ignored in CI
+/// (about 3 minutes of CPU, fischer-ti085's four runs the most):
+/// `cargo test -p motor-emulator --test it -- --ignored duty_limit_at_four_carrier_phases --nocapture`.
+#[test]
+#[ignore = "a measurement, printed: about 3 minutes of CPU"]
+fn duty_limit_at_four_carrier_phases() {
+    for (board, motor) in BENCHES {
+        check_fits(motor, board);
+        for phase in [0.0, 0.25, 0.5, 0.75] {
+            match step_at_top_speed(motor, board, Patches::default(), phase) {
+                Ok(o) => println!(
+                    "{motor} on {board}, carrier phase {phase}: torque {:.2} of the tolerance, currents {:.3} A of {:.3}, {} periods within a tick of the limit, peak duty {:.5}",
+                    o.torque_ratio, o.worst_i, o.i_tol, o.at_limit, o.peak_duty
+                ),
+                Err(e) => println!("{motor} on {board}, carrier phase {phase}: {e}"),
+            }
+        }
     }
 }

@@ -110,7 +110,7 @@ fn fischer_image_is_a_g474_flash_image_under_64_kib() {
 /// * the HardFault vector points at the entry in app/src/board/fault.rs, which moves
 ///   MSP to `_stack_start` before anything could push onto the overflowed stack;
 /// * the fault record and the live control state are in `.uninit` (not zeroed at boot)
-///   under their documented symbols, 15 and 8 words.
+///   under their documented symbols, 16 and 8 words.
 #[test]
 fn stack_below_the_statics_and_the_fault_record_in_uninit() {
     use object::{Object, ObjectSection, ObjectSymbol};
@@ -145,11 +145,11 @@ fn stack_below_the_statics_and_the_fault_record_in_uninit() {
     }
     assert!(ram_sections >= 2, "found .bss and .uninit");
 
-    // The record: 6 + 8 + 1 words (magic, cause, flags, PC, CFSR, HFSR; state with the
-    // bus-off count; CRC).
+    // The record: 7 + 8 + 1 words (magic, cause, flags, PC, CFSR, HFSR, the start-up
+    // check's measurement; state with the bus-off count; CRC).
     let (uninit_start, _) = symbol("__suninit");
     let (uninit_end, _) = symbol("__euninit");
-    for (name, words) in [("MOTOR_FAULT_RECORD", 15), ("MOTOR_CONTROL_STATE", 8)] {
+    for (name, words) in [("MOTOR_FAULT_RECORD", 16), ("MOTOR_CONTROL_STATE", 8)] {
         let (at, size) = symbol(name);
         assert_eq!(size, 4 * words, "{name} size");
         assert!(

@@ -104,9 +104,8 @@ pub struct Control {
     tripped: bool,
     /// Electrical speed of the last step \[rad/s\], for the over-speed trip.
     omega_e: f32,
-    /// Why this period tripped (and what the start-up check that refused the drive
-    /// measured), recorded at its end with its state.
-    trip_cause: Option<(FaultCause, Option<FaultMeasurement>)>,
+    /// Why this period tripped, recorded at its end with its state.
+    trip_cause: Option<Trip>,
     /// What the last step measured, for a commissioning routine.
     measured: Measured,
     /// The start-up measurement of the current sensing's zero level.
@@ -121,6 +120,14 @@ pub struct Control {
     acquisition: Acquisition,
     /// The trips, about the measured zero levels once known.
     trips: Trips,
+}
+
+/// A trip waiting for the period's end to be recorded: its cause and what the start-up
+/// check that refused the drive measured.
+#[derive(Clone, Copy)]
+struct Trip {
+    cause: FaultCause,
+    measured: Option<FaultMeasurement>,
 }
 
 /// Passes the [`Control`] from `run` to the interrupt once.
@@ -167,7 +174,7 @@ impl Control {
     /// record's measurement).
     fn refuse(&mut self, cause: FaultCause, measured: Option<FaultMeasurement>) {
         if !self.tripped && self.trip_cause.is_none() {
-            self.trip_cause = Some((cause, measured));
+            self.trip_cause = Some(Trip { cause, measured });
         }
         self.tripped = true;
         pwm::outputs_off(&self.tim1);
@@ -272,7 +279,10 @@ impl Control {
         pwm::set_compare(&self.tim1, out.compare);
         let on = bringup::finish_period(&mut pwm::Break(&self.tim1), &mut self.tripped, run);
         if self.tripped && !was_tripped && self.trip_cause.is_none() {
-            self.trip_cause = Some((FaultCause::Break, None));
+            self.trip_cause = Some(Trip {
+                cause: FaultCause::Break,
+                measured: None,
+            });
         }
         let periods = TICKS.fetch_add(1, Ordering::Relaxed).wrapping_add(1);
         fault::keep_state(&ControlState {
@@ -292,8 +302,8 @@ impl Control {
     /// Seals the fault record once, for the first trip (the drive stays off until
     /// reset, and the record waits for it).
     fn record_trip(&mut self) {
-        if let Some((cause, measured)) = self.trip_cause.take() {
-            fault::record(cause, measured);
+        if let Some(t) = self.trip_cause.take() {
+            fault::record(t.cause, t.measured);
         }
     }
 }

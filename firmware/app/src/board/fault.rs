@@ -45,7 +45,7 @@ pub fn halt() -> ! {
 /// Records `cause` (with the control state of the last period) and stops.
 pub fn stop(cause: FaultCause) -> ! {
     cortex_m::interrupt::disable();
-    let record = seal(cause, None, 0, 0, None);
+    let record = seal(FaultRecord::of(cause));
     outputs_off_and_wait(&record)
 }
 
@@ -99,7 +99,12 @@ extern "C" fn hard_fault(sp: u32) -> ! {
     // SAFETY: `classify_hard_fault` returns an address only when the whole exception
     // frame lies inside the stack region, which is RAM.
     let pc = pc_at.map(|a| unsafe { core::ptr::read_volatile(a as *const u32) });
-    let record = seal(cause, pc, cfsr, hfsr, None);
+    let record = seal(FaultRecord {
+        pc,
+        cfsr,
+        hfsr,
+        ..FaultRecord::of(cause)
+    });
     outputs_off_and_wait(&record)
 }
 
@@ -159,20 +164,18 @@ pub fn keep_state(state: &ControlState) {
 /// Records a trip of the control interrupt (the outputs are already off; the drive
 /// stays off until reset), with what the start-up check that refused the drive measured.
 pub fn record(cause: FaultCause, measured: Option<FaultMeasurement>) {
-    seal(cause, None, 0, 0, measured);
+    seal(FaultRecord {
+        measured,
+        ..FaultRecord::of(cause)
+    });
 }
 
-/// Seals a record of `cause` with the live control state; returns it.
-fn seal(cause: FaultCause, pc: Option<u32>, cfsr: u32, hfsr: u32, measured: Option<FaultMeasurement>) -> FaultRecord {
+/// Seals `record` with the live control state; returns it.
+fn seal(record: FaultRecord) -> FaultRecord {
     let state = read_words((&raw const MOTOR_CONTROL_STATE).cast());
     let record = FaultRecord {
-        cause,
-        pc,
-        cfsr,
-        hfsr,
         state: ControlState::from_words(&state),
-        reported: false,
-        measured,
+        ..record
     };
     write_words((&raw mut MOTOR_FAULT_RECORD).cast(), &record.to_words());
     record

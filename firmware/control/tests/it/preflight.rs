@@ -54,6 +54,7 @@ fn bench() -> Bench {
 /// The refusal of `r`, its fault and measured figure (panics on a pass).
 fn refused(r: Result<PulseFigures, Refusal>) -> (PreflightFault, FaultMeasurement) {
     let r = r.expect_err("refused");
+    println!("refused: {r:?}");
     (r.fault, r.measured)
 }
 
