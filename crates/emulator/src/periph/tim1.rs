@@ -52,6 +52,9 @@ pub struct Tim1 {
     regs: [u32; 0x70 / 4],
     /// Active compare values CCR1..CCR4 (the preload registers are `regs`).
     active_ccr: [u32; 4],
+    /// CCR1..CCR3 active in the window before the current one: where its OCxREF rose,
+    /// an edge the window's start cuts, whose dead time may reach into this window.
+    previous_ccr: [u32; 3],
     /// Whether BDTR has been written since reset (LOCK is frozen after that).
     bdtr_written: bool,
     /// Counter start [timer ticks since reset... in bus sub-ticks], when running.
@@ -106,6 +109,7 @@ impl Tim1 {
         Self {
             regs,
             active_ccr: [0; 4],
+            previous_ccr: [0; 3],
             bdtr_written: false,
             started_at: None,
             tick: 8,
@@ -257,6 +261,8 @@ impl Tim1 {
     pub fn update_at(&mut self, t: u64) {
         if self.regs[0] & UDIS != 0 {
             self.updates_disabled += 1;
+            // A new window with the same compare values.
+            self.previous_ccr = [self.active_ccr[0], self.active_ccr[1], self.active_ccr[2]];
             return;
         }
         if let Some(tr) = self.written_after_trigger.take() {
@@ -268,6 +274,7 @@ impl Tim1 {
     /// The update event: preloaded compare values become active (OCxPE, RM0440
     /// §28.3.10), REP_CNT is reloaded from RCR, UIF is set.
     pub fn update(&mut self) {
+        self.previous_ccr = [self.active_ccr[0], self.active_ccr[1], self.active_ccr[2]];
         for ch in 0..4 {
             self.active_ccr[ch] = self.regs[(0x34 / 4) + ch];
         }
@@ -364,10 +371,10 @@ impl Tim1 {
                 let dead = self.dead_ticks() as f64 * tick_s;
                 match (e, ne) {
                     (false, false) => (None, None),
-                    (true, true) => (
-                        Some(xor(&r.delay_rise(dead), p)),
-                        Some(xor(&r.not().delay_rise(dead), np)),
-                    ),
+                    (true, true) => {
+                        let (hi, lo) = self.across_the_window_start(ch, &r, dead, tick_s);
+                        (Some(xor(&hi, p)), Some(xor(&lo, np)))
+                    }
                     (true, false) => (Some(xor(&r, p)), if ossr { level(np) } else { None }),
                     (false, true) => (if ossr { level(p) } else { None }, Some(xor(&r, np))),
                 }
@@ -376,6 +383,37 @@ impl Tim1 {
             out[ch + 3] = lo;
         }
         out
+    }
+
+    /// The dead-time generator's two outputs before their polarities (RM0440 §28.3.15:
+    /// each output rises the dead time after its OCxREF edge, falls with it) over the
+    /// window of [`Tim1::outputs`], `r` its OCxREF. Within the window each rising edge is
+    /// delayed by `dead`. An interval that starts with the window did not rise there: with
+    /// the update at the underflow OCxREF's high pulse spans the window's start (CNT < CCR
+    /// on both sides of CNT = 0), having risen `CCR_prev` ticks before it, the previous
+    /// window's compare value — so its output turns on only `dead − CCR_prev` ticks into
+    /// this window when CCR_prev is below the dead time (a bottom leg near its limit p =
+    /// ⌈t_d/2⌉ ticks, `codegen::design::duty_limit`), and at `dead` when OCxREF was low
+    /// at the previous window's end (CCR_prev = 0); likewise the complement, high from the
+    /// start only with CCR = 0, rose there if OCxREF was high at the previous window's end.
+    /// Until stop 43 the window's first interval was taken as on from the start: such a leg
+    /// got up to `dead` of high time the timer never gives. With the update at the
+    /// overflow (the pulse centred in the window, no straddling high pulse) the window's
+    /// first interval is taken as is.
+    fn across_the_window_start(&self, ch: usize, r: &Wave, dead: f64, tick_s: f64) -> (Wave, Wave) {
+        let (mut hi, mut lo) = (r.delay_rise(dead), r.not().delay_rise(dead));
+        if self.update_at_overflow {
+            return (hi, lo);
+        }
+        let len = r.len;
+        let prev = f64::from(self.previous_ccr.get(ch).copied().unwrap_or(0)).min(f64::from(self.arr));
+        let from = |start: f64| Wave::from_intervals(len, vec![(start.max(0.0), len)]);
+        if r.at(0.0) {
+            hi = hi.and(&from(dead - prev * tick_s));
+        } else if prev > 0.0 {
+            lo = lo.and(&from(dead));
+        }
+        (hi, lo)
     }
 
     /// Seconds per timer tick.
@@ -641,5 +679,36 @@ mod tests {
         // RCR written after the first overflow: refused.
         let mut t2 = setup(0);
         assert!(t2.write(0x30, 1, 80 + 100 * 8).is_err());
+    }
+
+    /// The dead time of an edge the window's start cuts (update at the underflow, ARR =
+    /// 100, dead time 20 ticks, by hand): with the previous window's CCR = 30 the high
+    /// pulse rose 30 ticks before the window, so its output is on from the start; with
+    /// CCR = 8 it rose 8 ticks before, its output turns on 20 − 8 = 12 ticks in; with
+    /// CCR = 0 OCxREF rose at the window's start, on from 20. Within the window the rise
+    /// at 200 − 30 = 170 turns on at 190, and the complement (falling edge at 30) at 50.
+    #[test]
+    fn dead_time_across_the_window_start() {
+        let tick_s = 1e-8;
+        let mut t = Tim1::new();
+        // PWM mode 1 on CH1 (OC1M = 0110).
+        t.write(0x18, 0b110 << 4, 0).unwrap();
+        t.arr = 100;
+        t.started_at = Some(0);
+        t.active_ccr[0] = 30;
+        let r = t.ref_wave(0, tick_s);
+        let dead = 20.0 * tick_s;
+        let first_on = |t: &Tim1| t.across_the_window_start(0, &r, dead, tick_s).0.high[0].0 / tick_s;
+        for (previous, on_at) in [(30, 0.0), (8, 12.0), (0, 20.0)] {
+            t.previous_ccr[0] = previous;
+            assert!(
+                (first_on(&t) - on_at).abs() < 1e-9,
+                "CCR_prev {previous}: {}",
+                first_on(&t)
+            );
+        }
+        let (hi, lo) = t.across_the_window_start(0, &r, dead, tick_s);
+        assert!((hi.high[1].0 / tick_s - 190.0).abs() < 1e-9);
+        assert!((lo.high[0].0 / tick_s - 50.0).abs() < 1e-9);
     }
 }
