@@ -170,13 +170,17 @@ impl Rig {
         first_enabled_period(&self.machine).ok_or_else(|| "no enabled period".into())
     }
 
+    /// The address of the image's fault record (`MOTOR_FAULT_RECORD`) if it holds one of
+    /// this layout (word 0 the magic).
+    fn sealed_record(&self) -> Option<u32> {
+        let at = self.machine.symbol("MOTOR_FAULT_RECORD")?;
+        (self.machine.peek(at).ok()? == FAULT_RECORD_MAGIC).then_some(at)
+    }
+
     /// The cause the image sealed in its fault record (`MOTOR_FAULT_RECORD` word 1,
     /// firmware README "Fault record"), if the record is valid.
     pub fn fault_cause(&self) -> Option<String> {
-        let at = self.machine.symbol("MOTOR_FAULT_RECORD")?;
-        if self.machine.peek(at).ok()? != FAULT_RECORD_MAGIC {
-            return None;
-        }
+        let at = self.sealed_record()?;
         let cause = self.machine.peek(at + 4).ok()?;
         let name = match cause {
             1 => "HardFault",
@@ -207,10 +211,7 @@ impl Rig {
     /// record (word 6, an f32, and the index in bits 4–5 of word 2; firmware README
     /// "Fault record", read as a probe would): `None` without a record or a measurement.
     pub fn fault_measurement(&self) -> Option<(f32, u8)> {
-        let at = self.machine.symbol("MOTOR_FAULT_RECORD")?;
-        if self.machine.peek(at).ok()? != FAULT_RECORD_MAGIC {
-            return None;
-        }
+        let at = self.sealed_record()?;
         let flags = self.machine.peek(at + 8).ok()?;
         if flags & RECORD_HAS_MEASURED == 0 {
             return None;
@@ -222,9 +223,16 @@ impl Rig {
     /// The CAN bus-off count the control interrupt last wrote into its state
     /// (`MOTOR_CONTROL_STATE` word 6, firmware README "Fault record"), if written.
     pub fn bus_off_count(&self) -> Option<u32> {
+        let flags = self.live_state(7)?;
+        (flags >> 31 == 1).then(|| self.live_state(6)).flatten()
+    }
+
+    /// Word `k` of the control state the control interrupt last wrote
+    /// (`MOTOR_CONTROL_STATE`, firmware README "Fault record": 0 i_d, 1 i_q, 2 θ_e,
+    /// 3 ω_e, 4 U_dc, 5 periods, 6 bus-offs, 7 flags).
+    pub fn live_state(&self, k: u32) -> Option<u32> {
         let at = self.machine.symbol("MOTOR_CONTROL_STATE")?;
-        let flags = self.machine.peek(at + 4 * 7).ok()?;
-        (flags >> 31 == 1).then(|| self.machine.peek(at + 4 * 6).ok()).flatten()
+        self.machine.peek(at + 4 * k).ok()
     }
 
     /// The standstill analog source, to change currents or the DC link.

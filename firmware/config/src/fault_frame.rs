@@ -78,13 +78,9 @@ mod tests {
     fn trip_report() {
         assert_eq!(can::FAULT_CURRENT_PER_LSB, 0.1);
         let r = FaultRecord {
-            cause: FaultCause::Trip,
             pc: Some(0x0800_1234),
-            cfsr: 0,
-            hfsr: 0,
             state: Some(state(212.26)),
-            reported: false,
-            measured: None,
+            ..FaultRecord::of(FaultCause::Trip)
         };
         let d = encode(&r);
         assert_eq!(d, [4, 0x0F, 0x34, 0x12, 0x00, 0x08, 0x4B, 0x08]);
@@ -95,15 +91,7 @@ mod tests {
     /// NaN (documented as "not a number").
     #[test]
     fn bare_and_saturated() {
-        let mut r = FaultRecord {
-            cause: FaultCause::Watchdog,
-            pc: None,
-            cfsr: 0,
-            hfsr: 0,
-            state: None,
-            reported: false,
-            measured: None,
-        };
+        let mut r = FaultRecord::of(FaultCause::Watchdog);
         assert_eq!(encode(&r), [9, 0, 0, 0, 0, 0, 0, 0]);
         r.state = Some(state(5000.0));
         assert_eq!(&encode(&r)[6..], &0x7FFFu16.to_le_bytes());
@@ -119,17 +107,13 @@ mod tests {
     #[test]
     fn measurement_report() {
         let mut r = FaultRecord {
-            cause: FaultCause::ResolverSignal,
-            pc: None,
-            cfsr: 0,
-            hfsr: 0,
             state: Some(ControlState {
                 running: false,
                 tripped: false,
                 ..state(0.0)
             }),
-            reported: false,
             measured: Some(FaultMeasurement::of(0.25)),
+            ..FaultRecord::of(FaultCause::ResolverSignal)
         };
         assert_eq!(encode(&r), [19, 0x12, 0x00, 0x00, 0x80, 0x3E, 0, 0]);
         r.cause = FaultCause::CurrentOffset;

@@ -332,13 +332,8 @@ impl FaultRecord {
 pub fn at_boot(record: &[u32; RECORD_WORDS], state: &[u32; STATE_WORDS], watchdog_reset: bool) -> Option<FaultRecord> {
     FaultRecord::from_words(record).or_else(|| {
         watchdog_reset.then(|| FaultRecord {
-            cause: FaultCause::Watchdog,
-            pc: None,
-            cfsr: 0,
-            hfsr: 0,
             state: ControlState::from_words(state),
-            reported: false,
-            measured: None,
+            ..FaultRecord::of(FaultCause::Watchdog)
         })
     })
 }
@@ -390,10 +385,7 @@ mod tests {
 
     fn record() -> FaultRecord {
         FaultRecord {
-            cause: FaultCause::Trip,
             pc: Some(0x0800_1234),
-            cfsr: 0,
-            hfsr: 0,
             state: Some(ControlState {
                 i_d: -1.5,
                 i_q: 212.25,
@@ -405,8 +397,7 @@ mod tests {
                 running: true,
                 tripped: true,
             }),
-            reported: false,
-            measured: None,
+            ..FaultRecord::of(FaultCause::Trip)
         }
     }
 
@@ -425,13 +416,10 @@ mod tests {
         let r = record();
         assert_eq!(FaultRecord::from_words(&r.to_words()), Some(r));
         let bare = FaultRecord {
-            cause: FaultCause::StackOverflow,
-            pc: None,
             cfsr: CFSR_STKERR,
             hfsr: 1 << 30,
-            state: None,
             reported: true,
-            measured: None,
+            ..FaultRecord::of(FaultCause::StackOverflow)
         };
         assert_eq!(FaultRecord::from_words(&bare.to_words()), Some(bare));
         // A start-up check's refusal with its figure: phase w's zero level 2 992 codes

@@ -404,8 +404,7 @@ fn every_pair_boots_with_the_rotor_at_any_angle() {
 /// The image's ω̂_e \[rad/s\] of the last period (`ControlState` word 3, firmware README
 /// "Fault record").
 fn observed_speed(rig: &Rig) -> f64 {
-    let at = rig.machine.symbol("MOTOR_CONTROL_STATE").expect("live state symbol");
-    f64::from(f32::from_bits(rig.machine.peek(at + 12).unwrap()))
+    f64::from(f32::from_bits(rig.live_state(3).expect("live state")))
 }
 
 /// Power-up with the rotor turning (a drive reset by its watchdog in a moving vehicle, or

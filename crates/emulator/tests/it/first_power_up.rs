@@ -60,8 +60,7 @@ fn rig_with_errors(motor: &str, board: &str, errors: impl Fn(f64) -> [f64; 3]) -
 
 /// The image's measured i_d, i_q \[A\] of the last period (`ControlState` words 0, 1).
 fn measured_dq(rig: &Rig) -> (f64, f64) {
-    let at = rig.machine.symbol("MOTOR_CONTROL_STATE").expect("live state symbol");
-    let word = |k: u32| f64::from(f32::from_bits(rig.machine.peek(at + 4 * k).unwrap()));
+    let word = |k: u32| f64::from(f32::from_bits(rig.live_state(k).expect("live state")));
     (word(0), word(1))
 }
 
