@@ -192,7 +192,7 @@ static const float CHALMERS_HEV50_LIMITS_SWITCHING_FREQUENCY_HZ = 10000.0f;
  *  Inputs: f_s = 10000 Hz (spec). */
 static const float CHALMERS_HEV50_LIMITS_SAMPLE_PERIOD_S = 0.0001f;
 
-/** 184.752 V: k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's shortest pulse leaves a little less), thesis B (2.50); design::duty_limit.
+/** 184.752 V: k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's gap p = t_d at either end of the carrier leaves a little less), thesis B (2.50); design::duty_limit.
  *  Inputs: U_dc = 320 V (spec), k = 1. */
 static const float CHALMERS_HEV50_LIMITS_VOLTAGE_LIMIT_V = 184.75209f;
 

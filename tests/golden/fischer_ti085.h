@@ -192,7 +192,7 @@ static const float FISCHER_TI085_LIMITS_SWITCHING_FREQUENCY_HZ = 20000.0f;
  *  Inputs: f_s = 20000 Hz (spec). */
 static const float FISCHER_TI085_LIMITS_SAMPLE_PERIOD_S = 5e-5f;
 
-/** 346.41 V: k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's shortest pulse leaves a little less), thesis B (2.50); design::duty_limit.
+/** 346.41 V: k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's gap p = t_d at either end of the carrier leaves a little less), thesis B (2.50); design::duty_limit.
  *  Inputs: U_dc = 600 V (spec), k = 1. */
 static const float FISCHER_TI085_LIMITS_VOLTAGE_LIMIT_V = 346.41016f;
 

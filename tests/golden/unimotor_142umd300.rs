@@ -195,7 +195,7 @@ pub mod limits {
     ///
     /// Inputs: f_s = 20000 Hz (spec).
     pub const SAMPLE_PERIOD_S: f32 = 5e-5;
-    /// 346.41 V: `k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's shortest pulse leaves a little less)`, thesis B (2.50); design::duty_limit.
+    /// 346.41 V: `k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's gap p = t_d at either end of the carrier leaves a little less)`, thesis B (2.50); design::duty_limit.
     ///
     /// Inputs: U_dc = 600 V (spec), k = 1.
     pub const VOLTAGE_LIMIT_V: f32 = 346.41016;

@@ -49,17 +49,21 @@ fn edit(text: &str, edits: &[(&str, &str)]) -> String {
 /// (key, value) edits of one file.
 type Edits = Vec<(&'static str, &'static str)>;
 
+/// One group of boundary cases: the file (home and base), its edits, and the edits of
+/// the partner file `check` pairs it with.
+type Group = (Home, &'static str, Edits, &'static [(&'static str, &'static str)]);
+
 /// The boundary cases' accepted values, grouped per file: each case joins the first group
-/// of its file (home and base) whose keys it does not set otherwise and with which `check`
-/// still accepts the pair; returns (home, base, edits) per group.
-fn boundary_groups() -> Vec<(Home, &'static str, Edits)> {
-    let mut groups: Vec<(Home, &'static str, Edits)> = Vec::new();
+/// of its file (home, base and partner edits) whose keys it does not set otherwise and
+/// with which `check` still accepts the pair.
+fn boundary_groups() -> Vec<Group> {
+    let mut groups: Vec<Group> = Vec::new();
     for l in FIRMWARE_LIMITS {
         for c in l.cases {
             let mut mine: Vec<(&str, &str)> = c.also.to_vec();
             mine.push((c.key, c.accepted));
-            let joined = groups.iter_mut().find(|(home, base, edits)| {
-                if *home != c.home || *base != c.base {
+            let joined = groups.iter_mut().find(|(home, base, edits, partner)| {
+                if *home != c.home || *base != c.base || *partner != c.partner {
                     return false;
                 }
                 let clash = mine
@@ -70,26 +74,30 @@ fn boundary_groups() -> Vec<(Home, &'static str, Edits)> {
                 }
                 let mut all = edits.clone();
                 all.extend(mine.iter().copied());
-                pair(*home, base, &all).is_ok_and(|(m, b)| accepted(&m, &b).is_ok())
+                pair(*home, base, &all, partner).is_ok_and(|(m, b)| accepted(&m, &b).is_ok())
             });
             match joined {
-                Some((_, _, edits)) => edits.extend(mine),
-                None => groups.push((c.home, c.base, mine)),
+                Some((_, _, edits, _)) => edits.extend(mine),
+                None => groups.push((c.home, c.base, mine, c.partner)),
             }
         }
     }
     groups
 }
 
-/// The motor and board texts of a group: the edited file and the default partner.
-fn pair(home: Home, base: &str, edits: &[(&str, &str)]) -> Result<(String, String), String> {
+/// The motor and board texts of a group: the edited file and the default partner with
+/// `partner`'s edits.
+fn pair(home: Home, base: &str, edits: &[(&str, &str)], partner: &[(&str, &str)]) -> Result<(String, String), String> {
     Ok(match home {
         Home::Spec => (
             edit(&read(&format!("motors/{base}.toml")), edits),
-            read(&format!("boards/{}.toml", codegen::board::DEFAULT_BOARD)),
+            edit(
+                &read(&format!("boards/{}.toml", codegen::board::DEFAULT_BOARD)),
+                partner,
+            ),
         ),
         Home::Board => (
-            read("motors/fischer-ti085.toml"),
+            edit(&read("motors/fischer-ti085.toml"), partner),
             edit(&read(&format!("boards/{base}.toml")), edits),
         ),
     })
@@ -101,10 +109,10 @@ fn the_image_builds_at_every_limit_check_accepts() {
     let cases: usize = FIRMWARE_LIMITS.iter().map(|l| l.cases.len()).sum();
     println!("{cases} boundary cases in {} builds", groups.len());
     assert!(groups.len() < cases, "the cases should share builds");
-    for (k, (home, base, edits)) in groups.iter().enumerate() {
-        let (motor, board) = pair(*home, base, edits).unwrap();
+    for (k, (home, base, edits, partner)) in groups.iter().enumerate() {
+        let (motor, board) = pair(*home, base, edits, partner).unwrap();
         if let Err(e) = accepted(&motor, &board) {
-            panic!("{base} with {edits:?}: check refuses the accepted values together:\n{e}");
+            panic!("{base} with {edits:?} (partner {partner:?}): check refuses the accepted values together:\n{e}");
         }
         let t = std::time::Instant::now();
         if let Err(e) = build(&format!("boundary-{k}"), &motor, &board) {

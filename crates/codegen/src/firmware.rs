@@ -57,9 +57,9 @@ pub const CAN_SAMPLE_POINT: f64 = 0.875;
 /// controller's bit time is programmable from at least 8 quanta).
 pub const CAN_MIN_TQ_PER_BIT: u32 = 8;
 /// Most time quanta per nominal bit the FDCAN allows: 1 + 256 + 128 = 385 (RM0440
-/// §44.4.9, FDCAN_NBTP: NTSEG1 up to 256 quanta, NTSEG2 up to 128).
+/// §44.4.7, FDCAN_NBTP: NTSEG1 up to 256 quanta, NTSEG2 up to 128).
 pub const CAN_MAX_TQ_PER_BIT: u32 = 385;
-/// Largest nominal prescaler (NBRP + 1, RM0440 §44.4.9: NBRP 0 … 511).
+/// Largest nominal prescaler (NBRP + 1, RM0440 §44.4.7: NBRP 0 … 511).
 pub const CAN_MAX_PRESCALER: u32 = 512;
 
 /// Classic CAN's largest nominal bit rate \[bit/s\] (ISO 11898-1).
@@ -142,7 +142,7 @@ pub fn max_watchdog_timeout_s() -> f64 {
 }
 
 /// The shortest watchdog timeout the IWDG makes \[s\]: prescaler /4 with reload 1, 4 LSI
-/// ticks (125 µs at 32 kHz; RM0440 §41.3). The firmware's computation rounds a shorter
+/// ticks (125 µs at 32 kHz; RM0440 §42.3). The firmware's computation rounds a shorter
 /// request up to it, so `check` refuses one instead of building a longer timeout than
 /// asked.
 pub fn min_watchdog_timeout_s() -> f64 {
@@ -156,7 +156,7 @@ pub fn watchdog(seconds: f64) -> Result<(u8, u16), Refusal> {
     if seconds < shortest * (1.0 - 1e-9) {
         return Err(Refusal {
             problem: format!(
-                "{seconds} s is {:.2} ticks of the {} kHz LSI; the IWDG's shortest timeout is 4 ticks ({:.0} µs: prescaler /4, reload 1, RM0440 §41.3), so the image would wait longer than asked",
+                "{seconds} s is {:.2} ticks of the {} kHz LSI; the IWDG's shortest timeout is 4 ticks ({:.0} µs: prescaler /4, reload 1, RM0440 §42.3), so the image would wait longer than asked",
                 seconds * f64::from(LSI_HZ),
                 LSI_HZ / 1000,
                 shortest * 1e6
@@ -173,7 +173,7 @@ pub fn watchdog(seconds: f64) -> Result<(u8, u16), Refusal> {
     }
     Err(Refusal {
         problem: format!(
-            "{seconds} s is {:.0} ticks of the {} kHz LSI; the IWDG counts at most 256·{IWDG_MAX_RELOAD} = {} ticks ({:.2} s; prescaler /256, 12-bit reload, RM0440 §41.3)",
+            "{seconds} s is {:.0} ticks of the {} kHz LSI; the IWDG counts at most 256·{IWDG_MAX_RELOAD} = {} ticks ({:.2} s; prescaler /256, 12-bit reload, RM0440 §42.3)",
             seconds * f64::from(LSI_HZ),
             LSI_HZ / 1000,
             256 * IWDG_MAX_RELOAD,
@@ -187,7 +187,7 @@ pub fn watchdog(seconds: f64) -> Result<(u8, u16), Refusal> {
     })
 }
 
-/// The nominal bit timing of FDCAN1 (RM0440 §44.4.9): prescaler, time quanta and the
+/// The nominal bit timing of FDCAN1 (RM0440 §44.4.7): prescaler, time quanta and the
 /// FDCAN_NBTP value that holds them.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct CanBitTiming {
@@ -288,14 +288,14 @@ pub fn can_bit_rate(kernel_hz: u32, bit_rate: f64) -> Result<CanBitTiming, Refus
         .filter(|&&r| can_bit_timing(kernel_hz, f64::from(r)).is_some())
         .map(|&r| bit_rate_text(f64::from(r)))
         .collect();
-    // The image runs FDCAN1 as classic CAN (CCCR.FDOE left at its reset 0, RM0440 §44.4.1;
+    // The image runs FDCAN1 as classic CAN (CCCR.FDOE left at its reset 0, RM0440 §44.4.6;
     // firmware/app/src/board/can.rs), whose nominal bit rate ends at 1 Mbit/s (ISO
     // 11898-1; CiA 301's table ends there): a faster rate would build, and no classic
     // node on the bus could follow it.
     if bit_rate > f64::from(CLASSIC_CAN_MAX_BIT_RATE) {
         return Err(Refusal {
             problem: format!(
-                "{} is beyond classic CAN's nominal bit rate of at most 1 Mbit/s (ISO 11898-1): the image runs FDCAN1 in classic mode (FDCAN_CCCR.FDOE = 0, RM0440 §44.4.1), where a bit rate switch does not exist",
+                "{} is beyond classic CAN's nominal bit rate of at most 1 Mbit/s (ISO 11898-1): the image runs FDCAN1 in classic mode (FDCAN_CCCR.FDOE = 0, RM0440 §44.4.6), where a bit rate switch does not exist",
                 bit_rate_text(bit_rate)
             ),
             accepted: format!(
@@ -328,7 +328,7 @@ pub fn can_bit_rate(kernel_hz: u32, bit_rate: f64) -> Result<CanBitTiming, Refus
     let clocks = f64::from(kernel_hz) / bit_rate;
     Err(Refusal {
         problem: format!(
-            "the FDCAN kernel clock ({} MHz, PCLK1) cannot make {} exactly: a bit is {clocks:.4} clock periods, not a whole prescaler (1 … {CAN_MAX_PRESCALER}) × quanta ({CAN_MIN_TQ_PER_BIT} … {CAN_MAX_TQ_PER_BIT}) (RM0440 §44.4.9); every node of a bus must run the same nominal rate",
+            "the FDCAN kernel clock ({} MHz, PCLK1) cannot make {} exactly: a bit is {clocks:.4} clock periods, not a whole prescaler (1 … {CAN_MAX_PRESCALER}) × quanta ({CAN_MIN_TQ_PER_BIT} … {CAN_MAX_TQ_PER_BIT}) (RM0440 §44.4.7); every node of a bus must run the same nominal rate",
             f64::from(kernel_hz) / 1e6,
             bit_rate_text(bit_rate)
         ),
@@ -397,6 +397,9 @@ pub struct Case {
     pub refused: &'static str,
     /// Further (key, value) edits of the same file, applied to both.
     pub also: &'static [(&'static str, &'static str)],
+    /// (key, value) edits of the file `check` pairs it with (the default board for a
+    /// spec, fischer-ti085 for a board), where another limit would bind first there.
+    pub partner: &'static [(&'static str, &'static str)],
     /// The hand calculation.
     pub why: &'static str,
 }
@@ -437,6 +440,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 ("fir.pass_edge", "\"20 Hz\""),
                 ("fir.stop_edge", "\"400 Hz\""),
             ],
+            partner: &[],
             why: "ARR = 170e6/(2·f_s) + ½ truncated: 1298 Hz → 65485.9 → 65485 ≤ 65535; 1297 Hz → 65536.4 > 65535 (the limit is f_s = 170e6/(2·65534.5) = 1297.03 Hz); the Unimotor (5 pole pairs) at 1000 rpm has 12·f_e,max = 1000 Hz, so (1.1) does not bind, and its identification FIR's edges move below the Nyquist frequency (649 Hz)",
         }],
     },
@@ -453,7 +457,11 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 accepted: "\"5929 ns\"",
                 refused: "\"5930 ns\"",
                 also: &[],
-                why: "⌈5929·0.17⌉ = ⌈1007.93⌉ = 1008 ticks ≤ 1008; ⌈5930·0.17⌉ = ⌈1008.1⌉ = 1009 > 1008",
+                partner: &[
+                    ("drive.switching_frequency", "\"19 kHz\""),
+                    ("motor.datasheet.max_speed", "\"10000 rpm\""),
+                ],
+                why: "⌈5929·0.17⌉ = ⌈1007.93⌉ = 1008 ticks ≤ 1008; ⌈5930·0.17⌉ = ⌈1008.1⌉ = 1009 > 1008; fischer-ti085 at 19 kHz (ARR 4474, d_max = 3466/4474 = 0.775) and 10 000 rpm, as at 20 kHz the duty limit (4250 − 1008)/4250 = 0.763 would leave less than half of U_dc/√3 first, and at 19 kHz 0.506 of it is too little for 20 000 rpm (design::duty_limit)",
             },
             Case {
                 home: Home::Spec,
@@ -461,15 +469,19 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 key: "drive.dead_time",
                 accepted: "\"5.929 µs\"",
                 refused: "\"6 µs\"",
-                also: &[],
-                why: "5929 ns → 1008 ticks; 6000 ns → 1020 ticks > 1008",
+                also: &[
+                    ("drive.switching_frequency", "\"19 kHz\""),
+                    ("motor.datasheet.max_speed", "\"10000 rpm\""),
+                ],
+                partner: &[],
+                why: "5929 ns → 1008 ticks; 6000 ns → 1020 ticks > 1008; at 19 kHz (ARR 4474, d_max = 3466/4474 = 0.775) and 10 000 rpm, as at 20 kHz the duty limit 0.763 would leave less than half of U_dc/√3 first, and at 19 kHz 0.506 of it is too little for 20 000 rpm (design::duty_limit)",
             },
         ],
     },
     FirmwareLimit {
         firmware_messages: &["watchdog timeout out of range"],
         firmware_item: "firmware/config/src/config.rs: WATCHDOG",
-        limit: "IWDG: prescaler /4 … /256, 12-bit reload 1 … 4095: 4 … 256·4095 LSI ticks (125 µs … 32.76 s at 32 kHz, RM0440 §41.3)",
+        limit: "IWDG: prescaler /4 … /256, 12-bit reload 1 … 4095: 4 … 256·4095 LSI ticks (125 µs … 32.76 s at 32 kHz, RM0440 §42.3)",
         rule: "firmware::watchdog, at watchdog.timeout",
         cases: &[
             Case {
@@ -479,6 +491,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 accepted: "\"32.76 s\"",
                 refused: "\"32.77 s\"",
                 also: &[],
+                partner: &[],
                 why: "32.76 s·32 kHz = 1 048 319.9 ticks (f32) → ⌈1 048 319/256⌉ = 4095 ≤ 4095; 32.77 s → 1 048 640 ticks → 4097 > 4095",
             },
             Case {
@@ -488,6 +501,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 accepted: "\"125 µs\"",
                 refused: "\"120 µs\"",
                 also: &[],
+                partner: &[],
                 why: "125 µs·32 kHz = 4 ticks: prescaler /4, reload 1, the IWDG's shortest; 120 µs = 3.84 ticks, which the firmware's rounding would make 125 µs (longer than asked). The reference board's motors run T_s ≤ 50 µs, so 125 µs ≥ 2·T_s",
             },
         ],
@@ -495,7 +509,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
     FirmwareLimit {
         firmware_messages: &["the generated CAN bit timing does not make the board's bit rate from the FDCAN clock"],
         firmware_item: "firmware/app/src/board/can.rs: NBTP",
-        limit: "FDCAN_NBTP: kernel clock = rate·prescaler (1 … 512)·quanta (8 … 385), TSEG1 ≤ 256, TSEG2 ≤ 128 (RM0440 §44.4.9)",
+        limit: "FDCAN_NBTP: kernel clock = rate·prescaler (1 … 512)·quanta (8 … 385), TSEG1 ≤ 256, TSEG2 ≤ 128 (RM0440 §44.4.7)",
         rule: "firmware::can_bit_rate, at can.bit_rate (the board's NBTP is generated from it)",
         cases: &[
             Case {
@@ -505,6 +519,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 accepted: "\"1 Mbit/s\"",
                 refused: "\"800 kbit/s\"",
                 also: &[],
+                partner: &[],
                 why: "170 MHz/1 Mbit/s = 170 = 1·170 (prescaler 1, 170 quanta); 170 MHz/800 kbit/s = 212.5 clock periods: no whole prescaler·quanta",
             },
             Case {
@@ -514,6 +529,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 accepted: "\"125 kbit/s\"",
                 refused: "\"83.333 kbit/s\"",
                 also: &[],
+                partner: &[],
                 why: "170 MHz/125 kbit/s = 1360 = 5·272 (prescaler 5, 272 quanta); 170 MHz/83 333 bit/s = 2040.0082 periods",
             },
         ],
@@ -531,6 +547,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 accepted: "0x0DA",
                 refused: "0x0DB",
                 also: &[],
+                partner: &[],
                 why: "0x0DA … 0x0DF leaves 0x0E0 free; 0x0DB + 5 = 0x0E0",
             },
             Case {
@@ -540,6 +557,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 accepted: "0x0E1",
                 refused: "0x0E0",
                 also: &[],
+                partner: &[],
                 why: "0x0E1 is above the fault report; 0x0E0 is the fault report",
             },
         ],
@@ -556,13 +574,14 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
             accepted: "\"PB1\"",
             refused: "\"PF0\"",
             also: &[],
+            partner: &[],
             why: "TIM1_CH3N is PB1 (AF6), PB15 (AF4) or PF0 (AF6) on the STM32G474RE (DS12288 Table 13); PF0 is on port F",
         }],
     },
     FirmwareLimit {
         firmware_messages: &["an ADC sequence the JSQR cannot hold"],
         firmware_item: "firmware/config/src/config.rs: JSQR",
-        limit: "1 … 4 injected ranks per converter, channels 0 … 18 (RM0440 §21.4.21, ADC_JSQR)",
+        limit: "1 … 4 injected ranks per converter, channels 0 … 18 (RM0440 §21.7.16, ADC_JSQR)",
         rule: "board parsing (board::sequence::plan): at most four inputs per converter, at the first analog pin (`pins.resolver_sin`)",
         cases: &[Case {
             home: Home::Board,
@@ -578,6 +597,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
                 ("pins.gate_v_low", "\"PA12\""),
                 ("pins.break_input", "\"PA6\""),
             ],
+            partner: &[],
             why: "PA2 (ADC1_IN3), PA3 (ADC1_IN4), PB14 (ADC1_IN5), PB1 (ADC1_IN12) and PB12 (ADC1_IN11) are inputs of ADC1 only (DS12288 Table 13): SIN on PB12 makes five ranks on ADC1 > 4; on PA1 (ADC12_IN2) it goes to ADC2 with COS (PA7, ADC2_IN4); TIM1_CH2N and BKIN move to PA12 (AF6) and PA6 (AF6) to free PB14 and PB12",
         }],
     },
@@ -593,6 +613,7 @@ pub const FIRMWARE_LIMITS: &[FirmwareLimit] = &[
             accepted: "126",
             refused: "127",
             also: &[("fir.stop_edge", "\"300 Hz\"")],
+            partner: &[],
             why: "order 126 = 127 taps ≤ 127; order 127 = 128 taps (a 100–300 Hz transition at 20 kHz, where Kaiser's estimate for order 126 is 14.6·0.01·126 + 13 = 31 dB, far inside what the design resolves)",
         }],
     },

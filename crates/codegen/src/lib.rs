@@ -102,17 +102,32 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
             design::on_board(alone, &board, board_src)?;
             let l = limit.as_ref().expect("a duty limit below 1 comes from one");
             let key = design::duty_limit_key(l);
+            let (what, shorter) = if l.bound == design::duty_limit::DutyBound::DeadTime {
+                (
+                    format!(
+                        "TIM1's dead time of {:.0} ns keeps every compare value {} timer ticks from the carrier's ends, which",
+                        l.dead_time_s * 1e9,
+                        l.min_pulse
+                    ),
+                    "dead time",
+                )
+            } else {
+                (
+                    "the low-side shunts' sampling window".to_string(),
+                    "settling, dead or sampling time",
+                )
+            };
             let mut d = board_src.error(
                 board.span(key),
                 key,
                 format!(
-                    "the low-side shunts' sampling window limits the duty to {:.4} at f_s = {fs} Hz, which leaves {} ({file}) only {:.1} % of U_dc/√3 ({:.2} V): its design does not hold with that voltage (note)",
+                    "{what} limits the duty to {:.4} at f_s = {fs} Hz, which leaves {} ({file}) only {:.1} % of U_dc/√3 ({:.2} V): its design does not hold with that voltage (note)",
                     l.max_duty,
                     spec.name,
                     l.usable_voltage_fraction * 100.0,
                     l.usable_voltage_fraction * spec.drive.dc_link_voltage.value / 3f64.sqrt()
                 ),
-                "a shorter settling, dead or sampling time on the board, a lower switching frequency, or a motor that fits the usable voltage",
+                format!("a shorter {shorter} on the board, a lower switching frequency, or a motor that fits the usable voltage"),
             );
             d.notes.extend(e.0.iter().map(|x| x.to_string()));
             Err(Diagnostics(vec![d]))

@@ -494,14 +494,14 @@ impl Machine {
             let soc = self.uc.get_data_mut();
             let t = soc.time_s();
             // ARMv7-M B1.5.15: a fault in the HardFault handler locks the core up; with
-            // SYSCFG_CFGR2.CLL the LOCKUP output is TIM1's break (RM0440 §11.3.10).
+            // SYSCFG_CFGR2.CLL the LOCKUP output is TIM1's break (RM0440 §10.2.8).
             if soc.syscfg.lockup_to_break() {
                 soc.break_asserted = true;
                 soc.update_break();
             } else if soc.gates_can_switch() {
                 soc.fail(Broken::new(
                     "core LOCKUP",
-                    "the core locked up (a fault inside the HardFault handler, ARMv7-M B1.5.15) with the bridge still switching and SYSCFG_CFGR2.CLL clear: TIM1 keeps running with the last compare values and no code can clear MOE — CLL routes LOCKUP to TIM1's break (RM0440 §11.3.10)",
+                    "the core locked up (a fault inside the HardFault handler, ARMv7-M B1.5.15) with the bridge still switching and SYSCFG_CFGR2.CLL clear: TIM1 keeps running with the last compare values and no code can clear MOE — CLL routes LOCKUP to TIM1's break (RM0440 §10.2.8)",
                 ));
                 if let Some(v) = soc.violation.clone() {
                     return Err(Stop::Violation(v));

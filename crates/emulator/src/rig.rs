@@ -13,7 +13,7 @@ use crate::soc::{Analog, OPTR_NSWBOOT0, Patches, Soc, Wiring};
 use crate::wiring::{self, Standstill};
 use crate::{Machine, Stop};
 
-/// FLASH_OPTR as delivered (RM0440 §5.4.1, FLASH_OPTR reset value from the factory
+/// FLASH_OPTR as delivered (RM0440 §3.7.8, FLASH_OPTR reset value from the factory
 /// option bytes: 0xFFEF_F8AA, nSWBOOT0 = nBOOT0 = 1).
 pub const OPTR_FACTORY: u32 = 0xFFEF_F8AA;
 

@@ -19,7 +19,7 @@ use crate::violation::{Broken, Violation};
 
 pub use crate::periph::UNITS_PER_S;
 
-/// FLASH_OPTR.nSWBOOT0 (RM0440 §5.4.1): 1 = BOOT0 taken from the PB8-BOOT0 pin.
+/// FLASH_OPTR.nSWBOOT0 (RM0440 §3.7.8): 1 = BOOT0 taken from the PB8-BOOT0 pin.
 pub const OPTR_NSWBOOT0: u32 = 1 << 26;
 
 /// TIM1's digital break filter BKF = 0011: f_CK_INT, N = 8 (RM0440 TIMx_BDTR BKF): a
@@ -983,7 +983,7 @@ impl Soc {
                 "no peripheral model at this address (RM0440 §2.2.2 memory map)",
             ));
         };
-        // IWDG registers also take half-word accesses (RM0440 §41.4); NVIC_IPR bytes and
+        // IWDG registers also take half-word accesses (RM0440 §42.4); NVIC_IPR bytes and
         // half words (ARMv7-M B3.4.9, "byte-accessible").
         let narrow_ok = (block == Block::Iwdg && size == 2) || (block == Block::Scs && NVIC_IPR.contains(&off));
         let aligned = off % (size as u32).max(1) == 0;

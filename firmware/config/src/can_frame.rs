@@ -57,7 +57,7 @@ impl RxFrame {
 /// The bit rate \[bit/s\] FDCAN_NBTP `nbtp` makes from a `clock_hz` kernel clock, or
 /// `None` if its fields are out of range or the rate is not a whole number: prescaler
 /// NBRP + 1 (1 … 512), bit 1 + (NTSEG1 + 1) + (NTSEG2 + 1) quanta with NTSEG1 ≥ 1 (RM0440
-/// §44.4.9: NTSEG1 1 … 255, NTSEG2 0 … 127), SJW ≤ TSEG2. The generated `board::CAN_NBTP`
+/// §44.4.7: NTSEG1 1 … 255, NTSEG2 0 … 127), SJW ≤ TSEG2. The generated `board::CAN_NBTP`
 /// is computed by the code generator for the board's bit rate (`motorgen check` refuses a
 /// rate the clock cannot make); the image checks it again with this at compile time.
 pub const fn nbtp_bit_rate(clock_hz: u32, nbtp: u32) -> Option<u32> {

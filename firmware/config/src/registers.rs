@@ -321,7 +321,7 @@ pub const fn trigger_channel(at_carrier_maximum: bool, arr: u16) -> (u8, u16) {
     }
 }
 
-/// FLASH_OPTR bits for the boot source (RM0440 §5.4.1, §3.4.1): nSWBOOT0 (bit 26) = 0
+/// FLASH_OPTR bits for the boot source (RM0440 §3.7.8, §3.4.1): nSWBOOT0 (bit 26) = 0
 /// takes BOOT0 from the nBOOT0 option bit (bit 27) instead of the PB8-BOOT0 pin, and
 /// nBOOT0 = 1 selects the main flash.
 pub const OPTR_NSWBOOT0: u32 = 1 << 26;

@@ -34,13 +34,13 @@ const FILE_ALLOWLIST: &[(&str, &[f64], &str)] = &[
     (
         "can_frame.rs",
         &[128.0, 256.0, 512.0],
-        "FDCAN_NBTP field ranges (RM0440 §44.4.9)",
+        "FDCAN_NBTP field ranges (RM0440 §44.4.7)",
     ),
     ("fmac.rs", &[256.0], "FMAC local memory size in words (RM0440 §18.3.2)"),
     (
         "hw.rs",
-        &[170_000_000.0, 32_000.0],
-        "SYSCLK (DS12288 §3.9) and the LSI (DS12288 Table 56): the clocks codegen's `check` computes with are emitted as board::TIMER_CLOCK_HZ, FDCAN_CLOCK_HZ and LSI_HZ, and config.rs asserts they equal these",
+        &[170_000_000.0, 32_000.0, 85.0],
+        "SYSCLK (DS12288 §3.9) and the LSI (DS12288 Table 56): the clocks codegen's `check` computes with are emitted as board::TIMER_CLOCK_HZ, FDCAN_CLOCK_HZ and LSI_HZ, and config.rs asserts they equal these; PLL_N = 85 (HSI16/4·85/2 = 170 MHz, RM0440 §7.4.4), which equals the reference boards' 500 ns dead time in 170 MHz ticks (board::MIN_PULSE) by coincidence of the same clock",
     ),
 ];
 

@@ -9,8 +9,9 @@
 //! 4. duty (3.4)/(5.1): `DC_x = 1/2 + u_x/U_dc`, saturated to \[0, 1\].
 //!
 //! With a duty limit `d_max < 1` (low-side shunts need the low side on around the
-//! carrier maximum for the sampling, and on every board no pulse may be shorter than the
-//! dead time swallows; the generated `board::MAX_DUTY`, `codegen::design::duty_limit`)
+//! carrier maximum for the sampling, and on every board each compare value stays a dead
+//! time from the carrier's ends, so that each edge's dead interval falls in its own
+//! period; the generated `board::MAX_DUTY`, `codegen::design::duty_limit`)
 //! [`thpwm_limited`] scales the three phase voltages of
 //! step 3 together by `(d_max − 1/2)·U_dc / max_x |u_x|` when their peak exceeds it: the
 //! line-to-line voltages shrink by one factor, so the voltage vector keeps its angle and

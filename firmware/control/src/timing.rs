@@ -50,15 +50,15 @@ pub const fn dead_time_dtg(dead_ns: u32, timer_hz: u32) -> Option<u8> {
     }
 }
 
-/// Largest IWDG_RLR reload (12 bits, RM0440 §41.4.3).
+/// Largest IWDG_RLR reload (12 bits, RM0440 §42.4.3).
 pub const IWDG_MAX_RELOAD: u32 = 0x0FFF;
 /// Largest IWDG_PR prescaler code this firmware uses: 6, divider 4·2⁶ = 256 (RM0440
-/// §41.4.2; code 7 divides by 256 as well).
+/// §42.4.2; code 7 divides by 256 as well).
 pub const IWDG_MAX_PRESCALER: u32 = 6;
 
 /// IWDG prescaler code PR (divider 4·2^PR, PR ≤ [`IWDG_MAX_PRESCALER`]) and reload RLR
 /// (≤ [`IWDG_MAX_RELOAD`]) for a timeout of at least `lsi_ticks` LSI periods (RM0440
-/// §41.3): the smallest divider that fits, reload rounded up. `None` if the timeout
+/// §42.3): the smallest divider that fits, reload rounded up. `None` if the timeout
 /// exceeds 256·4095 ticks.
 pub const fn iwdg_setting(lsi_ticks: u32) -> Option<(u8, u16)> {
     let mut pr = 0;

@@ -145,7 +145,7 @@ impl Signal {
     }
 
     /// The peripheral function the firmware drives it with: TIM1 for the gates and the
-    /// break (RM0440 §29), TIM3 CH1 for the excitation (locked to TIM1, see the firmware's
+    /// break (RM0440 §28), TIM3 CH1 for the excitation (locked to TIM1, see the firmware's
     /// `resolver` module), FDCAN1 for CAN, ADC1/ADC2 for the analog inputs.
     pub fn need(self) -> Need {
         match self {
@@ -423,7 +423,7 @@ pub fn checks_option_bytes(board: &Board) -> bool {
     board.boot0 == Some(Boot0Handling::OptionBytes)
 }
 
-/// The break input's polarity as TIM1_BDTR.BKP (1 = active high, RM0440 §29.6.20).
+/// The break input's polarity as TIM1_BDTR.BKP (1 = active high, RM0440 §28.6.20).
 pub fn break_active_high(board: &Board) -> bool {
     board.break_polarity == Polarity::ActiveHigh
 }

@@ -1,7 +1,7 @@
 //! Which converter samples which analog input, in which rank, for how long.
 //!
 //! The firmware triggers ADC1 and ADC2 together from TIM1 and converts up to four
-//! injected ranks each (ADC_JSQR.JL = 0…3, RM0440 §21.4.21). The plan puts every input
+//! injected ranks each (ADC_JSQR.JL = 0…3, RM0440 §21.7.16). The plan puts every input
 //! on a converter that has it as a channel and prefers, in this order: the resolver's
 //! SIN and COS on different converters, at the same rank where that delays no current's
 //! sample (`align_resolver`; with the lock-step below they are then held at the same

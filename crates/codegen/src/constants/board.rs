@@ -5,7 +5,7 @@
 //! §21.4.21; DS12288 Table 67, thesis A (7.2), (7.4)), the ADC clock, the ADC-to-SI
 //! scalings of the sensing (thesis A (4.16), Table 4.1), the measured phases (thesis A
 //! (2.7)), the dead time (thesis A §3.2), the sampling instant, break polarity and BOOT0
-//! handling (RM0440 §29, §3.4.1; DS12288 §3.7), the trips, the CAN timing, the watchdog
+//! handling (RM0440 §28, §3.4.1; DS12288 §3.7), the trips, the CAN timing, the watchdog
 //! and the conversion time (DS12288 Table 66). Every entry is taken from the board file
 //! (its key is named) or computed from it with the formula given.
 
@@ -230,7 +230,7 @@ impl<'a> OnBoard<'a> {
             formula: Lit(
                 "1: ADC trigger TRGO2 = OC4REF at the carrier maximum (low-side pulse centre); 0: at the minimum",
             ),
-            equation: Lit("RM0440 §29.3.5, §29.6.2"),
+            equation: Lit("RM0440 §29.3.5, §28.6.2"),
             inputs: Of(|c| c.key("sensing.sample_instant")),
             json: Json::At("/board/sample_at_carrier_maximum"),
         },
@@ -286,7 +286,7 @@ impl<'a> OnBoard<'a> {
                 (intv(c.o.break_active_high.into(), "u8", "uint8_t"), physical)
             }),
             formula: Lit("TIM1_BDTR.BKP"),
-            equation: Lit("RM0440 §29.6.20"),
+            equation: Lit("RM0440 §28.6.20"),
             inputs: Of(|c| c.key("break_input.polarity")),
             json: Json::At("/board/break_active_high"),
         },
@@ -416,7 +416,7 @@ impl<'a> OnBoard<'a> {
                 (intv(rate.into(), "u32", "uint32_t"), phys(f64::from(rate), "bit/s"))
             }),
             formula: Lit("FDCAN1 nominal bit rate"),
-            equation: Lit("RM0440 §44.4.9"),
+            equation: Lit("RM0440 §44.4.7"),
             inputs: Of(|c| c.key("can.bit_rate")),
             json: Json::At("/board/can_bit_rate"),
         },
@@ -439,7 +439,7 @@ impl<'a> OnBoard<'a> {
             formula: Lit(
                 "f_FDCAN = rate·prescaler·(1 + TSEG1 + TSEG2), sample point nearest 87.5 %, smallest prescaler, SJW = TSEG2; fields value − 1",
             ),
-            equation: Lit("RM0440 §44.4.9 (FDCAN_NBTP); CiA 601-3"),
+            equation: Lit("RM0440 §44.4.7 (FDCAN_NBTP); CiA 601-3"),
             inputs: Of(|c| {
                 format!(
                     "{}, FDCAN kernel clock {} Hz",
@@ -496,7 +496,7 @@ impl<'a> OnBoard<'a> {
             name: "WATCHDOG_TIMEOUT_S",
             value: F32(|c| c.b.watchdog_timeout_s, "s"),
             formula: Lit("independent-watchdog timeout"),
-            equation: Lit("RM0440 §41"),
+            equation: Lit("RM0440 §42"),
             inputs: Of(|c| c.key("watchdog.timeout")),
             json: Json::At("/board/board/watchdog_timeout_s"),
         },
@@ -527,7 +527,7 @@ impl<'a> OnBoard<'a> {
             name: "MIN_PULSE",
             value: Custom(|c| c.compare_ticks(c.o.duty_limit.min_pulse)),
             formula: Lit(
-                "p = ⌈t_d/2⌉ with t_d TIM1's dead time in timer ticks (DTG decoded): a compare value within p of 0 or ARR gives a pulse 2·g < t_d the dead time swallows, so MAX_COMPARE ≤ ARR − p",
+                "p = t_d, TIM1's dead time in timer ticks (DTG decoded): a compare value within p of 0 or ARR puts the dead interval of its edge in the neighbouring period (below p/2 swallows the pulse), so MAX_COMPARE ≤ ARR − p",
             ),
             equation: Lit("RM0440 §28.3.15 (dead-time insertion), §28.6.20 (DTG); design::duty_limit"),
             inputs: Of(|c| format!("pwm.dead_time ({}), drive.dead_time ({})", c.b.file, c.d.spec_file)),
@@ -537,7 +537,7 @@ impl<'a> OnBoard<'a> {
             name: "MAX_COMPARE",
             value: Custom(|c| c.compare_ticks(c.o.duty_limit.max_compare)),
             formula: Lit(
-                "min(ARR − ⌈h·f_TIM⌉, ARR − MIN_PULSE): the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h and that the dead time does not swallow",
+                "min(ARR − ⌈h·f_TIM⌉, ARR − MIN_PULSE): the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h and keeps its dead intervals in its own period",
             ),
             equation: Lit("RM0440 §29.3.10 (centre-aligned PWM); design::duty_limit"),
             inputs: Of(|c| {

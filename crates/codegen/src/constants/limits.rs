@@ -41,7 +41,7 @@ impl<'a> Limits<'a> {
             name: "VOLTAGE_LIMIT_V",
             value: F32(|c| c.d.current_loop.voltage_limit_v, "V"),
             formula: Lit(
-                "k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's shortest pulse leaves a little less)",
+                "k·U_dc/√3 (voltage circle), k the usable fraction the board's duty limit leaves (1 without a board; with in-line sensing the dead time's gap p = t_d at either end of the carrier leaves a little less)",
             ),
             equation: Lit("thesis B (2.50); design::duty_limit"),
             inputs: Of(|c| {

@@ -32,37 +32,49 @@
 //! **In-line sensing** (Hall sensors, in-line shunts) measures the phase current whatever
 //! the switches do: no limit from the sampling. The reference boards' isolated drivers
 //! (1EDI20N12AF) state no bootstrap supply that a 100 % duty would starve, so only the
-//! dead time's shortest pulse (below) limits it.
+//! dead time (below) limits it.
 //!
-//! **Pulses the dead time swallows.** A compare value within `p` of either end of the
-//! carrier gives a pulse the dead time swallows: OCxREF is low for `2·(ARR − CCR)` timer
-//! ticks about the maximum (high for `2·CCR` about the minimum), and the complementary
-//! output rises `t_d` after OCxREF's edge (RM0440 §28.3.15: "if the delay is greater
-//! than the width of the active output … the corresponding pulse is not generated"), so
-//! a pulse of `2·g < t_d` ticks never turns its switch on: both switches are off for `2·g + t_d` ticks and the
-//! phase follows its current's sign through a diode (`design::dead_time`) instead of the
-//! command. With `t_d` in timer ticks (TIM1_BDTR.DTG as the image programs it, RM0440
-//! §28.6.20),
+//! **Dead intervals that leave their period.** TIM1 turns a switch on `t_d` after its
+//! OCxREF edge (RM0440 §28.3.15, dead-time insertion; `t_d` in timer ticks as the image
+//! programs TIM1_BDTR.DTG, §28.6.20). In one period, update to update (the update at the
+//! underflow, `sections::board::control_timing`), a leg's OCxREF is high from the
+//! update until the up-count reaches CCR, low for `2·(ARR − CCR)` ticks about the
+//! maximum, and high again from the down-count's CCR to the next update; so the period
+//! holds two edges, each followed by a dead interval of `t_d` in which both switches
+//! are off and the phase follows its current's sign through a diode
+//! (`design::dead_time`). The falling edge's interval ends inside the low pulse if
+//! `2·(ARR − CCR) ≥ t_d`, and the rising edge's ends before the update if `CCR ≥ t_d`.
+//! Then every period holds exactly its own two dead intervals: its volt-seconds are its
+//! compare value's less a dead-time error set by the current's sign alone — the same in
+//! every period at a given current, a slow disturbance the current loop's integrator
+//! takes out. A compare value below `t_d` moves the rising edge's interval across the
+//! update: part of this period's error lands in the next one, by how much depends on
+//! the neighbouring compare values, and (below `t_d/2`, where `2·CCR < t_d`) the dead
+//! time swallows the pulse altogether ("if the delay is greater than the width of the
+//! active output … the corresponding pulse is not generated", §28.3.15). So
 //!
 //! ```text
-//! p = ⌈t_d/2⌉   compare units,      d_max ≤ (ARR − p)/ARR
+//! p = t_d   compare units,      d_max ≤ (ARR − p)/ARR
 //! ```
 //!
-//! `p` is the shortest gap whose volt-seconds are the command's (its switch turns on, or
-//! for an even `t_d` just reaches its turn-on); with `d ≤ d_max` and the
-//! modulator's symmetry about 1/2 (`d ≥ 1 − d_max`) no leg's pulse is swallowed at either
-//! end. In-line sensing has no other limit, so there `d_max = 1 − p/ARR` (0.98988 for
-//! 500 ns at 20 kHz). Without it a leg within `p` of a rail loses up to `t_d/2` of its
-//! period's volt-seconds, and which legs do depends on where the rotor's angle falls on
-//! the carrier. Measured (stop 42) with a torque step at 20 000 rpm on fischer-ti085,
-//! whose electrical turn there is 15 carrier periods: the emulated bridge, which swallows
-//! such pulses, put the image's i_q 4–6 A below `verify`'s ideal inverter; and `verify`
-//! itself, with those compare values moved to the nearer of no pulse and `p`, gave
-//! 32.4–39.5 A of i_q 14 ms into the step for four shifts of the rotor by a quarter
-//! period against the carrier (38.7–38.8 A with the rails reached as the ideal inverter
-//! has them). A low-side shunt's window needs more: its two conditions together give
-//! `2·h ≥ t_d + t_set + t_s,k + t_lat > t_d`, so the limit changes only in-line boards
-//! (the code takes the smaller limit all the same). The dead time is TIM1's; a gate
+//! and with the modulator's symmetry about 1/2 (`d ≥ 1 − d_max`) every compare value
+//! lies in `[p, ARR − p]`, both conditions hold. In-line sensing has no other limit, so
+//! there `d_max = 1 − p/ARR` (0.98000 for 500 ns, 85 ticks, at 20 kHz).
+//!
+//! Measured with a torque step at 20 000 rpm on fischer-ti085 (15 carrier periods per
+//! electrical turn, so a leg leaves a rail within a few periods):
+//! - stop 42, d_max = 1: the emulated bridge (which swallows such pulses, as the
+//!   hardware does) put the image's i_q 4–6 A below `verify`'s ideal inverter;
+//! - stop 43, p = ⌈t_d/2⌉ = 43 (no pulse swallowed, but compare values down to 43 < 85):
+//!   torque 0.73–1.68 of the at-speed tolerance off `verify`'s at four carrier phases,
+//!   bisected to the rising edge's interval crossing the update (a bottom leg went
+//!   45 → 115 → 538 ticks in three periods);
+//! - stop 44, p = t_d = 85: 0.41–0.76 at the same four phases (`motor-emulator`'s
+//!   `duty_limit` tests).
+//!
+//! A low-side shunt's window usually needs more: its settling condition alone asks
+//! `h ≥ t_d + t_set − (t_k − t_tick)` (the NUCLEO: h = 1 515 ns against t_d = 500 ns);
+//! the code takes the smaller limit all the same. The dead time is TIM1's; a gate
 //! driver inserting a longer one of its own would need the longer (the NUCLEO's L6398
 //! inserts 320 ns under TIM1's 500 ns; no in-line board in `boards/` has one).
 //!
@@ -95,8 +107,8 @@ pub struct CurrentRank {
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "snake_case")]
 pub enum DutyBound {
-    /// No limit from the sampling (in-line sensing): the dead time's shortest pulse
-    /// (module documentation, "Pulses the dead time swallows").
+    /// No limit from the sampling (in-line sensing): the dead time, p = t_d (module
+    /// documentation, "Dead intervals that leave their period").
     DeadTime,
     /// The dead time and settling before the first current rank's sampling starts.
     Settling,
@@ -114,7 +126,7 @@ pub struct DutyLimit {
     /// Half the low-side pulse the sampling needs, h \[s\] (0 for in-line sensing).
     pub half_window_s: f64,
     /// Which condition set `max_compare`: the sampling window's h, or the dead time's
-    /// shortest pulse.
+    /// gap p.
     pub bound: DutyBound,
     /// Dead time t_d \[s\].
     pub dead_time_s: f64,
@@ -124,15 +136,16 @@ pub struct DutyLimit {
     pub ranks: Vec<CurrentRank>,
     /// The usable fraction of the THPWM linear range U_dc/√3 ([`usable_voltage_fraction`]).
     pub usable_voltage_fraction: f64,
-    /// The shortest pulse the dead time lets through, p = ⌈t_d/2⌉ \[compare units\]
-    /// ([`min_pulse`]; module documentation, "Pulses the dead time swallows").
+    /// The shortest gap a compare value keeps from either end of the carrier, p = t_d
+    /// \[compare units\] ([`min_pulse`]; module documentation, "Dead intervals that leave
+    /// their period").
     pub min_pulse: u16,
 }
 
 /// The duty limit of `board` at switching frequency `fs_hz` with dead time
 /// `dead_time_s` (the longer of the board's and the spec's): low-side shunts as the
-/// module documentation derives it, and on every board no pulse the dead time swallows
-/// (d_max ≤ 1 − p/ARR). `None` when f_s needs an
+/// module documentation derives it, and on every board no dead interval that leaves its
+/// period (d_max ≤ 1 − p/ARR). `None` when f_s needs an
 /// auto-reload TIM1 cannot hold (refused elsewhere, `firmware::pwm_period`).
 pub fn for_board(board: &crate::board::Board, fs_hz: f64, dead_time_s: f64) -> Option<DutyLimit> {
     use crate::board::Placement;
@@ -150,7 +163,7 @@ pub fn for_board(board: &crate::board::Board, fs_hz: f64, dead_time_s: f64) -> O
     let (h, bound) = half_window(&ranks, dead_time_s, settling, 1.0 / timer_hz);
     let p = min_pulse(dead_time_s);
     let window = if low_side { max_compare(h, arr, timer_hz) } else { arr };
-    // The sampling window or the dead time's shortest pulse, whichever is shorter.
+    // The sampling window or the dead time's gap, whichever leaves the smaller duty.
     let (max_compare, bound) = if window <= arr.saturating_sub(p) {
         (window, bound)
     } else {
@@ -170,12 +183,12 @@ pub fn for_board(board: &crate::board::Board, fs_hz: f64, dead_time_s: f64) -> O
     })
 }
 
-/// p = ⌈t_d/2⌉ \[compare units\] of a dead time of `dead_time_s` as TIM1 makes it: the
+/// p = t_d \[compare units\] of a dead time of `dead_time_s` as TIM1 makes it: the
 /// image's DTG code (`firmware::dead_time`, never shorter than asked) decoded to ticks
 /// of the timer clock (RM0440 §28.6.20); 0 where TIM1 cannot make it (refused at the
 /// key, `firmware::dead_time`).
 pub fn min_pulse(dead_time_s: f64) -> u16 {
-    crate::firmware::dead_time(dead_time_s).map_or(0, |dtg| motor_control::timing::dtg_ticks(dtg).div_ceil(2) as u16)
+    crate::firmware::dead_time(dead_time_s).map_or(0, |dtg| motor_control::timing::dtg_ticks(dtg) as u16)
 }
 
 /// The ranks of `board`'s sequences that sample a phase current (padding repeats
@@ -284,14 +297,14 @@ mod tests {
     use super::*;
 
     /// By hand: 500 ns at 170 MHz is 85 ticks (DTG = 85, RM0440 §28.6.20: `0xx` codes
-    /// count single ticks), p = ⌈85/2⌉ = 43; 320 ns → 54.4 → 55 ticks (never shorter),
-    /// p = 28; 1 µs → 170 ticks, above 127 so DTG = 0x80 | (85 − 64) = 0x95, which is
-    /// (64 + 21)·2 = 170 ticks, p = 85; no dead time, p = 0.
+    /// count single ticks), p = 85; 320 ns → 54.4 → 55 ticks (never shorter), p = 55;
+    /// 1 µs → 170 ticks, above 127 so DTG = 0x80 | (85 − 64) = 0x95, which is
+    /// (64 + 21)·2 = 170 ticks, p = 170; no dead time, p = 0.
     #[test]
     fn min_pulse_by_hand() {
-        assert_eq!(min_pulse(500e-9), 43);
-        assert_eq!(min_pulse(320e-9), 28);
-        assert_eq!(min_pulse(1e-6), 85);
+        assert_eq!(min_pulse(500e-9), 85);
+        assert_eq!(min_pulse(320e-9), 55);
+        assert_eq!(min_pulse(1e-6), 170);
         assert_eq!(min_pulse(0.0), 0);
     }
 

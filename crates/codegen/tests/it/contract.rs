@@ -351,14 +351,14 @@ fn the_nucleo_duty_limit_and_usable_voltage_by_hand() {
         fw.voltage_limit_v
     );
     // The same motor on the reference board (Hall sensors): no limit from the sampling,
-    // only the dead time's shortest pulse. By hand: 500 ns at 170 MHz is 85 ticks
-    // (TIM1_BDTR.DTG = 85, RM0440 §28.6.20), p = ⌈85/2⌉ = 43 compare units, so
-    // MAX_COMPARE = 2125 − 43 = 2082 and d_max = 2082/2125 = 0.979765; k from the same
+    // only the dead time's gap. By hand: 500 ns at 170 MHz is 85 ticks
+    // (TIM1_BDTR.DTG = 85, RM0440 §28.6.20), p = t_d = 85 compare units, so
+    // MAX_COMPARE = 2125 − 85 = 2040 and d_max = 2040/2125 = 0.96; k from the same
     // phase-peak property as above.
     let r = on_board("maxon-ec45-flat-70w", &[], "motorgen-reference").unwrap();
     let lr = &r.board.as_ref().unwrap().duty_limit;
-    assert_eq!((lr.min_pulse, lr.max_compare), (43, 2082));
-    assert!((lr.max_duty - 2082.0 / 2125.0).abs() < 1e-12);
+    assert_eq!((lr.min_pulse, lr.max_compare), (85, 2040));
+    assert!((lr.max_duty - 0.96).abs() < 1e-12);
     assert_eq!(lr.bound, codegen::design::duty_limit::DutyBound::DeadTime);
     let kr = lr.usable_voltage_fraction;
     let peak_r = (0..100_000)
@@ -367,7 +367,7 @@ fn the_nucleo_duty_limit_and_usable_voltage_by_hand() {
             kr / s3 * phi.cos() - (3.0 * phi).cos() / (6.0 * s3)
         })
         .fold(f64::MIN, f64::max);
-    assert!((peak_r - (2082.0 / 2125.0 - 0.5)).abs() < 1e-8, "{peak_r}");
+    assert!((peak_r - (0.96 - 0.5)).abs() < 1e-8, "{peak_r}");
     assert!((r.current_loop.voltage_limit_v - kr * 24.0 / s3).abs() < 1e-9);
 }
 
@@ -375,9 +375,10 @@ fn the_nucleo_duty_limit_and_usable_voltage_by_hand() {
 /// a switching frequency that would leave enough. By hand: maxon-ec45-flat-70w switched
 /// at 80 kHz (ARR = 170 MHz/160 kHz = 1062.5 → 1063) on the reference board with a
 /// 5.9 µs dead time: 1003 ticks, encoded as the next TIM1_BDTR.DTG step (`111` codes
-/// count 16 ticks: 63·16 = 1008, RM0440 §28.6.20), so p = 504 and d_max = (1063 − 504)/1063
-/// = 0.5259, below the 0.7722 that leaves half of U_dc/√3 (0.5 plus the THPWM phase peak
-/// at k = ½, by a dense scan of φ).
+/// count 16 ticks: 63·16 = 1008, RM0440 §28.6.20), so p = t_d = 1008 and d_max =
+/// (1063 − 1008)/1063 = 0.0517, below the 0.7722 that leaves half of U_dc/√3 (0.5 plus the
+/// THPWM phase peak at k = ½, by a dense scan of φ); f_s ≤ (1 − 0.7722)·170 MHz/(2·1008)
+/// = 19.21 kHz would leave enough.
 #[test]
 fn a_dead_time_leaving_an_in_line_board_too_little_duty_is_refused_at_its_key() {
     let spec = read("motors/maxon-ec45-flat-70w.toml")
@@ -388,12 +389,38 @@ fn a_dead_time_leaving_an_in_line_board_too_little_duty_is_refused_at_its_key() 
     assert_ne!(long, board);
     let e = codegen::design_with_board("m.toml", &spec, "b.toml", &long).unwrap_err();
     let d = refused_at(&e, &long, "pwm.dead_time");
+    assert!(d.problem.contains("is 1008 timer ticks as TIM1 makes it"), "{e}");
+    assert!(d.problem.contains("only 0.052"), "{e}");
+    assert!(d.accepted.contains("at most 1921"), "{e}");
+    assert!(d.accepted.contains("switching at most"), "{e}");
+}
+
+/// A dead time that leaves an in-line board enough duty for the rule above but too
+/// little voltage for the motor's top speed is refused at the board's key, naming the
+/// dead time (not a sampling window the board does not have), the motor's rule as a note.
+/// By hand: fischer-ti085 at 19 kHz (ARR = 170 MHz/38 kHz = 4473.7 → 4474) with 5929 ns
+/// (1008 ticks): d_max = (4474 − 1008)/4474 = 0.7747, above the 0.7722 floor, leaving
+/// 50.6 % of U_dc/√3, too little for 20 000 rpm (`firmware::FIRMWARE_LIMITS` runs the
+/// same values at 10 000 rpm).
+#[test]
+fn a_dead_time_leaving_a_motor_too_little_voltage_is_refused_naming_the_dead_time() {
+    let spec = set_toml_key(
+        &read("motors/fischer-ti085.toml"),
+        "drive.switching_frequency",
+        "\"19 kHz\"",
+    );
+    let board = set_toml_key(&read("boards/motorgen-reference.toml"), "pwm.dead_time", "\"5929 ns\"");
+    let e = codegen::design_with_board("m.toml", &spec, "b.toml", &board).unwrap_err();
+    let d = refused_at(&e, &board, "pwm.dead_time");
     assert!(
-        d.problem.contains("swallows every pulse shorter than 1008 timer ticks"),
+        d.problem
+            .contains("dead time of 5929 ns keeps every compare value 1008 timer ticks"),
         "{e}"
     );
-    assert!(d.problem.contains("0.526"), "{e}");
-    assert!(d.accepted.contains("switching at most"), "{e}");
+    assert!(d.problem.contains("0.7747") && d.problem.contains("50.6 %"), "{e}");
+    assert!(!d.problem.contains("shunt"), "{e}");
+    assert!(d.accepted.starts_with("a shorter dead time"), "{e}");
+    assert!(d.notes.iter().any(|n| n.contains("max_speed")), "{e}");
 }
 
 /// A settling time that leaves the NUCLEO too little duty is refused at that key: 10 µs

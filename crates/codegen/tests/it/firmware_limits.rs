@@ -162,18 +162,19 @@ fn edited(home: Home, base: &str, edits: &[(&str, &str)]) -> (String, String) {
 }
 
 /// The verdict of `check` on a case's file alone and on the pair with the default motor
-/// (for a board) or board (for a spec).
-fn check(home: Home, file: &str, text: &str) -> Result<(), codegen::Diagnostics> {
+/// (for a board) or board (for a spec), that file edited by `partner`.
+fn check(home: Home, file: &str, text: &str, partner: &[(&str, &str)]) -> Result<(), codegen::Diagnostics> {
+    let other = |rel: &str| partner.iter().fold(read(rel), |t, (k, v)| set_toml_key(&t, k, v));
     match home {
         Home::Spec => {
             codegen::design_source(file, text)?;
             let board = format!("boards/{}.toml", codegen::board::DEFAULT_BOARD);
-            codegen::design_with_board(file, text, &board, &read(&board)).map(|_| ())
+            codegen::design_with_board(file, text, &board, &other(&board)).map(|_| ())
         }
         Home::Board => {
             codegen::board_source(file, text)?;
             let motor = "motors/fischer-ti085.toml";
-            codegen::design_with_board(motor, &read(motor), file, text).map(|_| ())
+            codegen::design_with_board(motor, &other(motor), file, text).map(|_| ())
         }
     }
 }
@@ -186,7 +187,7 @@ fn every_limit_is_refused_at_its_key_and_its_boundary_accepted() {
             let mut edits: Vec<(&str, &str)> = c.also.to_vec();
             edits.push((c.key, c.accepted));
             let (file, text) = edited(c.home, c.base, &edits);
-            if let Err(e) = check(c.home, &file, &text) {
+            if let Err(e) = check(c.home, &file, &text, c.partner) {
                 panic!(
                     "{} = {} ({}): accepted by hand, refused:\n{e}",
                     c.key, c.accepted, c.why
@@ -195,7 +196,7 @@ fn every_limit_is_refused_at_its_key_and_its_boundary_accepted() {
             edits.pop();
             edits.push((c.key, c.refused));
             let (file, text) = edited(c.home, c.base, &edits);
-            let e = check(c.home, &file, &text)
+            let e = check(c.home, &file, &text, c.partner)
                 .err()
                 .unwrap_or_else(|| panic!("{} = {} ({}): refused by hand, accepted", c.key, c.refused, c.why));
             let d =

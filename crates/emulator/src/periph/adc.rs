@@ -34,7 +34,7 @@ pub const ADRDY_POLLS_WITHOUT_RETRY: u32 = 3;
 /// JEXTSEL of TIM1_TRGO2 for ADC1/2 injected conversions (RM0440 §21.4.19, Table 164:
 /// adc_jext_trg8).
 pub const JEXTSEL_TIM1_TRGO2: u32 = 8;
-/// SAR conversion cycles at 12 bits (RM0440 §21.4.16: t_CONV = t_SMPL + 12.5 cycles).
+/// SAR conversion cycles at 12 bits (RM0440 §21.4.12: t_CONV = t_SMPL + 12.5 cycles).
 /// The emulator keeps its own copy of this and [`TRIGGER_LATENCY_CYCLES`], read from
 /// RM0440 and DS12288, rather than codegen's: the design's timing is checked against
 /// them, not taken from itself.

@@ -1,5 +1,5 @@
 //! RCC, PWR and FLASH: the clock tree as far as the image drives it (RM0440 §7 RCC,
-//! §6 PWR, §5 FLASH). Ready flags follow their enables, SYSCLK/HCLK follow SW and HPRE,
+//! §6 PWR, §3 FLASH). Ready flags follow their enables, SYSCLK/HCLK follow SW and HPRE,
 //! and the rules of a switch above 150 MHz are checked at the write that makes HCLK
 //! change.
 
@@ -8,7 +8,7 @@ use crate::violation::Broken;
 /// HSI16 \[Hz\] (RM0440 §7.2.2).
 pub const HSI_HZ: f64 = 16e6;
 
-/// RCC_AHB1ENR, AHB2ENR, APB1ENR1, APB2ENR offsets (RM0440 §7.4.16–§7.4.20).
+/// RCC_AHB1ENR, AHB2ENR, APB1ENR1, APB2ENR offsets (RM0440 §7.4.14–§7.4.19).
 pub const AHB1ENR: u32 = 0x48;
 /// RCC_AHB2ENR.
 pub const AHB2ENR: u32 = 0x4C;
@@ -43,7 +43,7 @@ const PWR_KNOWN: &[u32] = &[
     0x00, 0x04, 0x08, 0x0C, 0x10, 0x14, 0x18, 0x20, 0x24, 0x28, 0x2C, 0x30, 0x34, 0x38, 0x3C, 0x40, 0x44, 0x48, 0x4C,
     0x80,
 ];
-/// Known FLASH registers (RM0440 §5.7).
+/// Known FLASH registers (RM0440 §3.7).
 const FLASH_KNOWN: &[u32] = &[
     0x00, 0x04, 0x08, 0x0C, 0x10, 0x14, 0x18, 0x20, 0x24, 0x28, 0x2C, 0x30, 0x44, 0x48, 0x4C, 0x50, 0x70, 0x74,
 ];
@@ -64,13 +64,13 @@ impl Clocks {
         c.rcc[word(0x08)] = 0x0000_0005;
         // §7.4.4 RCC_PLLCFGR reset 0x0000_1000 (PLLN = 16).
         c.rcc[word(0x0C)] = 0x0000_1000;
-        // §7.4.16 RCC_AHB1ENR reset 0x0000_0100 (FLASHEN).
+        // §7.4.14 RCC_AHB1ENR reset 0x0000_0100 (FLASHEN).
         c.rcc[word(AHB1ENR)] = 0x0000_0100;
-        // §6.4.1 PWR_CR1 reset 0x0000_0200 (VOS range 1); §6.4.18 PWR_CR5 0x0000_0100
+        // §6.4.1 PWR_CR1 reset 0x0000_0200 (VOS range 1); §6.4.22 PWR_CR5 0x0000_0100
         // (R1MODE = 1: range 1 normal, not boost).
         c.pwr[0] = 0x0000_0200;
         c.pwr[word(0x80)] = 0x0000_0100;
-        // §5.7.1 FLASH_ACR reset 0x0000_0600 (ICEN, DCEN, 0 wait states); §5.7.6 FLASH_CR
+        // §3.7.1 FLASH_ACR reset 0x0000_0600 (ICEN, DCEN, 0 wait states); §3.7.6 FLASH_CR
         // reset 0xC000_0000 (LOCK, OPTLOCK).
         c.flash[0] = 0x0000_0600;
         c.flash[word(0x14)] = 0xC000_0000;
@@ -83,7 +83,7 @@ impl Clocks {
         self.rcc[word(off)]
     }
 
-    /// PWR's clock (RCC_APB1ENR1.PWREN, RM0440 §7.4.19).
+    /// PWR's clock (RCC_APB1ENR1.PWREN, RM0440 §7.4.17).
     pub fn pwr_clocked(&self) -> bool {
         self.rcc[word(APB1ENR1)] & (1 << 28) != 0
     }
@@ -149,7 +149,7 @@ impl Clocks {
         self.flash[0] & 0xF
     }
 
-    /// Wait states HCLK needs (RM0440 §5.3.3, Table 29 "Number of wait states according
+    /// Wait states HCLK needs (RM0440 §3, Table 29 "Number of wait states according
     /// to CPU clock (HCLK) frequency"): range 1 boost 34/68/102/136/170 MHz, range 1
     /// normal 30/60/90/120/150 MHz per 0–4 WS.
     fn wait_states_needed(&self, hclk: f64) -> u32 {
@@ -174,7 +174,7 @@ impl Clocks {
             return Err(Broken::new(
                 register,
                 format!(
-                    "HCLK {:.0} MHz with FLASH_ACR.LATENCY = {}: {} wait states needed (RM0440 §5.3.3, Table 29)",
+                    "HCLK {:.0} MHz with FLASH_ACR.LATENCY = {}: {} wait states needed (RM0440 §3, Table 29)",
                     hclk / 1e6,
                     self.latency(),
                     self.wait_states_needed(hclk)
@@ -317,7 +317,7 @@ impl Clocks {
                 if latency < self.wait_states_needed(self.hclk_hz()) {
                     return Err(Broken::new(
                         "FLASH_ACR",
-                        "LATENCY lowered below what the running HCLK needs (RM0440 §5.3.3)",
+                        "LATENCY lowered below what the running HCLK needs (RM0440 §3)",
                     ));
                 }
                 self.flash[0] = value;

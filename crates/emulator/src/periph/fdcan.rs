@@ -28,7 +28,7 @@ const TXBUF: u32 = 0x278;
 const TX_ELEMENTS: u32 = 3;
 const TX_ELEMENT_BYTES: u32 = 72;
 
-/// CCCR bits (RM0440 §44.4.7).
+/// CCCR bits (RM0440 §44.4.6).
 const INIT: u32 = 1;
 const CCE: u32 = 1 << 1;
 /// PSR.BO (RM0440 §44.4.13).
@@ -253,19 +253,19 @@ impl Fdcan {
         }
         self.advance(now);
         Ok(match off {
-            // RXF0S: F0FL, F0GI, F0PI, F0F (RM0440 §44.4.21).
+            // RXF0S: F0FL, F0GI, F0PI, F0F (RM0440 §44.4.22).
             0x90 => {
                 let put = (self.get + self.fill) % RX_ELEMENTS;
                 self.fill | (self.get << 8) | (put << 16) | (u32::from(self.fill == RX_ELEMENTS) << 24)
             }
             // TXFQS: TFFL free level, TFGI get index, TFQPI put index, TFQF full
-            // (RM0440 §44.4.29).
+            // (RM0440 §44.4.27).
             0xC4 => {
                 let pending = self.tx_pending.len() as u32;
                 let get = self.tx_pending.front().map_or(self.tx_put, |p| p.0);
                 (TX_ELEMENTS - pending) | (get << 8) | (self.tx_put << 16) | (u32::from(pending == TX_ELEMENTS) << 21)
             }
-            // TXBRP: the pending requests (RM0440 §44.4.30).
+            // TXBRP: the pending requests (RM0440 §44.4.28).
             0xC8 => self.tx_pending.iter().fold(0, |m, p| m | 1 << p.0),
             _ => self.regs[(off / 4) as usize],
         })
@@ -280,12 +280,12 @@ impl Fdcan {
         if PROTECTED.contains(&off) && self.cccr() & (INIT | CCE) != (INIT | CCE) {
             return Err(Broken::new(
                 format!("FDCAN1+{off:#04x}"),
-                "protected register written without CCCR.INIT = 1 and CCE = 1 (RM0440 §44.4.7)",
+                "protected register written without CCCR.INIT = 1 and CCE = 1 (RM0440 §44.4.6)",
             ));
         }
         match off {
             0x18 => {
-                // CCE can only be set while INIT = 1; clearing INIT clears CCE (§44.4.7).
+                // CCE can only be set while INIT = 1; clearing INIT clears CCE (§44.4.6).
                 let mut v = value;
                 if v & INIT == 0 {
                     v &= !CCE;
@@ -317,7 +317,7 @@ impl Fdcan {
                 }
                 self.regs[0x18 / 4] = v;
             }
-            // RXF0A: acknowledge up to F0AI (RM0440 §44.4.22).
+            // RXF0A: acknowledge up to F0AI (RM0440 §44.4.23).
             0x94 => {
                 let ai = value & 7;
                 if ai >= RX_ELEMENTS || self.fill == 0 {
@@ -330,7 +330,7 @@ impl Fdcan {
                 if n > self.fill {
                     return Err(Broken::new(
                         "FDCAN1_RXF0A",
-                        "acknowledge index beyond the fill level (RM0440 §44.4.22)",
+                        "acknowledge index beyond the fill level (RM0440 §44.4.23)",
                     ));
                 }
                 self.fill -= n;
@@ -338,7 +338,7 @@ impl Fdcan {
                 self.regs[0x94 / 4] = ai;
                 self.last_ack_s = Some(now);
             }
-            // TXBAR: add requests (RM0440 §44.4.31); in FIFO mode the buffer is the put
+            // TXBAR: add requests (RM0440 §44.4.29); in FIFO mode the buffer is the put
             // index TXFQS.TFQPI, free (ST's HAL_FDCAN_AddMessageToTxFifoQ writes the
             // element at the put index and requests that buffer).
             0xCC => {

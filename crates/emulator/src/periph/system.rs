@@ -1,4 +1,4 @@
-//! IWDG (RM0440 §41), SYSCFG (§11), DBGMCU (§47) and the Cortex-M4 system control
+//! IWDG (RM0440 §42), SYSCFG (§10), DBGMCU (§47) and the Cortex-M4 system control
 //! space: NVIC, SCB, SysTick, MPU (plain storage: the image may program a stack guard),
 //! FPU control (ARMv7-M Architecture Reference Manual B3).
 
@@ -33,7 +33,7 @@ impl Default for Iwdg {
 }
 
 impl Iwdg {
-    /// Timeout of the current PR/RLR \[s\]: (RLR + 1)·4·2^PR / f_LSI (RM0440 §41.3.2).
+    /// Timeout of the current PR/RLR \[s\]: (RLR + 1)·4·2^PR / f_LSI (RM0440 §42.3.2).
     pub fn timeout_s(&self) -> f64 {
         f64::from(self.rlr + 1) * f64::from(4u32 << self.pr.min(6)) / LSI_HZ
     }
@@ -52,7 +52,7 @@ impl Iwdg {
     }
 
     /// Register write at `now` \[s\]: keys 0xCCCC start, 0x5555 unlock, 0xAAAA reload
-    /// (RM0440 §41.4.1); PR/RLR/WINR are write-protected without the unlock key (§41.3.6).
+    /// (RM0440 §42.4.1); PR/RLR/WINR are write-protected without the unlock key (§42.3.6).
     pub fn write(&mut self, off: u32, value: u32, now: f64) -> Result<(), Broken> {
         match off {
             0x00 => match value & 0xFFFF {
@@ -76,7 +76,7 @@ impl Iwdg {
                 if !self.unlocked {
                     return Err(Broken::new(
                         "IWDG",
-                        "PR/RLR/WINR written without the 0x5555 key: write-protected (RM0440 §41.3.6)",
+                        "PR/RLR/WINR written without the 0x5555 key: write-protected (RM0440 §42.3.6)",
                     ));
                 }
                 match off {
@@ -91,7 +91,7 @@ impl Iwdg {
     }
 }
 
-/// SYSCFG: CFGR2's lock bits are set-only until reset (RM0440 §11.3.10).
+/// SYSCFG: CFGR2's lock bits are set-only until reset (RM0440 §10.2.8).
 #[derive(Debug, Default)]
 pub struct Syscfg {
     regs: [u32; 10],
@@ -190,7 +190,7 @@ impl Scs {
     }
 
     /// Priority of IRQ `n` as the NVIC holds it: the upper four bits of its IPR byte
-    /// (the STM32G4 implements 4 priority bits, PM0214 §4.3.7 / RM0440 §16.1; the lower
+    /// (the STM32G4 implements 4 priority bits, PM0214 §4.3.7; the lower
     /// bits read as zero).
     pub fn priority(&self, n: u32) -> u8 {
         self.ipr.get(n as usize).copied().unwrap_or(0) & 0xF0

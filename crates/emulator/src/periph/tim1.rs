@@ -28,7 +28,7 @@ const CCER_POLARITY_BITS: u32 = 0xAAAA | (1 << 17) | (1 << 21);
 pub const BIF: u32 = 1 << 7;
 /// SR.UIF.
 const UIF: u32 = 1;
-/// TIMx_CR1.UDIS (RM0440 §29.6.1).
+/// TIMx_CR1.UDIS (RM0440 §28.6.1).
 const UDIS: u32 = 1 << 1;
 
 /// Known TIM1 registers (RM0440 §28.6, register map).
@@ -89,7 +89,7 @@ pub struct Tim1 {
     /// Measured loop timing: bus units from a trigger to the update that made the
     /// compare values written after it active (min, max, count).
     pub trigger_to_update: Option<(u64, u64, u64)>,
-    /// Update events TIMx_CR1.UDIS suppressed (RM0440 §29.6.1: no UEV, the shadow
+    /// Update events TIMx_CR1.UDIS suppressed (RM0440 §28.6.1: no UEV, the shadow
     /// registers keep their values).
     pub updates_disabled: u64,
 }
@@ -104,7 +104,7 @@ impl Tim1 {
     /// Reset state (all registers 0, RM0440 §28.6).
     pub fn new() -> Self {
         let mut regs = [0; 0x70 / 4];
-        // AF1 reset 0x0000_0001: BKINE = 1 (RM0440 §28.6.25).
+        // AF1 reset 0x0000_0001: BKINE = 1 (RM0440 §28.6.27).
         regs[0x60 / 4] = 1;
         Self {
             regs,
@@ -159,7 +159,7 @@ impl Tim1 {
     }
 
     /// Whether the break input, as TIM1 sees it through AF1 (BKINE, BKINP, RM0440
-    /// §28.6.25) and BDTR.BKP, is active for the pin level `level`.
+    /// §28.6.27) and BDTR.BKP, is active for the pin level `level`.
     pub fn break_input_active(&self, level: bool) -> bool {
         let af1 = self.reg(0x60);
         if af1 & 1 == 0 {
@@ -256,7 +256,7 @@ impl Tim1 {
     }
 
     /// The update event at `t` (bus units), unless TIMx_CR1.UDIS holds it off (then
-    /// nothing is loaded: RM0440 §29.6.1); records the trigger → effective delay of
+    /// nothing is loaded: RM0440 §28.6.1); records the trigger → effective delay of
     /// compare values written since the last one.
     pub fn update_at(&mut self, t: u64) {
         if self.regs[0] & UDIS != 0 {
@@ -392,8 +392,9 @@ impl Tim1 {
     /// the update at the underflow OCxREF's high pulse spans the window's start (CNT < CCR
     /// on both sides of CNT = 0), having risen `CCR_prev` ticks before it, the previous
     /// window's compare value — so its output turns on only `dead − CCR_prev` ticks into
-    /// this window when CCR_prev is below the dead time (a bottom leg near its limit p =
-    /// ⌈t_d/2⌉ ticks, `codegen::design::duty_limit`), and at `dead` when OCxREF was low
+    /// this window when CCR_prev is below the dead time (which `codegen::design::duty_limit`
+    /// keeps the image's compare values from since stop 44, p = t_d; a patched image or a
+    /// board file's shorter dead time can still do it), and at `dead` when OCxREF was low
     /// at the previous window's end (CCR_prev = 0); likewise the complement, high from the
     /// start only with CCR = 0, rose there if OCxREF was high at the previous window's end.
     /// Until stop 43 the window's first interval was taken as on from the start: such a leg

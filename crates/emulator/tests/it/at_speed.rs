@@ -67,8 +67,8 @@ pub(crate) const MAX_SPEEDUP: f64 = 3.0;
 /// correction and the compare writes' UDIS window (the at-speed maximum went from at most
 /// 900 to 901 on maxon-ec45-flat-70w), so 950: 22 % of the 4 250 cycles of a 40 kHz
 /// period, the fastest carrier in `motors/`. Stop 42 bounded the in-line boards' duty by
-/// the dead time's shortest pulse (`codegen::design::duty_limit`: d_max = 0.97976 for
-/// maxon-ec45-flat-70w's 40 kHz on the reference board, where it was 1), so the
+/// the dead time (`codegen::design::duty_limit`: d_max = 0.97976 for maxon-ec45-flat-70w's
+/// 40 kHz on the reference board, where it was 1; 0.96 since stop 44's p = t_d), so the
 /// modulator's scaling to `MAX_DUTY` now runs where the voltage nears the circle: its
 /// at-speed maximum went from 939 to 958. So 975: 23 % of the 4 250 cycles at 40 kHz.
 pub const INTERRUPT_BUDGET: u64 = 975;

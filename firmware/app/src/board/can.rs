@@ -96,7 +96,7 @@ impl Can {
         Some(frame)
     }
 
-    /// The Tx FIFO can take a frame (TXFQS.TFQF clear, RM0440 §44.4.29).
+    /// The Tx FIFO can take a frame (TXFQS.TFQF clear, RM0440 §44.4.27).
     pub fn has_room(&self) -> bool {
         self.regs.txfqs().read().tfqf().bit_is_clear()
     }

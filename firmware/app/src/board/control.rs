@@ -224,7 +224,7 @@ impl Control {
         // A commissioning routine replaces the torque demand (or switches off). The break
         // as TIM1 latched it: TIM1_SR.BIF (bit 7) is set by hardware as soon as the break
         // input goes active, and software can clear it only once the input is inactive
-        // again (RM0440 §29.6.5, TIMx_SR (x = 1, 8, 20)) — so a break since the last
+        // again (RM0440 §28.6.5, TIMx_SR (x = 1, 8, 20)) — so a break since the last
         // period's MOE decision aborts a routine here, before its demand is run;
         // `finish_period` reads BIF again before MOE.
         let guards = Guards {

@@ -24,7 +24,7 @@ use motor_control::can_protocol::{FaultMeasurement, Frame};
 /// Routes faults the software can no longer handle to TIM1's break input and stops TIM1
 /// under a debugger halt (defect 6): SYSCFG_CFGR2.CLL (Cortex-M4 LOCKUP), SPL (SRAM
 /// parity), ECCL (flash double ECC error) — write-once lock bits that connect the
-/// error outputs to the break inputs of TIM1/8/20/15/16/17 (RM0440 §11.3.10); without
+/// error outputs to the break inputs of TIM1/8/20/15/16/17 (RM0440 §10.2.8); without
 /// them a core in lockup (a fault inside the HardFault handler) leaves the bridge
 /// switching with the last compare values. DBGMCU_APB2FZ.DBG_TIM1_STOP: TIM1's counter
 /// stops and its outputs go to their safe state while the core is halted (RM0440

@@ -54,7 +54,7 @@ use fault::halt;
 ///    image runs only if FLASH_OPTR.nSWBOOT0 = 0 and nBOOT0 = 1, so PB8's level at the
 ///    next reset cannot start the system bootloader (DS12288 §3.7);
 /// 2. fault routing (defect 6): SYSCFG_CFGR2 locks the Cortex-M4 LOCKUP output, SRAM
-///    parity and flash ECC errors onto TIM1's break (RM0440 §11.3.10 — a locked-up core
+///    parity and flash ECC errors onto TIM1's break (RM0440 §10.2.8 — a locked-up core
 ///    can no longer clear MOE itself), and DBGMCU_APB2FZ.DBG_TIM1_STOP stops TIM1 with its
 ///    outputs in the safe state while a debugger halts the core;
 /// 3. TIM1 with MOE = 0 and its one BDTR write (defects 4, 8), then the pins (the gate

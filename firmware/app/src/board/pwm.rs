@@ -126,7 +126,7 @@ pub fn start(tim1: &pac::TIM1) {
 
 /// Compare values for the next period (preloaded, applied at the next update), written
 /// atomically with respect to the update event: TIMx_CR1.UDIS is held for the three
-/// writes (RM0440 §29.6.1, UDIS: "the update event is not generated, shadow registers
+/// writes (RM0440 §28.6.1, UDIS: "the update event is not generated, shadow registers
 /// keep their value"), so an update can never load one new and two old values — it loads
 /// all three of this period, or, held off, the previous three for one more period. The
 /// writes follow the conversions well before the update one period after the trigger

@@ -1,4 +1,4 @@
-//! Independent watchdog (RM0440 §41), timeout [`crate::config::WATCHDOG`] =
+//! Independent watchdog (RM0440 §42), timeout [`crate::config::WATCHDOG`] =
 //! [`crate::hw::WATCHDOG_CONTROL_PERIODS`] control periods.
 
 use stm32g4::stm32g474 as pac;
@@ -6,7 +6,7 @@ use stm32g4::stm32g474 as pac;
 use super::clocks::{POLL_LIMIT, wait_for};
 use crate::config::WATCHDOG;
 
-/// Key values of IWDG_KR (RM0440 §41.4.1).
+/// Key values of IWDG_KR (RM0440 §42.4.1).
 const KEY_START: u16 = 0xCCCC;
 const KEY_UNLOCK: u16 = 0x5555;
 const KEY_REFRESH: u16 = 0xAAAA;

@@ -1,4 +1,4 @@
-//! Equiripple FIR low-pass for the STM32G474 FMAC (thesis A §6.2, RM0440 §17.3.7–17.3.8).
+//! Equiripple FIR low-pass for the STM32G474 FMAC (thesis A §6.2, RM0440 §18.3.7–18.3.8).
 //!
 //! # Source
 //!
@@ -40,7 +40,7 @@
 //! re-measured on a dense grid ([`GRID_POINTS_PER_TAP`]·N + 1 points per band,
 //! band edges included).
 //!
-//! # FMAC (RM0440 §17.3.7–17.3.8)
+//! # FMAC (RM0440 §18.3.7–18.3.8)
 //!
 //! Inputs, outputs and coefficients are q1.15 (i16); the accumulator is 26 bits,
 //! q4.22, and wraps (it is not saturated); an optional gain of 0–42 dB (left
@@ -71,7 +71,7 @@ use serde::Serialize;
 pub use error::FirError;
 pub use response::magnitude;
 
-/// Words of FMAC local memory (RM0440 §17.3.8) [16-bit words].
+/// Words of FMAC local memory (RM0440 §18.3.8) [16-bit words].
 pub const FMAC_MEMORY_WORDS: usize = 256;
 /// Largest tap count the FMAC holds: 2N + 1 ≤ 256 ⇒ N ≤ 127 \[taps\].
 pub const FMAC_MAX_TAPS: usize = (FMAC_MEMORY_WORDS - 1) / 2;

@@ -144,7 +144,7 @@ pub struct BoardOut {
     /// CAN nominal bit rate \[bit/s\].
     pub can_bit_rate: u32,
     /// FDCAN1's nominal bit timing for that rate from the FDCAN kernel clock
-    /// (`firmware::can_bit_timing`, RM0440 §44.4.9).
+    /// (`firmware::can_bit_timing`, RM0440 §44.4.7).
     pub can_timing: CanBitTiming,
     /// What does not fit between this board and this motor (also in the design's
     /// warnings), located at the board key.
@@ -587,16 +587,15 @@ pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs
     let d_floor = 0.5 + duty_limit::thpwm_phase_peak(MIN_USABLE_VOLTAGE_FRACTION);
     let key = duty_limit_key(l);
     if l.bound == DutyBound::DeadTime {
-        // The dead time's shortest pulse p of ARR = f_TIM/(2·f_s): p/ARR ≤ 1 − d_floor.
+        // The dead time's gap p of ARR = f_TIM/(2·f_s): p/ARR ≤ 1 − d_floor.
         let timer_hz = f64::from(crate::firmware::TIMER_CLOCK_HZ);
         let fs_max = (1.0 - d_floor) * timer_hz / (2.0 * f64::from(l.min_pulse));
         return Some(board_src.error(
             board.span(key),
             key,
             format!(
-                "a dead time of {:.0} ns swallows every pulse shorter than {} timer ticks, so at f_s = {fs_hz} Hz no compare value may come within {} of either end of the carrier: the duty may reach only {:.3}, leaving {:.0} % of U_dc/√3 (at least {:.0} % is needed)",
+                "a dead time of {:.0} ns is {} timer ticks as TIM1 makes it, and no compare value may come within that of either end of the carrier (its edge's dead interval would fall into the next period), so at f_s = {fs_hz} Hz the duty may reach only {:.3}, leaving {:.0} % of U_dc/√3 (at least {:.0} % is needed)",
                 l.dead_time_s * 1e9,
-                2 * u32::from(l.min_pulse),
                 l.min_pulse,
                 l.max_duty,
                 l.usable_voltage_fraction * 100.0,
@@ -672,7 +671,7 @@ pub fn offset_bound_code(board: &Board) -> i32 {
 ///   with CCR4 = 1), or for low-side shunts one tick before the maximum (PWM mode 2,
 ///   CCR4 = ARR − 1) so the conversions start inside the low-side pulse;
 /// * the update event, which loads the preloaded compare values (TIMx_CCMRx.OCxPE, RM0440
-///   §29.3.10), falls at the same carrier extreme, once per period (RCR = 1 with
+///   §28.3.10), falls at the same carrier extreme, once per period (RCR = 1 with
 ///   REP_CNT set at the start, RM0440 §29.3.5);
 /// * the control interrupt writes the compare values after the conversions, within the
 ///   period: the next update, one carrier period 2·ARR ticks after the one at the
