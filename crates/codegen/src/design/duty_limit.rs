@@ -47,7 +47,8 @@
 //! Then every period holds exactly its own two dead intervals: its volt-seconds are its
 //! compare value's less a dead-time error set by the current's sign alone — the same in
 //! every period at a given current, a slow disturbance the current loop's integrator
-//! takes out. A compare value below `t_d` moves the rising edge's interval across the
+//! takes out (the emulated bridge splits each dead interval evenly, so there such a
+//! period gives exactly its compare value's volt-seconds). A compare value below `t_d` moves the rising edge's interval across the
 //! update: part of this period's error lands in the next one, by how much depends on
 //! the neighbouring compare values, and (below `t_d/2`, where `2·CCR < t_d`) the dead
 //! time swallows the pulse altogether ("if the delay is greater than the width of the

@@ -10,7 +10,8 @@
 //! half of the step.
 //!
 //! The run: boot, 20 ms at zero torque, a ramp at zero torque to the at-speed scenario's
-//! top speed, [`HOLD_S`] there, then the MTPA torque on the board's current circle for
+//! top speed, [`HOLD_S`] there (at zero torque, or the step's negative on
+//! mit-mini-cheetah-actuator), then the MTPA torque on the board's current circle for
 //! [`AFTER_S`] ([`AMK_AFTER_S`] on amk-dd5-ipm). The ramp is `verify`'s own field-weakening ramp
 //! ([`motor_verify::field_weakening::Ramp`]: ω rises as (1 − cos πτ)/2, so the
 //! acceleration ends smoothly), its peak acceleration the at-speed scenario's rule, its
@@ -29,10 +30,11 @@
 //! 20 000 rpm); the 400 A variant of the reference board (the same hardware with another
 //! sensing gain) with emrax-228-hv, chalmers-hev50 (15.4 s of ramp at 10 kHz) and
 //! amk-dd5-ipm (20 000 rpm, a 100 ms step, below). unimotor-142umd300 has no ψ_M, so no
-//! torque to step. mit-mini-cheetah-actuator's step stops short of the limit since stop
-//! 44 (peak 0.95294–0.95624 of 0.96 over the four carrier phases): at its top speed,
-//! 2 292 rpm, the drive keeps a margin; its run checks the limit is never passed and the
-//! comparison. The defect: the compare values one timer tick beyond `MAX_COMPARE`
+//! torque to step. mit-mini-cheetah-actuator's step is a reversal (`Pair::before` = −1:
+//! the negative torque held at the top speed, then the positive): from zero torque its
+//! step stopped short of the limit since stop 44 (peak 0.95294–0.95624 of 0.96 over the
+//! four carrier phases; at its top speed, 2 292 rpm, the design keeps a voltage margin),
+//! while the reversal's doubled L·di/dt reaches it for 8–12 periods. The defect: the compare values one timer tick beyond `MAX_COMPARE`
 //! (`Patches::compare_beyond`) and the rule fires.
 //!
 //! Until stop 42 the in-line boards' limit was d_max = 1, and at 20 000 rpm the legs
@@ -70,7 +72,7 @@
 //! |---|---|---|---|
 //! | maxon, NUCLEO | 0.41 / 0.40 / 0.42 / 0.40 | 0.46–0.47 A (0.61) | 0.87859 (0.87859) |
 //! | maxon, reference | 0.04 / 0.06 / 0.04 / 0.05 | 0.03–0.04 A (0.73) | 0.96 (0.96) |
-//! | mit-mini-cheetah, reference | 0.36 / 0.45 / 0.32 / 0.38 | 0.46–0.74 A (1.76) | 0.95294–0.95624 (0.96) |
+//! | mit-mini-cheetah, reference, reversal | 0.36 / 0.45 / 0.32 / 0.38 | 0.46–0.74 A (1.76) | 0.96 (0.96) |
 //! | fischer-ti085, reference | 0.73 / 0.41 / 0.45 / 0.76 | 1.17–2.18 A (3.61) | 0.98 (0.98) |
 //! | emrax-228-hv, 400 A | 0.25 / 0.11 / 0.15 / 0.12 | 1.88–3.33 A (14.22) | 0.98 (0.98) |
 //! | chalmers-hev50, 400 A | 0.02 / 0.02 / 0.03 / 0.03 | 0.50–0.62 A (13.32) | 0.99 (0.99) |
@@ -128,11 +130,12 @@ struct Outcome {
 struct Pair {
     board: &'static str,
     motor: &'static str,
-    /// Whether the step drives the duty to its limit (else the drive keeps a margin at
-    /// its top speed, and the run checks the limit is never passed and the comparison).
-    reaches: bool,
     /// The step's length \[s\]; the comparison takes its second half.
     after_s: f64,
+    /// The torque held at the top speed before the step, as a share of the step's torque
+    /// (0: from zero torque; −1: a reversal, where the current loop's voltage demand
+    /// L·di/dt doubles).
+    before: f64,
 }
 
 /// The scenario's pairs (module documentation): every board in `boards/`.
@@ -140,44 +143,44 @@ const BENCHES: [Pair; 7] = [
     Pair {
         board: "nucleo-g474re-ihm08m1",
         motor: "maxon-ec45-flat-70w",
-        reaches: true,
         after_s: AFTER_S,
+        before: 0.0,
     },
     Pair {
         board: "motorgen-reference",
         motor: "maxon-ec45-flat-70w",
-        reaches: true,
         after_s: AFTER_S,
+        before: 0.0,
     },
     Pair {
         board: "motorgen-reference",
         motor: "mit-mini-cheetah-actuator",
-        reaches: false,
         after_s: AFTER_S,
+        before: -1.0,
     },
     Pair {
         board: "motorgen-reference",
         motor: "fischer-ti085",
-        reaches: true,
         after_s: AFTER_S,
+        before: 0.0,
     },
     Pair {
         board: "motorgen-reference-400a",
         motor: "emrax-228-hv",
-        reaches: true,
         after_s: AFTER_S,
+        before: 0.0,
     },
     Pair {
         board: "motorgen-reference-400a",
         motor: "chalmers-hev50",
-        reaches: true,
         after_s: AFTER_S,
+        before: 0.0,
     },
     Pair {
         board: "motorgen-reference-400a",
         motor: "amk-dd5-ipm",
-        reaches: true,
         after_s: AMK_AFTER_S,
+        before: 0.0,
     },
 ];
 
@@ -193,7 +196,11 @@ fn check_fits(motor: &str, board: &str) {
 /// what stopped it (a strict-mode rule) or switched the drive off.
 fn step_at_top_speed(pair: Pair, patches: Patches, carrier_phase: f64) -> Result<Outcome, String> {
     let Pair {
-        board, motor, after_s, ..
+        board,
+        motor,
+        after_s,
+        before,
+        ..
     } = pair;
     let (mut rig, spec) = crate::closed_loop::closed_loop(Bench::new(motor, board)?.patched(patches))?;
     let design = rig.design.clone();
@@ -254,7 +261,17 @@ fn step_at_top_speed(pair: Pair, patches: Patches, carrier_phase: f64) -> Result
     };
     let t_step = ((at + ramp.duration + HOLD_S) / period).ceil() * period;
     let end = t_step + after_s;
-    let command = move |tf: f64| if tf + 1e-9 >= t_step { torque } else { 0.0 };
+    // The hold's torque from the first setpoint frame after the ramp's end.
+    let t_hold = ((at + ramp.duration) / period).ceil() * period;
+    let command = move |tf: f64| {
+        if tf + 1e-9 >= t_step {
+            torque
+        } else if tf + 1e-9 >= t_hold {
+            before * torque
+        } else {
+            0.0
+        }
+    };
     let started = std::time::Instant::now();
     let mut t = at;
     // When the image took the step's frame off the bus (RXF0A written in its main loop,
@@ -300,7 +317,17 @@ fn step_at_top_speed(pair: Pair, patches: Patches, carrier_phase: f64) -> Result
         .map(|x| x.t - sample_lead)
         .find(|&sigma| sigma > step_taken)
         .ok_or("no sample after the image took the step")?;
-    let command_at = |tv: f64| if t_s + tv >= taken_at - 0.5 * ts { torque } else { 0.0 };
+    // The hold's torque from its frame's time (the image takes it up to a period later;
+    // both have settled by the step, `HOLD_S` later).
+    let command_at = |tv: f64| {
+        if t_s + tv >= taken_at - 0.5 * ts {
+            torque
+        } else if t_s + tv >= t_hold {
+            before * torque
+        } else {
+            0.0
+        }
+    };
     let reference = verify_run(&setup, &command_at, &|t| speed(t_s + t), n, setup.signal_gain());
     let reference = &reference[1..];
 
@@ -378,16 +405,14 @@ const LONG: [&str; 2] = ["fischer-ti085", "amk-dd5-ipm"];
 /// have stopped the run), and the image's torque and currents are verify's.
 fn reaches_the_duty_limit(pairs: impl Iterator<Item = Pair>, phases: &[f64]) {
     for pair in pairs {
-        let Pair {
-            board, motor, reaches, ..
-        } = pair;
+        let Pair { board, motor, .. } = pair;
         check_fits(motor, board);
         for &phase in phases {
             let o = step_at_top_speed(pair, Patches::default(), phase)
                 .unwrap_or_else(|e| panic!("{motor} on {board}, carrier phase {phase}: {e}"));
             let tick = 1.0 / f64::from(o.arr);
             assert!(
-                !reaches || (o.peak_duty >= o.max_duty - tick && o.at_limit > 0),
+                o.peak_duty >= o.max_duty - tick && o.at_limit > 0,
                 "{motor} on {board}, carrier phase {phase}: the duty reached only {} (limit {})",
                 o.peak_duty,
                 o.max_duty
