@@ -105,16 +105,16 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
             let (what, shorter) = if l.bound == design::duty_limit::DutyBound::DeadTime {
                 (
                     format!(
-                        "TIM1's dead time of {:.0} ns keeps every compare value {} timer ticks from the carrier's ends, which",
+                        "TIM1's dead time of {:.0} ns (the longer of the board's and the motor's) keeps every compare value at least {} timer ticks from the carrier's ends and so",
                         l.dead_time_s * 1e9,
                         l.min_pulse
                     ),
-                    "dead time",
+                    "dead time (`pwm.dead_time` here, `drive.dead_time` in the motor file)",
                 )
             } else {
                 (
                     "the low-side shunts' sampling window".to_string(),
-                    "settling, dead or sampling time",
+                    "settling, dead or sampling time on the board",
                 )
             };
             let mut d = board_src.error(
@@ -127,7 +127,7 @@ pub fn design_with_board(file: &str, text: &str, board_file: &str, board_text: &
                     l.usable_voltage_fraction * 100.0,
                     l.usable_voltage_fraction * spec.drive.dc_link_voltage.value / 3f64.sqrt()
                 ),
-                format!("a shorter {shorter} on the board, a lower switching frequency, or a motor that fits the usable voltage"),
+                format!("a shorter {shorter}, a lower switching frequency, or a motor that fits the usable voltage"),
             );
             d.notes.extend(e.0.iter().map(|x| x.to_string()));
             Err(Diagnostics(vec![d]))

@@ -332,7 +332,7 @@ pub fn board(b: &crate::design::BoardOut, d: &Design) -> String {
         let l = &b.duty_limit;
         let why = match l.bound {
             crate::design::duty_limit::DutyBound::DeadTime => format!(
-                "no pulse shorter than the {:.0} ns dead time lets through ({} compare ticks from either end; in-line sensing reads the current whatever the switches do)",
+                "every compare value at least the {:.0} ns dead time ({} ticks) from either end, so each edge's dead interval stays in its own period (in-line sensing reads the current whatever the switches do)",
                 l.dead_time_s * 1e9,
                 l.min_pulse
             ),

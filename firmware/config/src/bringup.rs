@@ -31,7 +31,7 @@ pub fn enable_adc<A: AdcEnable>(adc: &mut A, polls: u32) -> bool {
     false
 }
 
-/// TIM1's break and main-output bits (RM0440 §29.3.18, TIMx_SR.BIF, TIMx_BDTR.MOE).
+/// TIM1's break and main-output bits (RM0440 §28.3.18, TIMx_SR.BIF, TIMx_BDTR.MOE).
 pub trait BreakControl {
     /// TIMx_SR.BIF reads 1 (a break was latched).
     fn break_flag(&mut self) -> bool;
@@ -52,7 +52,7 @@ pub enum BreakActive {
 /// Arms the break after the BKIN pin has been routed (GPIO alternate function) and BKE
 /// set: clears BIF — latched while BKE was set before the pin carried the comparator —
 /// and reads it back. BIF cannot be cleared while the break input is active, and MOE
-/// cannot be set then (RM0440 §29.3.18), so a flag that stays means the drive must stay
+/// cannot be set then (RM0440 §28.3.18), so a flag that stays means the drive must stay
 /// off.
 pub fn arm_break<T: BreakControl>(tim: &mut T) -> Result<(), BreakActive> {
     tim.clear_break_flag();

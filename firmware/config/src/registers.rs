@@ -302,7 +302,7 @@ pub const MMS_OC4REF: u8 = 0b0111;
 /// conduct while CNT < CCRx, so around the carrier minimum (CNT = 0) the high sides
 /// conduct and around the maximum (CNT = ARR) the low sides do. The update event does
 /// *not* mark the sampling instant by itself: it comes once per period, at the underflow
-/// or at the overflow as [`repetition`] sets it up (RM0440 §29.3.5, Figure "update rate
+/// or at the overflow as [`repetition`] sets it up (RM0440 §28.3.5, Figure "update rate
 /// examples depending on mode and TIMx_RCR"). So the trigger comes from channel 4:
 /// OC4REF as TRGO2 for the ADC and as TRGO for TIM3.
 ///
@@ -430,7 +430,7 @@ mod tests {
         assert_eq!(pull(0x06, 0b01)[1], Field::default());
     }
 
-    /// The update event's place, by hand from RM0440 §29.3.5's rule (RCR written before
+    /// The update event's place, by hand from RM0440 §28.3.5's rule (RCR written before
     /// the launch: underflow; after it: overflow): sampling at the minimum keeps RCR = 1
     /// throughout; at the maximum RCR = 0 goes into REP_CNT at the UG and 1 is written
     /// after the launch.

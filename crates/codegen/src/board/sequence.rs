@@ -203,7 +203,7 @@ pub(super) fn plan(
         cx.err(
             p.span.clone(),
             &format!("pins.{}", p.signal.key()),
-            "the analog inputs cannot be shared out over ADC1 and ADC2 (at most four injected conversions each, RM0440 §21.4.21)",
+            "the analog inputs cannot be shared out over ADC1 and ADC2 (at most four injected conversions each, ADC_JSQR.JL, RM0440 §21.7.16)",
             "analog pins that ADC1 and ADC2 both convert (ADC12 inputs), at most four on a converter",
         );
         return None;

@@ -230,7 +230,7 @@ impl<'a> OnBoard<'a> {
             formula: Lit(
                 "1: ADC trigger TRGO2 = OC4REF at the carrier maximum (low-side pulse centre); 0: at the minimum",
             ),
-            equation: Lit("RM0440 §29.3.5, §28.6.2"),
+            equation: Lit("RM0440 §28.3.5, §28.6.2"),
             inputs: Of(|c| c.key("sensing.sample_instant")),
             json: Json::At("/board/sample_at_carrier_maximum"),
         },
@@ -539,7 +539,7 @@ impl<'a> OnBoard<'a> {
             formula: Lit(
                 "min(ARR − ⌈h·f_TIM⌉, ARR − MIN_PULSE): the largest compare value whose low-side pulse 2·(ARR − CCR) covers ±h and keeps its dead intervals in its own period",
             ),
-            equation: Lit("RM0440 §29.3.10 (centre-aligned PWM); design::duty_limit"),
+            equation: Lit("RM0440 §28.3.10 (centre-aligned PWM); design::duty_limit"),
             inputs: Of(|c| {
                 format!(
                     "SAMPLING_HALF_WINDOW_S, MIN_PULSE, drive.switching_frequency ({}), bound: {:?}",
@@ -605,8 +605,8 @@ impl<'a> Adc<'a> {
                 let physical = c.list(|s| format!("{} IN{}", s.pin, s.channel));
                 (u8_array(&c.on.o.adc_channels[c.k]), physical)
             }),
-            formula: Lit("injected ranks JSQ1.. (currents first, RM0440 §21.4.21)"),
-            equation: Lit("RM0440 §21.4.21"),
+            formula: Lit("injected ranks JSQ1.. (currents first, ADC_JSQR, RM0440 §21.7.16)"),
+            equation: Lit("RM0440 §21.7.16 (ADC_JSQR)"),
             inputs: Of(|c| c.on.key("pins")),
             json: Json::Of(|c| format!("/board/adc_channels/{}", c.k)),
         },

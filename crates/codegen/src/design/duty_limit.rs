@@ -2,7 +2,7 @@
 //! current loop and the field weakening.
 //!
 //! **Low-side shunts** carry a phase current only while their leg's low-side switch
-//! conducts. With TIM1's centre-aligned carrier (PWM mode 1, RM0440 §29.3.10) a leg's
+//! conducts. With TIM1's centre-aligned carrier (PWM mode 1, RM0440 §28.3.10) a leg's
 //! OCxREF is low for `(1 − d)·T_s` centred on the carrier maximum; the complementary
 //! output, which turns the low side on, rises one dead time `t_d` after OCxREF falls
 //! (RM0440 §28.3.15) and falls with OCxREF. The ADC trigger TRGO2 rises one timer tick
@@ -36,23 +36,27 @@
 //!
 //! **Dead intervals that leave their period.** TIM1 turns a switch on `t_d` after its
 //! OCxREF edge (RM0440 §28.3.15, dead-time insertion; `t_d` in timer ticks as the image
-//! programs TIM1_BDTR.DTG, §28.6.20). In one period, update to update (the update at the
-//! underflow, `sections::board::control_timing`), a leg's OCxREF is high from the
-//! update until the up-count reaches CCR, low for `2·(ARR − CCR)` ticks about the
-//! maximum, and high again from the down-count's CCR to the next update; so the period
-//! holds two edges, each followed by a dead interval of `t_d` in which both switches
-//! are off and the phase follows its current's sign through a diode
-//! (`design::dead_time`). The falling edge's interval ends inside the low pulse if
-//! `2·(ARR − CCR) ≥ t_d`, and the rising edge's ends before the update if `CCR ≥ t_d`.
-//! Then every period holds exactly its own two dead intervals: its volt-seconds are its
-//! compare value's less a dead-time error set by the current's sign alone — the same in
-//! every period at a given current, a slow disturbance the current loop's integrator
-//! takes out (the emulated bridge splits each dead interval evenly, so there such a
-//! period gives exactly its compare value's volt-seconds). A compare value below `t_d` moves the rising edge's interval across the
-//! update: part of this period's error lands in the next one, by how much depends on
-//! the neighbouring compare values, and (below `t_d/2`, where `2·CCR < t_d`) the dead
-//! time swallows the pulse altogether ("if the delay is greater than the width of the
-//! active output … the corresponding pulse is not generated", §28.3.15). So
+//! programs TIM1_BDTR.DTG, §28.6.20). A leg's OCxREF is high while CNT < CCR: high for
+//! `2·CCR` ticks about the carrier minimum, low for `2·(ARR − CCR)` about the maximum,
+//! so one period, update to update, holds two edges, each followed by a dead interval of
+//! `t_d` in which both switches are off and the phase follows its current's sign through
+//! a diode (`design::dead_time`). With the update at the underflow (the in-line boards,
+//! `sections::board::control_timing`) the high pulse spans the update: the falling
+//! edge's interval ends inside the low pulse if `2·(ARR − CCR) ≥ t_d`, and the rising
+//! edge's ends before the update if `CCR ≥ t_d`. With the update at the maximum (the
+//! low-side boards) the roles swap: the low pulse spans the update, so `ARR − CCR ≥ t_d`
+//! and `2·CCR ≥ t_d`. Where both hold, every period holds exactly its own two dead
+//! intervals: its volt-seconds are its compare value's less a dead-time error set by
+//! the current's sign alone — the same in every period at a given current, a slow
+//! disturbance the current loop's integrator takes out (the emulated bridge splits each
+//! dead interval evenly, so there such a period gives exactly its compare value's
+//! volt-seconds). A compare value within `t_d` of the rail at the update moves its
+//! edge's dead interval across the update: part of this period's error lands in the
+//! next one, by how much depends on the neighbouring compare values, and within
+//! `t_d/2` of either rail the dead time swallows the pulse altogether ("if the delay is
+//! greater than the width of the active output … the corresponding pulse is not
+//! generated", §28.3.15). Keeping every compare value in `[t_d, ARR − t_d]` satisfies
+//! all four conditions whichever extreme the update is at, so
 //!
 //! ```text
 //! p = t_d   compare units,      d_max ≤ (ARR − p)/ARR

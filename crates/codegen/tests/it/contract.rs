@@ -377,8 +377,10 @@ fn the_nucleo_duty_limit_and_usable_voltage_by_hand() {
 /// 5.9 µs dead time: 1003 ticks, encoded as the next TIM1_BDTR.DTG step (`111` codes
 /// count 16 ticks: 63·16 = 1008, RM0440 §28.6.20), so p = t_d = 1008 and d_max =
 /// (1063 − 1008)/1063 = 0.0517, below the 0.7722 that leaves half of U_dc/√3 (0.5 plus the
-/// THPWM phase peak at k = ½, by a dense scan of φ); f_s ≤ (1 − 0.7722)·170 MHz/(2·1008)
-/// = 19.21 kHz would leave enough.
+/// THPWM phase peak at k = ½, by a dense scan of φ, 0.772166). Enough needs ARR ≥
+/// ⌈1008/(1 − 0.772166)⌉ = ⌈4424.3⌉ = 4425, which ARR = ⌊170 MHz/(2·f_s) + ½⌋ gives up to
+/// f_s = 170 MHz/(2·4424.5) = 19 211.2 Hz: at 19 211 Hz ARR = ⌊4424.55 + ½⌋ = 4425 and
+/// d_max = 3417/4425 = 0.77220 (at 19 212 Hz ARR = 4424, d_max = 0.77215, too little).
 #[test]
 fn a_dead_time_leaving_an_in_line_board_too_little_duty_is_refused_at_its_key() {
     let spec = read("motors/maxon-ec45-flat-70w.toml")
@@ -391,7 +393,7 @@ fn a_dead_time_leaving_an_in_line_board_too_little_duty_is_refused_at_its_key() 
     let d = refused_at(&e, &long, "pwm.dead_time");
     assert!(d.problem.contains("is 1008 timer ticks as TIM1 makes it"), "{e}");
     assert!(d.problem.contains("only 0.052"), "{e}");
-    assert!(d.accepted.contains("at most 1921"), "{e}");
+    assert!(d.accepted.contains("at most 19211 Hz"), "{e}");
     assert!(d.accepted.contains("switching at most"), "{e}");
 }
 
@@ -414,7 +416,7 @@ fn a_dead_time_leaving_a_motor_too_little_voltage_is_refused_naming_the_dead_tim
     let d = refused_at(&e, &board, "pwm.dead_time");
     assert!(
         d.problem
-            .contains("dead time of 5929 ns keeps every compare value 1008 timer ticks"),
+            .contains("dead time of 5929 ns (the longer of the board's and the motor's) keeps every compare value at least 1008 timer ticks"),
         "{e}"
     );
     assert!(d.problem.contains("0.7747") && d.problem.contains("50.6 %"), "{e}");

@@ -10,7 +10,7 @@
 //! * Repetition counter: one update event per carrier period, at the board's sampling
 //!   instant — the *underflow* (carrier minimum) for sampling there, RCR = 1 loaded before
 //!   the counter starts; the *overflow* (carrier maximum) for low-side shunts, RCR = 0 at
-//!   the UG and RCR = 1 written right after the start (RM0440 §29.3.5;
+//!   the UG and RCR = 1 written right after the start (RM0440 §28.3.5;
 //!   [`crate::config::REPETITION`]). The preloaded compare values from a control step
 //!   take effect there, one period after the trigger they came from (with the
 //!   currents' hold instants after the trigger and the half period, the loop delay the
@@ -27,7 +27,7 @@
 //! * TIM1_BDTR is written once ([`crate::config::BDTR`]): dead time, OSSR = OSSI = 1 (with
 //!   MOE = 0 all six outputs are driven to their idle, off, levels), break
 //!   enable with the board's polarity and filter, LOCK level 1. LOCK and the fields it
-//!   protects are write-once after reset (RM0440 §29.3.18): the old second write for
+//!   protects are write-once after reset (RM0440 §28.3.18): the old second write for
 //!   LOCK never took effect.
 //! * BKIN clears MOE in hardware; AOE = 0 keeps it cleared. BIF is armed only after the
 //!   pin is routed ([`arm_break`]) and read again before MOE is set each period
@@ -118,7 +118,7 @@ pub fn arm_break(tim1: &pac::TIM1) -> Result<(), BreakActive> {
 pub fn start(tim1: &pac::TIM1) {
     tim1.cr1().modify(|_, w| w.cen().set_bit());
     // With the update at the overflow: RCR written after the launch, long before the
-    // first overflow half a carrier period later (RM0440 §29.3.5).
+    // first overflow half a carrier period later (RM0440 §28.3.5).
     if let Some(rep) = REPETITION.1 {
         tim1.rcr().write(|w| w.rep().set(u16::from(rep)));
     }

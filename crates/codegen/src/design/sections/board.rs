@@ -583,18 +583,17 @@ pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs
     if l.usable_voltage_fraction >= MIN_USABLE_VOLTAGE_FRACTION {
         return None;
     }
-    // d_floor: the duty whose usable fraction is the floor; T_s ≥ 2h/(1 − d_floor).
+    // d_floor: the duty whose usable fraction is the floor.
     let d_floor = 0.5 + duty_limit::thpwm_phase_peak(MIN_USABLE_VOLTAGE_FRACTION);
     let key = duty_limit_key(l);
+    let timer_hz = f64::from(crate::firmware::TIMER_CLOCK_HZ);
     if l.bound == DutyBound::DeadTime {
-        // The dead time's gap p of ARR = f_TIM/(2·f_s): p/ARR ≤ 1 − d_floor.
-        let timer_hz = f64::from(crate::firmware::TIMER_CLOCK_HZ);
-        let fs_max = (1.0 - d_floor) * timer_hz / (2.0 * f64::from(l.min_pulse));
+        let fs_max = highest_switching_frequency(u32::from(l.min_pulse), d_floor);
         return Some(board_src.error(
             board.span(key),
             key,
             format!(
-                "a dead time of {:.0} ns is {} timer ticks as TIM1 makes it, and no compare value may come within that of either end of the carrier (its edge's dead interval would fall into the next period), so at f_s = {fs_hz} Hz the duty may reach only {:.3}, leaving {:.0} % of U_dc/√3 (at least {:.0} % is needed)",
+                "a dead time of {:.0} ns (the longer of the board's and the motor's) is {} timer ticks as TIM1 makes it, and no compare value may come within that of either end of the carrier (its edge's dead interval would fall into the next period), so at f_s = {fs_hz} Hz the duty may reach only {:.3}, leaving {:.0} % of U_dc/√3 (at least {:.0} % is needed)",
                 l.dead_time_s * 1e9,
                 l.min_pulse,
                 l.max_duty,
@@ -602,12 +601,12 @@ pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs
                 MIN_USABLE_VOLTAGE_FRACTION * 100.0
             ),
             format!(
-                "a shorter dead time, or a motor switching at most {:.0} Hz (d_max ≥ {d_floor:.3})",
-                fs_max.floor()
+                "a shorter dead time (`pwm.dead_time` here, `drive.dead_time` in the motor file), or a motor switching at most {fs_max} Hz (d_max ≥ {d_floor:.3})"
             ),
         ));
     }
-    let fs_max = (1.0 - d_floor) / (2.0 * l.half_window_s);
+    let window_ticks = (l.half_window_s * timer_hz - 1e-9).ceil().max(0.0) as u32;
+    let fs_max = highest_switching_frequency(window_ticks, d_floor);
     Some(board_src.error(
         board.span(key),
         key,
@@ -622,10 +621,29 @@ pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs
             MIN_USABLE_VOLTAGE_FRACTION * 100.0
         ),
         format!(
-            "a shorter settling, dead or sampling time, or a motor switching at most {:.0} Hz (d_max ≥ {d_floor:.3})",
-            fs_max.floor()
+            "a shorter settling, dead or sampling time, or a motor switching at most {fs_max} Hz (d_max ≥ {d_floor:.3})"
         ),
     ))
+}
+
+/// The highest whole switching frequency \[Hz\] whose duty limit `(ARR − gap)/ARR`, with
+/// `gap` timer ticks kept from the carrier's end, reaches `d_floor`, ARR as the image
+/// rounds it (`firmware::pwm_period`): the smallest ARR that does is
+/// `⌈gap/(1 − d_floor)⌉`, and `ARR = ⌊f_TIM/(2·f_s) + ½⌋` holds it for
+/// `f_s ≤ f_TIM/(2·(ARR − ½))`; checked down from there whole hertz by whole hertz
+/// against the same rounding. 0 when no 16-bit ARR leaves enough.
+pub fn highest_switching_frequency(gap: u32, d_floor: f64) -> u32 {
+    let timer_hz = f64::from(crate::firmware::TIMER_CLOCK_HZ);
+    let arr_min = (f64::from(gap) / (1.0 - d_floor)).ceil();
+    let leaves_enough = |fs: u32| {
+        crate::firmware::pwm_period(f64::from(fs))
+            .is_ok_and(|arr| f64::from(arr) >= arr_min && (f64::from(arr) - f64::from(gap)) / f64::from(arr) >= d_floor)
+    };
+    let mut fs = (timer_hz / (2.0 * (arr_min - 0.5))).floor().max(0.0) as u32;
+    while fs > 0 && !leaves_enough(fs) {
+        fs -= 1;
+    }
+    fs
 }
 
 /// The ADC's noise taken for the offset average \[12-bit LSB rms\]: the ideal 12-bit
@@ -672,7 +690,7 @@ pub fn offset_bound_code(board: &Board) -> i32 {
 ///   CCR4 = ARR − 1) so the conversions start inside the low-side pulse;
 /// * the update event, which loads the preloaded compare values (TIMx_CCMRx.OCxPE, RM0440
 ///   §28.3.10), falls at the same carrier extreme, once per period (RCR = 1 with
-///   REP_CNT set at the start, RM0440 §29.3.5);
+///   REP_CNT set at the start, RM0440 §28.3.5);
 /// * the control interrupt writes the compare values after the conversions, within the
 ///   period: the next update, one carrier period 2·ARR ticks after the one at the
 ///   trigger, loads them — for the low-side trigger one tick later, as the trigger
