@@ -88,18 +88,10 @@ fn boundary_groups() -> Vec<Group> {
 /// The motor and board texts of a group: the edited file and the default partner with
 /// `partner`'s edits.
 fn pair(home: Home, base: &str, edits: &[(&str, &str)], partner: &[(&str, &str)]) -> Result<(String, String), String> {
+    let other = edit(&read(&home.partner()), partner);
     Ok(match home {
-        Home::Spec => (
-            edit(&read(&format!("motors/{base}.toml")), edits),
-            edit(
-                &read(&format!("boards/{}.toml", codegen::board::DEFAULT_BOARD)),
-                partner,
-            ),
-        ),
-        Home::Board => (
-            edit(&read("motors/fischer-ti085.toml"), partner),
-            edit(&read(&format!("boards/{base}.toml")), edits),
-        ),
+        Home::Spec => (edit(&read(&format!("motors/{base}.toml")), edits), other),
+        Home::Board => (other, edit(&read(&format!("boards/{base}.toml")), edits)),
     })
 }
 

@@ -164,17 +164,16 @@ fn edited(home: Home, base: &str, edits: &[(&str, &str)]) -> (String, String) {
 /// The verdict of `check` on a case's file alone and on the pair with the default motor
 /// (for a board) or board (for a spec), that file edited by `partner`.
 fn check(home: Home, file: &str, text: &str, partner: &[(&str, &str)]) -> Result<(), codegen::Diagnostics> {
-    let other = |rel: &str| partner.iter().fold(read(rel), |t, (k, v)| set_toml_key(&t, k, v));
+    let other = home.partner();
+    let other_text = partner.iter().fold(read(&other), |t, (k, v)| set_toml_key(&t, k, v));
     match home {
         Home::Spec => {
             codegen::design_source(file, text)?;
-            let board = format!("boards/{}.toml", codegen::board::DEFAULT_BOARD);
-            codegen::design_with_board(file, text, &board, &other(&board)).map(|_| ())
+            codegen::design_with_board(file, text, &other, &other_text).map(|_| ())
         }
         Home::Board => {
             codegen::board_source(file, text)?;
-            let motor = "motors/fischer-ti085.toml";
-            codegen::design_with_board(motor, &other(motor), file, text).map(|_| ())
+            codegen::design_with_board(&other, &other_text, file, text).map(|_| ())
         }
     }
 }

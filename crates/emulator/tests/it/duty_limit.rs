@@ -263,17 +263,20 @@ fn step_at_top_speed(pair: Pair, patches: Patches, carrier_phase: f64) -> Result
     };
     let t_step = ((at + ramp.duration + HOLD_S) / period).ceil() * period;
     let end = t_step + after_s;
-    // The hold's torque from the first setpoint frame after the ramp's end.
+    // The hold's torque from the first setpoint frame after the ramp's end, the step's
+    // from `step_at`: the image's frames step at `t_step`, verify where the image took
+    // the step (below).
     let t_hold = ((at + ramp.duration) / period).ceil() * period;
-    let command = move |tf: f64| {
-        if tf + 1e-9 >= t_step {
+    let schedule = move |t: f64, step_at: f64| {
+        if t >= step_at {
             torque
-        } else if tf + 1e-9 >= t_hold {
+        } else if t >= t_hold {
             before * torque
         } else {
             0.0
         }
     };
+    let command = move |tf: f64| schedule(tf + 1e-9, t_step);
     let started = std::time::Instant::now();
     let mut t = at;
     // When the image took the step's frame off the bus (RXF0A written in its main loop,
@@ -321,15 +324,7 @@ fn step_at_top_speed(pair: Pair, patches: Patches, carrier_phase: f64) -> Result
         .ok_or("no sample after the image took the step")?;
     // The hold's torque from its frame's time (the image takes it up to a period later;
     // both have settled by the step, `HOLD_S` later).
-    let command_at = |tv: f64| {
-        if t_s + tv >= taken_at - 0.5 * ts {
-            torque
-        } else if t_s + tv >= t_hold {
-            before * torque
-        } else {
-            0.0
-        }
-    };
+    let command_at = |tv: f64| schedule(t_s + tv, taken_at - 0.5 * ts);
     let reference = verify_run(&setup, &command_at, &|t| speed(t_s + t), n, setup.signal_gain());
     let reference = &reference[1..];
 

@@ -631,13 +631,13 @@ pub fn refuse_duty_limit(board: &Board, board_src: Source<'_>, l: &DutyLimit, fs
 /// rounds it (`firmware::pwm_period`): the smallest ARR that does is
 /// `⌈gap/(1 − d_floor)⌉`, and `ARR = ⌊f_TIM/(2·f_s) + ½⌋` holds it for
 /// `f_s ≤ f_TIM/(2·(ARR − ½))`; checked down from there whole hertz by whole hertz
-/// against the same rounding. 0 when no 16-bit ARR leaves enough.
+/// against the same rounding and the limit itself. 0 when no 16-bit ARR leaves enough.
 pub fn highest_switching_frequency(gap: u32, d_floor: f64) -> u32 {
     let timer_hz = f64::from(crate::firmware::TIMER_CLOCK_HZ);
     let arr_min = (f64::from(gap) / (1.0 - d_floor)).ceil();
     let leaves_enough = |fs: u32| {
         crate::firmware::pwm_period(f64::from(fs))
-            .is_ok_and(|arr| f64::from(arr) >= arr_min && (f64::from(arr) - f64::from(gap)) / f64::from(arr) >= d_floor)
+            .is_ok_and(|arr| (f64::from(arr) - f64::from(gap)) / f64::from(arr) >= d_floor)
     };
     let mut fs = (timer_hz / (2.0 * (arr_min - 0.5))).floor().max(0.0) as u32;
     while fs > 0 && !leaves_enough(fs) {
