@@ -380,17 +380,6 @@ pub enum Home {
     Board,
 }
 
-impl Home {
-    /// The file (repository-relative) a case's file is checked and built with: the
-    /// default board for a spec, fischer-ti085 (the README's default motor) for a board.
-    pub fn partner(self) -> String {
-        match self {
-            Home::Spec => format!("boards/{}.toml", crate::board::DEFAULT_BOARD),
-            Home::Board => "motors/fischer-ti085.toml".to_string(),
-        }
-    }
-}
-
 /// One boundary case of a limit: a value at `key` that `check` accepts and one it refuses
 /// (at that key), with the other edits the base file needs for this limit to be the one
 /// that binds; the numbers are hand calculations, written in `why`.
@@ -408,7 +397,7 @@ pub struct Case {
     pub refused: &'static str,
     /// Further (key, value) edits of the same file, applied to both.
     pub also: &'static [(&'static str, &'static str)],
-    /// (key, value) edits of the file `check` pairs it with ([`Home::partner`]), where
+    /// (key, value) edits of the file `check` pairs it with (`Home::partner`, in `board`), where
     /// another limit would bind first there.
     pub partner: &'static [(&'static str, &'static str)],
     /// The hand calculation.

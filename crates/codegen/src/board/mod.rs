@@ -43,6 +43,20 @@ pub use sequence::{AdcSlot, Converter};
 /// The board `motorgen firmware` and the firmware build use when none is named.
 pub const DEFAULT_BOARD: &str = "motorgen-reference";
 
+// Here rather than beside `Home` in `firmware`, which the board module uses and which
+// must not use it back (tests/it/layers.rs: no module cycles).
+impl crate::firmware::Home {
+    /// The file (repository-relative) a firmware-limit case's file is checked and built
+    /// with: the default board ([`DEFAULT_BOARD`]) for a spec, fischer-ti085 (the README's
+    /// default motor) for a board.
+    pub fn partner(self) -> String {
+        match self {
+            crate::firmware::Home::Spec => format!("boards/{DEFAULT_BOARD}.toml"),
+            crate::firmware::Home::Board => "motors/fischer-ti085.toml".to_string(),
+        }
+    }
+}
+
 /// Frames the drive sends or receives after the setpoint identifier: status, command,
 /// capture header, capture data, capture end (identifiers setpoint_id + 1 … + 5, the
 /// `can` constants group); a board's `can.setpoint_id` leaves room for them.
